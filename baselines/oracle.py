@@ -1,0 +1,55 @@
+"""Scripted interception policy for ``EyeCatchOracle-v0`` (the upper bound of the ladder).
+
+It reads the *true* ball state that only the Oracle variant puts in the observation, extrapolates
+the ballistic flight to the frontal plane ``x = intercept_x`` in front of the right shoulder, and
+holds the hand there, closed (or open, to check that an open hand never catches). It is a check of
+the environment (throws are catchable, catch detection works), not a model of human catching; on
+the foveated variants its input is noisy and it has no filter, so it is not a leaderboard agent.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from visuomotor_gym.envs.catch import HAND_WORKSPACE, SEAT_ORIGIN
+from visuomotor_gym.envs.observation import ObservationLayout
+from visuomotor_gym.scenarios.throws import GRAVITY
+
+_S = ObservationLayout().slices
+
+
+class InterceptOracle:
+    """Move the catch site to where the ball will cross ``x = intercept_x`` (world, metres)."""
+
+    def __init__(self, intercept_x: float = 0.38, grasp_closed: bool = True):
+        self.intercept_x = float(intercept_x)
+        self.grasp = 1.0 if grasp_closed else -1.0
+
+    def intercept_point(self, obs: np.ndarray) -> np.ndarray | None:
+        """World point where the observed ball crosses the intercept plane, or None."""
+        if obs[_S["ball_visible"]][0] < 0.5:
+            return None
+        rot = obs[_S["eye_rot"]].astype(float).reshape(3, 3)
+        eye = obs[_S["eye_pos"]].astype(float) + SEAT_ORIGIN
+        pos = eye + rot @ obs[_S["ball_pos"]].astype(float)
+        vel = rot @ obs[_S["ball_vel"]].astype(float)
+        if vel[0] >= -1e-6:
+            return None
+        t = (self.intercept_x - pos[0]) / vel[0]
+        if t < 0:
+            return None
+        return pos + vel * t + 0.5 * GRAVITY * t * t
+
+    def predict(self, observation, state=None, episode_start=None, deterministic=True):
+        obs = np.asarray(observation, dtype=float)
+        action = np.zeros(9, dtype=np.float32)
+        point = self.intercept_point(obs)
+        if point is not None:
+            lo, hi = HAND_WORKSPACE[:, 0], HAND_WORKSPACE[:, 1]
+            action[:3] = np.clip(2.0 * (point - SEAT_ORIGIN - lo) / (hi - lo) - 1.0, -1.0, 1.0)
+        else:  # hold the hand where it is
+            hand = obs[_S["hand_pos"]].astype(float)
+            lo, hi = HAND_WORKSPACE[:, 0], HAND_WORKSPACE[:, 1]
+            action[:3] = np.clip(2.0 * (hand - lo) / (hi - lo) - 1.0, -1.0, 1.0)
+        action[3] = self.grasp
+        return action, state

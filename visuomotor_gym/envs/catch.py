@@ -1,0 +1,715 @@
+"""EyeCatch: catch a thrown ball while seeing it only through a foveated, saccading eye."""
+
+from __future__ import annotations
+
+import math
+import os
+import warnings
+from collections import deque
+from dataclasses import asdict, fields
+from typing import Any
+
+import gymnasium as gym
+import mujoco
+import numpy as np
+from gymnasium import spaces
+
+from visuomotor_gym.assets import asset_path
+from visuomotor_gym.body import names
+from visuomotor_gym.control.hand import HandControlParams, HandController
+from visuomotor_gym.envs.observation import ObservationLayout
+from visuomotor_gym.envs.rewards import REWARD_TERMS, SHAPED_WEIGHTS, SPARSE_WEIGHTS, catch_reward
+from visuomotor_gym.oculomotor.plant import (
+    DEG,
+    OculomotorParams,
+    OculomotorPlant,
+    angles_from_direction,
+    direction_from_angles,
+)
+from visuomotor_gym.scenarios.throws import BALL_RADIUS, ThrowDistribution, sample_throw
+from visuomotor_gym.vision import foveation
+from visuomotor_gym.vision.foveation import VisionParams
+
+VISION_MODES = ("foveated", "full_view", "oracle")
+CONTROL_MODES = ("hand", "joint")
+OBS_MODES = ("flat", "dict")
+REWARD_MODES = ("sparse", "shaped")
+RENDER_CAMERAS = ("both", "scene", "eye", "over_shoulder")
+
+SEAT_ORIGIN = np.array([0.0, 0.0, 0.5])  # the pelvis joint, world frame
+# Hand workspace of control="hand": an axis-aligned box in the seat frame (min, max), metres.
+HAND_WORKSPACE = np.array([[-0.1, 0.7], [-0.8, 0.3], [0.0, 1.0]])
+# Ready posture at reset (degrees): hand in front of the belly, palm facing the body's midline.
+READY_POSTURE_DEG = {
+    "shoulder_flex": 30.0,
+    "shoulder_abd": 10.0,
+    "shoulder_rot": 0.0,
+    "elbow": 80.0,
+    "forearm_rot": 0.0,
+    "wrist_flex": 0.0,
+    "wrist_dev": 0.0,
+}
+MISS_BEHIND_X = -0.3  # seat frame: the ball is behind the catcher
+MISS_FLOOR_Z = BALL_RADIUS + 0.02  # world frame: the ball is on the floor
+GAZE_AGE_CAP_S = 1.0
+
+
+def _coerce(cls, value, arg_name):
+    """Accept a params dataclass, a dict of its fields, or None (defaults)."""
+    if value is None:
+        return cls()
+    if isinstance(value, cls):
+        return value
+    if isinstance(value, dict):
+        allowed = {f.name for f in fields(cls)}
+        unknown = sorted(set(value) - allowed)
+        if unknown:
+            raise TypeError(f"{arg_name}: unknown field(s) {unknown}; allowed: {sorted(allowed)}")
+        return cls(**value)
+    raise TypeError(f"{arg_name} must be a {cls.__name__}, a dict of its fields or None; got {type(value).__name__}")
+
+
+def _choice(value, allowed, arg_name):
+    if value not in allowed:
+        raise ValueError(f"{arg_name}={value!r} is not one of {list(allowed)}")
+    return value
+
+
+class EyeCatchEnv(gym.Env):
+    """
+    ## Description
+
+    A seated upper body (3-DOF torso, 7-DOF right arm, 2-DOF neck, cyclopean eye) must catch a ball
+    thrown from 3-6 m away, **seeing it only through a human-like eye** (Yeo et al., *Eyecatch*,
+    SIGGRAPH 2012; Eom et al., TOG 2019). The eye perceives the ball's position and velocity in the
+    eye frame with Gaussian noise whose covariance grows with distance and, steeply, with
+    eccentricity from the line of sight (Eyecatch Eq. 1-3); nothing is seen outside the +-60 deg field
+    of view or during a saccade. The eye moves under human limits: saccades of main-sequence
+    duration (<= 800 deg/s, at most one per 200 ms, ballistic) or pursuit (<= 100 deg/s), with a
+    vestibulo-ocular reflex that keeps gaze fixed in the world while the head and torso move. The
+    hand catches only if the ball enters the palm's catch volume while the fingers are closed;
+    otherwise it bounces off (MuJoCo contact).
+
+    Physics runs at 500 Hz, control at 50 Hz (the Kalman step of Eyecatch). The variants of the
+    observability ladder are keyword arguments of this one class (see ``visuomotor_gym.registration``).
+
+    ## Action Space
+
+    One ``Box(-1, 1, (9,), float32)`` with ``control="hand"`` (``(16,)`` with ``control="joint"``).
+    ``env.unwrapped.action_structure`` gives the blocks. Finite values outside [-1, 1] are clipped;
+    NaN, inf and wrong shapes raise ``ValueError``.
+
+    | index (hand) | index (joint) | meaning |
+    |---|---|---|
+    | 0-2 | - | hand target (catch-site centre), seat frame, mapped from [-1, 1] to x in [-0.1, 0.7], y in [-0.8, 0.3], z in [0.0, 1.0] m; the hand reference moves toward it at <= 2 m/s and damped least squares turns it into torso + arm setpoints |
+    | - | 0-9 | torso (3) and arm (7) joint setpoints, mapped linearly onto each joint's range |
+    | 3 | 10 | grasp: -1 open ... 1 closed (the fingers close in ~60 ms) |
+    | 4-5 | 11-12 | requested gaze change in retinal coordinates (azimuth, elevation) of the current eye frame, times ``gaze_action_range_deg`` (60 deg); 0 holds gaze fixed in the world |
+    | 6 | 13 | fixation (vergence) distance, log-mapped onto [0.1, 20] m; does not change the noise in v0 |
+    | 7-8 | 14-15 | head target: neck yaw in [-80, 80] deg and pitch in [-50, 40] deg (0 = straight ahead), reached at <= 300 deg/s |
+
+    ## Observation Space
+
+    ``Box(-inf, inf, (57,), float32)`` by default, or with ``obs_mode="dict"`` a ``Dict`` of the
+    same blocks. ``env.unwrapped.observation_structure`` maps block names to sizes. The ball blocks
+    are what the eye perceived (true state only in ``vision="oracle"``); everything else is
+    proprioception (an efference copy of the eye pose included).
+
+    OBSERVATION_TABLE
+
+    ## Rewards
+
+    A sum of named terms, each in ``info["reward_terms"]``. ``reward="sparse"`` (default): ``catch``
+    = +1 on the step of a catch. ``reward="shaped"`` adds ``miss`` (-0.2 once), ``approach``
+    (-0.01 x hand-ball distance in m), ``foveation`` (+0.005 x exp(-(eccentricity/5 deg)^2) when the
+    ball is seen) and ``effort`` (-0.001 x mean squared action). ``reward_weights`` overrides any
+    weight by name.
+
+    ## Starting State
+
+    The body starts upright in a ready posture with the hand open in front of the belly. A throw is
+    drawn from ``throw_distribution`` (``visuomotor_gym.scenarios.throws``): release 3-6 m ahead,
+    1-2 m high, +-1 m lateral; flight time 0.8-1.4 s; arrival in the catchable region in front of the
+    right shoulder. The ball is released at t = 0; gaze starts on the release point with a 2 deg
+    Gaussian jitter. The same seed gives the same throw across the whole ladder.
+
+    ## Episode End
+
+    Terminated when the ball is caught (``info["is_success"]``), missed (behind the body, on the
+    floor or far away) or the physics diverges (``info["physics_diverged"]``: MuJoCo's bad-state
+    warnings; the last finite observation is returned). Truncated only by the registered
+    ``max_episode_steps`` (125 steps = 2.5 s).
+
+    ## Arguments
+
+    | argument | default | meaning |
+    |---|---|---|
+    | ``render_mode`` | None | ``"rgb_array"`` or ``"human"`` |
+    | ``vision`` | ``"foveated"`` | ``"foveated"``, ``"full_view"`` (foveal noise everywhere, no field-of-view limit, no saccadic blindness) or ``"oracle"`` (true ball state) |
+    | ``vision_noise_scale`` | 1.0 | multiplies every vision standard deviation (10: poor vision) |
+    | ``vision_params`` | None | ``VisionParams`` or a dict of its fields (acuity, Weber fraction, depth noise, field of view) |
+    | ``visual_delay_s`` | 0.0 | visual latency, a multiple of the control period |
+    | ``bounce_wall`` | False | an invisible wall deflects the ball mid-flight |
+    | ``control`` | ``"hand"`` | ``"hand"`` (Cartesian) or ``"joint"`` |
+    | ``obs_mode`` | ``"flat"`` | ``"flat"`` or ``"dict"`` |
+    | ``reward`` | ``"sparse"`` | ``"sparse"`` or ``"shaped"`` |
+    | ``reward_weights`` | None | dict overriding term weights |
+    | ``oculomotor_params`` | None | ``OculomotorParams`` or dict (saccade and pursuit limits, eye ranges, head speed) |
+    | ``hand_params`` | None | ``HandControlParams`` or dict (2 m/s cap, DLS damping) |
+    | ``throw_distribution`` | None | ``ThrowDistribution`` or dict |
+    | ``control_dt`` | 0.02 | control period (s); must be a whole multiple of the 2 ms physics step |
+    | ``catch_radius`` | 0.06 | radius (m) of the palm's catch volume |
+    | ``grasp_closed_fraction`` | 0.6 | finger closure above which the hand counts as closed |
+    | ``gaze_action_range_deg`` | 60.0 | gaze change at action +-1 |
+    | ``render_camera`` | ``"both"`` | ``"both"`` (scene beside eye view), ``"scene"``, ``"eye"``, ``"over_shoulder"`` |
+    | ``width``, ``height`` | 480, 360 | size of each rendered camera image |
+    | ``record_plant`` | False | keep the 500 Hz gaze trace (``env.unwrapped.plant.trace()``) |
+
+    ## Version History
+
+    * v0: initial release.
+    """
+
+    metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 50}
+
+    def __init__(
+        self,
+        render_mode: str | None = None,
+        *,
+        vision: str = "foveated",
+        vision_noise_scale: float = 1.0,
+        vision_params: VisionParams | dict | None = None,
+        visual_delay_s: float = 0.0,
+        bounce_wall: bool = False,
+        control: str = "hand",
+        obs_mode: str = "flat",
+        reward: str = "sparse",
+        reward_weights: dict[str, float] | None = None,
+        oculomotor_params: OculomotorParams | dict | None = None,
+        hand_params: HandControlParams | dict | None = None,
+        throw_distribution: ThrowDistribution | dict | None = None,
+        control_dt: float = 0.02,
+        catch_radius: float = 0.06,
+        grasp_closed_fraction: float = 0.6,
+        gaze_action_range_deg: float = 60.0,
+        render_camera: str = "both",
+        width: int = 480,
+        height: int = 360,
+        record_plant: bool = False,
+        **unknown: Any,
+    ):
+        if unknown:
+            raise TypeError(
+                f"EyeCatchEnv got unknown argument(s) {sorted(unknown)}; allowed: {sorted(self._argument_names())}"
+            )
+        if render_mode is not None:
+            _choice(render_mode, self.metadata["render_modes"], "render_mode")
+        self.render_mode = render_mode
+        self.vision = _choice(vision, VISION_MODES, "vision")
+        self.control = _choice(control, CONTROL_MODES, "control")
+        self.obs_mode = _choice(obs_mode, OBS_MODES, "obs_mode")
+        self.render_camera = _choice(render_camera, RENDER_CAMERAS, "render_camera")
+        if not (math.isfinite(vision_noise_scale) and vision_noise_scale >= 0):
+            raise ValueError(f"vision_noise_scale must be finite and >= 0, got {vision_noise_scale!r}")
+        base_vision = _coerce(VisionParams, vision_params, "vision_params")
+        self.vision_params = base_vision.scaled(vision_noise_scale)
+        if vision == "full_view":
+            self.vision_params = VisionParams(**{**asdict(self.vision_params), "foveated": False})
+        self.oculomotor_params = _coerce(OculomotorParams, oculomotor_params, "oculomotor_params")
+        self.hand_params = _coerce(HandControlParams, hand_params, "hand_params")
+        self.throw_distribution = _coerce(ThrowDistribution, throw_distribution, "throw_distribution")
+        self.bounce_wall = bool(bounce_wall)
+        self.catch_radius = float(catch_radius)
+        self.grasp_closed_fraction = float(grasp_closed_fraction)
+        self.gaze_action_range = float(gaze_action_range_deg) * DEG
+        if not (self.catch_radius > 0 and 0 < self.grasp_closed_fraction <= 1 and self.gaze_action_range > 0):
+            raise ValueError("catch_radius and gaze_action_range_deg must be > 0; grasp_closed_fraction in (0, 1]")
+        weights = dict(SPARSE_WEIGHTS if _choice(reward, REWARD_MODES, "reward") == "sparse" else SHAPED_WEIGHTS)
+        for name, value in (reward_weights or {}).items():
+            if name not in REWARD_TERMS:
+                raise ValueError(f"reward_weights: unknown term {name!r}; known terms: {list(REWARD_TERMS)}")
+            weights[name] = float(value)
+        self.reward_mode = reward
+        self.reward_weights = weights
+        self.width, self.height = int(width), int(height)
+
+        # --- MuJoCo model and name lookups --------------------------------------------------
+        self.model = mujoco.MjModel.from_xml_path(str(asset_path("catch.xml")))
+        self.data = mujoco.MjData(self.model)
+        m = self.model
+        physics_dt = float(m.opt.timestep)
+        ratio = control_dt / physics_dt
+        if not (control_dt > 0 and abs(ratio - round(ratio)) < 1e-9 and round(ratio) >= 1):
+            raise ValueError(
+                f"control_dt={control_dt} must be a positive whole multiple of the physics timestep {physics_dt}"
+            )
+        self.n_substeps = int(round(ratio))
+        self.dt = self.n_substeps * physics_dt
+        self.metadata = {**self.metadata, "render_fps": int(round(1.0 / self.dt))}
+        delay_steps = visual_delay_s / self.dt
+        if not (visual_delay_s >= 0 and abs(delay_steps - round(delay_steps)) < 1e-9):
+            raise ValueError(f"visual_delay_s={visual_delay_s} must be >= 0 and a whole multiple of {self.dt} s")
+        self.visual_delay_s = float(visual_delay_s)
+        self.delay_steps = int(round(delay_steps))
+
+        def jid(name):
+            return mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, name)
+
+        def aid(name):
+            return mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, name)
+
+        body_j = [jid(n) for n in names.BODY_JOINTS]
+        self._body_qpos = np.array([m.jnt_qposadr[j] for j in body_j])
+        self._body_dof = np.array([m.jnt_dofadr[j] for j in body_j])
+        self._body_range = m.jnt_range[body_j].copy()
+        self._body_act = np.array([aid(n) for n in names.BODY_ACTUATORS])
+        self._body_actadr = np.array([m.actuator_actadr[a] for a in self._body_act])
+        neck_j = [jid(n) for n in names.NECK_JOINTS]
+        self._neck_qpos = np.array([m.jnt_qposadr[j] for j in neck_j])
+        self._neck_dof = np.array([m.jnt_dofadr[j] for j in neck_j])
+        self._neck_range = m.jnt_range[neck_j].copy()
+        self._neck_act = np.array([aid(n) for n in names.NECK_ACTUATORS])
+        self._neck_actadr = np.array([m.actuator_actadr[a] for a in self._neck_act])
+        self._grasp_act = aid(names.GRASP_ACTUATOR)
+        grasp_j = jid(names.GRASP)
+        self._grasp_qpos = m.jnt_qposadr[grasp_j]
+        self._grasp_max = float(m.jnt_range[grasp_j, 1])
+        self._eye_qpos = np.array([m.jnt_qposadr[jid(n)] for n in (names.EYE_AZIMUTH, names.EYE_ELEVATION)])
+        self._eye_dof = np.array([m.jnt_dofadr[jid(n)] for n in (names.EYE_AZIMUTH, names.EYE_ELEVATION)])
+        self._fix_qpos = m.jnt_qposadr[jid(names.EYE_FIXATION)]
+        ball_j = jid(names.BALL_JOINT)
+        self._ball_qpos = m.jnt_qposadr[ball_j]
+        self._ball_dof = m.jnt_dofadr[ball_j]
+        self._head_body = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, names.HEAD)
+        self._hand_body = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, names.HAND)
+        self._ball_body = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, names.BALL)
+        self._thrower_body = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, names.THROWER)
+        self._eye_offset = m.body_pos[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, names.EYE)].copy()
+        self._catch_site = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, names.CATCH_SITE)
+        self._wall_geom = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, names.BOUNCE_WALL_GEOM)
+        self._weld = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_EQUALITY, names.CATCH_WELD)
+        self._ready = np.array(
+            [0.0, 0.0, 0.0] + [READY_POSTURE_DEG[n] * DEG for n in names.ARM_JOINTS]
+        )
+        self.hand = HandController(
+            m, self._catch_site, self._body_dof, self._body_qpos, self._body_range, self._ready,
+            n_torso=len(names.TORSO_JOINTS), params=self.hand_params,
+        )
+        self.plant = OculomotorPlant(self.oculomotor_params, record=record_plant)
+        op = self.oculomotor_params
+        self._az_range = (op.eye_azimuth_range_deg[0] * DEG, op.eye_azimuth_range_deg[1] * DEG)
+        self._el_range = (op.eye_elevation_range_deg[0] * DEG, op.eye_elevation_range_deg[1] * DEG)
+        self._log_fix = (math.log(op.fixation_range_m[0]), math.log(op.fixation_range_m[1]))
+        self._bad_warnings = (
+            int(mujoco.mjtWarning.mjWARN_BADQACC),
+            int(mujoco.mjtWarning.mjWARN_BADQPOS),
+            int(mujoco.mjtWarning.mjWARN_BADQVEL),
+        )
+
+        # --- spaces -----------------------------------------------------------------------------
+        if self.control == "hand":
+            self.action_structure = {"hand_target": 3, "grasp": 1, "gaze": 2, "fixation": 1, "head": 2}
+        else:
+            self.action_structure = {"body_joints": 10, "grasp": 1, "gaze": 2, "fixation": 1, "head": 2}
+        n_act = sum(self.action_structure.values())
+        self._n_body_act = n_act - 6
+        self.action_space = spaces.Box(-1.0, 1.0, shape=(n_act,), dtype=np.float32)
+        self.layout = ObservationLayout()
+        self.observation_structure = self.layout.structure
+        self.observation_space = self.layout.flat_space() if obs_mode == "flat" else self.layout.dict_space()
+        self._s = self.layout.slices
+
+        self._renderers: dict[str, mujoco.Renderer] = {}
+        self._viewer = None
+        self._warned_human = False
+        self._reset_episode_state()
+
+    @classmethod
+    def _argument_names(cls) -> list[str]:
+        import inspect
+
+        params = inspect.signature(cls.__init__).parameters
+        return [p for p in params if p not in ("self", "unknown")]
+
+    # ------------------------------------------------------------------------------------------
+    # Gymnasium API
+    # ------------------------------------------------------------------------------------------
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        super().reset(seed=seed)
+        if options:
+            raise ValueError(f"reset options are not supported; got {sorted(options)}")
+        m, d = self.model, self.data
+        mujoco.mj_resetData(m, d)
+        self._reset_episode_state()
+        self.throw = sample_throw(self.np_random, self.throw_distribution, float(m.opt.timestep), self.bounce_wall)
+        throw = self.throw
+
+        # Body in the ready posture, servo setpoints equal to it.
+        d.qpos[self._body_qpos] = self._ready
+        d.act[self._body_actadr] = self._ready
+        d.qpos[self._neck_qpos] = 0.0
+        d.act[self._neck_actadr] = 0.0
+        d.ctrl[:] = 0.0
+        # Ball at the release point, already thrown.
+        d.qpos[self._ball_qpos : self._ball_qpos + 3] = throw.release_pos
+        d.qpos[self._ball_qpos + 3 : self._ball_qpos + 7] = (1.0, 0.0, 0.0, 0.0)
+        d.qvel[self._ball_dof : self._ball_dof + 3] = throw.release_vel
+        m.body_pos[self._thrower_body] = (throw.release_pos[0] + 0.35, throw.release_pos[1], 0.0)
+        self._place_wall(throw)
+        d.eq_active[self._weld] = 0
+        mujoco.mj_forward(m, d)
+        self._warning_counts = [d.warning[w].number for w in self._bad_warnings]
+
+        # Gaze on the release point (the thrower's hand), with a small jitter.
+        eye_pos = d.xpos[self._head_body] + d.xmat[self._head_body].reshape(3, 3) @ self._eye_offset
+        az, el = angles_from_direction(throw.release_pos - eye_pos)
+        gaze = direction_from_angles(az + throw.gaze_offset[0], el + throw.gaze_offset[1])
+        self.plant.reset(gaze, time=0.0)
+        self._fixation = float(np.linalg.norm(throw.release_pos - eye_pos))
+        self._apply_gaze()
+        self._prev_eye_pos = self._eye_pos.copy()
+        self.hand.reset(d.site_xpos[self._catch_site])
+        self._hand_prev = d.site_xpos[self._catch_site].copy()
+        obs = self._observe(saccading=False)
+        self._last_obs = obs
+        info = self._info(caught=False, missed=False, diverged=False, terms={}, visible=bool(obs[self._s["ball_visible"]][0]))
+        info.update(
+            release_pos=throw.release_pos.copy(),
+            release_vel=throw.release_vel.copy(),
+            arrival_pos=throw.arrival_pos.copy(),
+            flight_time=throw.flight_time,
+            wall_y=throw.wall_y,
+        )
+        return self._format(obs), info
+
+    def step(self, action):
+        a = self._check_action(action)
+        m, d = self.model, self.data
+        dt = self.dt
+        nb = self._n_body_act
+
+        # --- eye: requested gaze change, in retinal coordinates of the current eye frame --------
+        q_az = float(a[nb + 1]) * self.gaze_action_range
+        q_el = float(a[nb + 2]) * self.gaze_action_range
+        target = self._eye_rot @ direction_from_angles(q_az, q_el)
+        plant_step = self.plant.step(target, dt, self.n_substeps, self.np_random)
+        lo, hi = self._log_fix
+        fix_target = math.exp(lo + (float(a[nb + 3]) + 1.0) * 0.5 * (hi - lo))
+        vergence = self.oculomotor_params.vergence_max_diopter_s * dt  # rate limit in diopters
+        inv = min(max(1.0 / fix_target, 1.0 / self._fixation - vergence), 1.0 / self._fixation + vergence)
+        self._fixation = 1.0 / inv
+
+        # --- head: velocity-limited position servo -------------------------------------------
+        head_a = a[nb + 4 : nb + 6].astype(float)
+        head_target = np.where(head_a >= 0, head_a * self._neck_range[:, 1], -head_a * self._neck_range[:, 0])
+        vmax = self.oculomotor_params.head_max_deg_s * DEG
+        d.ctrl[self._neck_act] = np.clip((head_target - d.act[self._neck_actadr]) / dt, -vmax, vmax)
+
+        # --- torso and arm ----------------------------------------------------------------------
+        setpoint = d.act[self._body_actadr]
+        if self.control == "hand":
+            lo_ws, hi_ws = HAND_WORKSPACE[:, 0], HAND_WORKSPACE[:, 1]
+            target_seat = lo_ws + (a[:3].astype(float) + 1.0) * 0.5 * (hi_ws - lo_ws)
+            self.hand.advance_reference(target_seat + SEAT_ORIGIN, dt)
+            new_setpoint = self.hand.setpoints(d, setpoint)
+        else:
+            r = self._body_range
+            new_setpoint = r[:, 0] + (a[:10].astype(float) + 1.0) * 0.5 * (r[:, 1] - r[:, 0])
+        ctrl_lo = m.actuator_ctrlrange[self._body_act, 0]
+        ctrl_hi = m.actuator_ctrlrange[self._body_act, 1]
+        d.ctrl[self._body_act] = np.clip((new_setpoint - setpoint) / dt, ctrl_lo, ctrl_hi)
+        d.ctrl[self._grasp_act] = (float(a[nb]) + 1.0) * 0.5 * self._grasp_max
+
+        # --- physics ---------------------------------------------------------------------------
+        caught, diverged = self._simulate()
+        if diverged:
+            info = self._info(caught=False, missed=False, diverged=True, terms={}, visible=False)
+            return self._format(self._last_obs.copy()), 0.0, True, False, info
+        mujoco.mj_kinematics(m, d)
+        mujoco.mj_comPos(m, d)
+        caught = caught or self._catch_now(d.xpos[self._ball_body])
+        self._apply_gaze()
+        obs = self._observe(saccading=plant_step.saccading)
+        self._last_obs = obs
+        self._prev_eye_pos = self._eye_pos.copy()
+
+        # --- outcome and reward --------------------------------------------------------------
+        ball = d.qpos[self._ball_qpos : self._ball_qpos + 3]
+        missed = (not caught) and self._is_missed(ball)
+        hand_ball = float(np.linalg.norm(d.site_xpos[self._catch_site] - ball))
+        visible = bool(obs[self._s["ball_visible"]][0])
+        ecc = foveation.eccentricity(self._true_ball_eye()[0]) if visible else None
+        reward, terms = catch_reward(
+            self.reward_weights, caught, missed, hand_ball, ecc, float(np.mean(np.square(a)))
+        )
+        info = self._info(caught=caught, missed=missed, diverged=False, terms=terms, visible=visible)
+        info["saccade_onset"] = plant_step.saccade_started
+        if self.render_mode == "human":
+            self.render()
+        return self._format(obs), reward, caught or missed, False, info
+
+    def render(self):
+        if self.render_mode is None:
+            gym.logger.warn("render() called without a render_mode; pass render_mode='rgb_array' or 'human'")
+            return None
+        mujoco.mj_kinematics(self.model, self.data)  # the eye joints were written after the last step
+        if self.render_mode == "human":
+            return self._render_human()
+        cams = {
+            "both": (names.SCENE_CAMERA, names.EYE_CAMERA),
+            "scene": (names.SCENE_CAMERA,),
+            "eye": (names.EYE_CAMERA,),
+            "over_shoulder": (names.OVER_SHOULDER_CAMERA,),
+        }[self.render_camera]
+        frames = [self._render_camera(c) for c in cams]
+        return frames[0] if len(frames) == 1 else np.concatenate(frames, axis=1)
+
+    def close(self):
+        for r in self._renderers.values():
+            r.close()
+        self._renderers = {}
+        if self._viewer is not None:
+            self._viewer.close()
+            self._viewer = None
+
+    def __getstate__(self):
+        state = self.__dict__.copy()
+        state["_renderers"] = {}
+        state["_viewer"] = None
+        return state
+
+    # ------------------------------------------------------------------------------------------
+    # Pieces of a step
+    # ------------------------------------------------------------------------------------------
+    def _reset_episode_state(self) -> None:
+        self._caught = False
+        self._delay_buffer: deque = deque(maxlen=self.delay_steps + 1)
+        self._fixation = 1.0
+        self._eye_rot = np.eye(3)
+        self._eye_pos = np.zeros(3)
+        self._eye_in_head = (0.0, 0.0)
+
+    def _check_action(self, action) -> np.ndarray:
+        a = np.asarray(action, dtype=np.float64)
+        if a.shape != self.action_space.shape:
+            raise ValueError(
+                f"action must have shape {self.action_space.shape} (blocks {self.action_structure}), got shape {a.shape}"
+            )
+        if not np.all(np.isfinite(a)):
+            bad = np.flatnonzero(~np.isfinite(a)).tolist()
+            raise ValueError(f"action contains NaN or inf at index {bad}: {a.tolist()}; actions must be finite in [-1, 1]")
+        return np.clip(a, -1.0, 1.0)
+
+    def _place_wall(self, throw) -> None:
+        m = self.model
+        if throw.wall_y is None:
+            m.geom_contype[self._wall_geom] = 0
+            return
+        half = float(m.geom_size[self._wall_geom, 1])
+        # The ball centre reflects at wall_y, so the wall surface sits one ball radius beyond it.
+        center_y = throw.wall_y + throw.wall_side * (BALL_RADIUS + half)
+        mid_x = 0.5 * (throw.release_pos[0] + throw.arrival_pos[0])
+        m.body_pos[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, names.BOUNCE_WALL)] = (mid_x, center_y, 1.5)
+        m.geom_contype[self._wall_geom] = 1
+
+    def _simulate(self) -> tuple[bool, bool]:
+        """Run the physics substeps; return (caught, diverged)."""
+        m, d = self.model, self.data
+        ball_q = self._ball_qpos
+        caught = False
+        if self._caught or not self._ball_near_hand():
+            mujoco.mj_step(m, d, nstep=self.n_substeps)
+        else:  # the ball may cross the catch volume within this step: check every substep
+            for _ in range(self.n_substeps):
+                mujoco.mj_step(m, d)
+                if not caught and self._catch_now(d.xpos[self._ball_body]):
+                    caught = True
+        diverged = any(d.warning[w].number != c for w, c in zip(self._bad_warnings, self._warning_counts))
+        if not diverged:
+            diverged = not (np.all(np.isfinite(d.qpos)) and np.all(np.isfinite(d.qvel)))
+            diverged = diverged or not np.all(np.abs(d.qpos[ball_q : ball_q + 3]) < 1e3)
+        return caught, diverged
+
+    def _ball_near_hand(self) -> bool:
+        d = self.data
+        ball = d.qpos[self._ball_qpos : self._ball_qpos + 3]
+        speed = float(np.linalg.norm(d.qvel[self._ball_dof : self._ball_dof + 3]))
+        gap = float(np.linalg.norm(ball - d.site_xpos[self._catch_site])) - self.catch_radius
+        return gap < (speed + 2.0 * self.hand_params.max_speed_m_s) * self.dt + 0.05
+
+    def _catch_now(self, ball_pos: np.ndarray) -> bool:
+        """Catch test on consistent kinematics: ball centre in the catch volume, fingers closed."""
+        if self._caught:
+            return False
+        d = self.data
+        closed = d.qpos[self._grasp_qpos] >= self.grasp_closed_fraction * self._grasp_max
+        if not closed:
+            return False
+        diff = ball_pos - d.site_xpos[self._catch_site]
+        if float(diff @ diff) > self.catch_radius**2:
+            return False
+        self._caught = True
+        self._activate_weld()
+        return True
+
+    def _activate_weld(self) -> None:
+        """Hold the caught ball in the hand: weld it at its current pose relative to the hand."""
+        m, d = self.model, self.data
+        hand_pos, hand_quat = d.xpos[self._hand_body], d.xquat[self._hand_body]
+        ball_pos, ball_quat = d.xpos[self._ball_body], d.xquat[self._ball_body]
+        rel_pos = d.xmat[self._hand_body].reshape(3, 3).T @ (ball_pos - hand_pos)
+        inv = np.zeros(4)
+        mujoco.mju_negQuat(inv, hand_quat)
+        rel_quat = np.zeros(4)
+        mujoco.mju_mulQuat(rel_quat, inv, ball_quat)
+        m.eq_data[self._weld, 3:6] = rel_pos
+        m.eq_data[self._weld, 6:10] = rel_quat
+        d.eq_active[self._weld] = 1
+
+    def _is_missed(self, ball: np.ndarray) -> bool:
+        x = ball[0] - SEAT_ORIGIN[0]
+        return bool(x < MISS_BEHIND_X or ball[2] < MISS_FLOOR_Z or abs(ball[1]) > 5.0 or x > 10.0 or ball[2] > 15.0)
+
+    def _apply_gaze(self) -> None:
+        """Vestibulo-ocular reflex: turn the world gaze into eye-in-head angles for the current head.
+
+        Clamps to the eye's range (Eom 4.1); if clamped, the plant's gaze becomes what was reached.
+        Needs current head kinematics. Sets the eye joints and the cached eye frame.
+        """
+        d = self.data
+        head_rot = d.xmat[self._head_body].reshape(3, 3)
+        gaze_head = head_rot.T @ self.plant.gaze
+        az, el = angles_from_direction(gaze_head)
+        az_c = min(max(az, self._az_range[0]), self._az_range[1])
+        el_c = min(max(el, self._el_range[0]), self._el_range[1])
+        ca, sa, ce, se = math.cos(az_c), math.sin(az_c), math.cos(el_c), math.sin(el_c)
+        eye_in_head = np.array([[ca * ce, -sa, -ca * se], [sa * ce, ca, -sa * se], [se, 0.0, ce]])
+        self._eye_rot = head_rot @ eye_in_head
+        if az_c != az or el_c != el:
+            self.plant.constrain(self._eye_rot[:, 0].copy())
+        self._eye_pos = d.xpos[self._head_body] + head_rot @ self._eye_offset
+        self._eye_in_head = (az_c, el_c)
+        d.qpos[self._eye_qpos[0]] = az_c
+        d.qpos[self._eye_qpos[1]] = el_c
+        d.qvel[self._eye_dof] = 0.0
+        d.qpos[self._fix_qpos] = self._fixation
+
+    def _true_ball_eye(self) -> tuple[np.ndarray, np.ndarray]:
+        """True ball position and velocity in the current eye frame (Eyecatch Eq. 6-7, no noise)."""
+        d = self.data
+        ball = d.qpos[self._ball_qpos : self._ball_qpos + 3]
+        vel = d.qvel[self._ball_dof : self._ball_dof + 3]
+        rt = self._eye_rot.T
+        return rt @ (ball - self._eye_pos), rt @ vel
+
+    def _see_ball(self, saccading: bool) -> tuple[np.ndarray, np.ndarray, bool]:
+        """One visual sample of the ball: (position, velocity, visible), eye frame."""
+        pos_eye, vel_eye = self._true_ball_eye()
+        if self.vision == "oracle":
+            return pos_eye, vel_eye, True
+        vp = self.vision_params
+        if vp.foveated and (saccading or not foveation.is_in_field_of_view(pos_eye, vp)):
+            return np.zeros(3), np.zeros(3), False
+        d = self.data
+        # Retinal slip: line-of-sight angular velocity minus the eye's own (world) angular velocity.
+        rel = d.qpos[self._ball_qpos : self._ball_qpos + 3] - self._eye_pos
+        rel_vel = d.qvel[self._ball_dof : self._ball_dof + 3] - (self._eye_pos - self._prev_eye_pos) / self.dt
+        dist2 = float(rel @ rel)
+        slip = np.cross(rel, rel_vel) / dist2 - self.plant.angular_velocity
+        along = rel * (float(slip @ rel) / dist2)
+        retinal_speed = float(np.linalg.norm(slip - along))
+        pos, vel = foveation.sample(pos_eye, vel_eye, retinal_speed, vp, self.np_random)
+        return pos, vel, True
+
+    def _observe(self, saccading: bool) -> np.ndarray:
+        d = self.data
+        s = self._s
+        obs = np.empty(self.layout.size, dtype=np.float32)
+        sample = self._see_ball(saccading)
+        if self.delay_steps:
+            self._delay_buffer.append(sample)
+            if len(self._delay_buffer) <= self.delay_steps:
+                sample = (np.zeros(3), np.zeros(3), False)  # nothing has reached the brain yet
+            else:
+                sample = self._delay_buffer[0]
+        pos, vel, visible = sample
+        obs[s["ball_pos"]] = pos
+        obs[s["ball_vel"]] = vel
+        obs[s["ball_visible"]] = 1.0 if visible else 0.0
+        obs[s["ball_age"]] = self.visual_delay_s
+        obs[s["eye_pos"]] = self._eye_pos - SEAT_ORIGIN
+        obs[s["eye_rot"]] = self._eye_rot.ravel()
+        obs[s["eye_in_head"]] = self._eye_in_head
+        obs[s["fixation"]] = self._fixation
+        since = self.plant.time - self.plant.last_onset
+        obs[s["saccade"]] = (1.0 if self.plant.saccade is not None else 0.0, min(since, GAZE_AGE_CAP_S))
+        obs[s["head_qpos"]] = d.qpos[self._neck_qpos]
+        obs[s["head_qvel"]] = d.qvel[self._neck_dof]
+        obs[s["body_qpos"]] = d.qpos[self._body_qpos]
+        obs[s["body_qvel"]] = d.qvel[self._body_dof]
+        obs[s["hand_pos"]] = d.site_xpos[self._catch_site] - SEAT_ORIGIN
+        hand = d.site_xpos[self._catch_site]
+        obs[s["hand_vel"]] = (hand - self._hand_prev) / self.dt
+        self._hand_prev = hand.copy()
+        obs[s["grasp"]] = d.qpos[self._grasp_qpos] / self._grasp_max
+        obs[s["time"]] = d.time
+        return obs
+
+    def _format(self, obs: np.ndarray):
+        if self.obs_mode == "flat":
+            return obs
+        return self.layout.to_dict(obs)
+
+    def _info(self, *, caught: bool, missed: bool, diverged: bool, terms: dict, visible: bool) -> dict:
+        """Step information. The true state in here is for scoring only: never feed it to a policy."""
+        d = self.data
+        return {
+            "is_success": bool(self._caught),
+            "caught": caught,
+            "missed": missed,
+            "physics_diverged": diverged,
+            "reward_terms": terms,
+            "ball_visible": visible,
+            "in_saccade": self.plant.saccade is not None,
+            "saccade_onset": False,
+            "time": float(d.time),
+            "ball_pos": d.qpos[self._ball_qpos : self._ball_qpos + 3].copy(),
+            "ball_vel": d.qvel[self._ball_dof : self._ball_dof + 3].copy(),
+            "hand_pos": d.site_xpos[self._catch_site].copy(),
+            "gaze_dir": self.plant.gaze.copy(),
+            "eye_pos": self._eye_pos.copy(),
+            "head_qpos": d.qpos[self._neck_qpos].copy(),
+        }
+
+    # ------------------------------------------------------------------------------------------
+    # Rendering
+    # ------------------------------------------------------------------------------------------
+    def _render_camera(self, camera: str) -> np.ndarray:
+        renderer = self._renderers.get(camera)
+        if renderer is None:
+            renderer = mujoco.Renderer(self.model, self.height, self.width)
+            self._renderers[camera] = renderer
+        renderer.update_scene(self.data, camera=camera)
+        return renderer.render().copy()
+
+    def _render_human(self):
+        headless = not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+        if headless or os.environ.get("MUJOCO_GL", "glfw") in ("egl", "osmesa"):
+            if not self._warned_human:
+                warnings.warn(
+                    "render_mode='human' needs a display and MUJOCO_GL=glfw; nothing is shown. "
+                    "Use render_mode='rgb_array' headless.",
+                    stacklevel=2,
+                )
+                self._warned_human = True
+            return None
+        if self._viewer is None:
+            import mujoco.viewer
+
+            self._viewer = mujoco.viewer.launch_passive(self.model, self.data)
+        self._viewer.sync()
+        return None
+
+
+if EyeCatchEnv.__doc__:
+    EyeCatchEnv.__doc__ = EyeCatchEnv.__doc__.replace("OBSERVATION_TABLE", ObservationLayout().markdown_table())

@@ -1,0 +1,102 @@
+"""The throw distribution of the catch family (DESIGN section 2.6), drawn from ``np_random`` only.
+
+A throw is sampled *backwards* from where it should arrive:
+
+1. a release point 3-6 m in front of the catcher, 1.0-2.0 m high, up to 1 m to either side;
+2. an arrival point inside the catchable region in front of the right shoulder;
+3. a flight time of 0.8-1.4 s;
+4. the launch velocity that carries the ball from 1 to 2 in exactly that time under gravity.
+
+Step 4 inverts MuJoCo's semi-implicit Euler integrator exactly (``p_N = p_0 + N dt v_0 +
+g dt^2 N (N+1) / 2``), so the simulated ball passes the arrival point at the sampled time to
+floating-point precision, not just to O(dt).
+
+Every throw consumes the same random numbers in the same order whatever the variant, so a seed
+gives the same throw across the whole observability ladder. ``EyeCatchBounce-v0`` additionally
+places an invisible vertical wall beside the flight and aims the ball at the arrival point's mirror
+image, so that after an elastic, frictionless bounce it still reaches the arrival point
+(Eyecatch section 5).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+GRAVITY = np.array([0.0, 0.0, -9.81])
+BALL_RADIUS = 0.025
+
+
+@dataclass(frozen=True)
+class ThrowDistribution:
+    """Uniform ranges (min, max) of the throw, in world coordinates (metres, seconds, degrees)."""
+
+    release_x_m: tuple[float, float] = (3.0, 6.0)  # distance in front of the catcher
+    release_y_m: tuple[float, float] = (-1.0, 1.0)  # lateral offset (+y is the catcher's left)
+    release_z_m: tuple[float, float] = (1.0, 2.0)  # release height above the floor
+    flight_time_s: tuple[float, float] = (0.8, 1.4)
+    arrival_x_m: tuple[float, float] = (0.30, 0.45)  # catchable region of the right arm
+    arrival_y_m: tuple[float, float] = (-0.40, -0.10)
+    arrival_z_m: tuple[float, float] = (0.85, 1.20)
+    gaze_jitter_deg: float = 2.0  # initial gaze: at the thrower's hand, +- this (std)
+    wall_clearance_m: tuple[float, float] = (0.8, 1.4)  # Bounce: wall distance beyond the path
+
+    def __post_init__(self) -> None:
+        for name, value in self.__dict__.items():
+            if isinstance(value, tuple):
+                lo, hi = value
+                if not (np.isfinite(lo) and np.isfinite(hi) and lo <= hi):
+                    raise ValueError(f"ThrowDistribution.{name} must be a (min, max) pair, got {value!r}")
+        if self.flight_time_s[0] <= 0:
+            raise ValueError("ThrowDistribution.flight_time_s must be positive")
+
+
+@dataclass(frozen=True)
+class Throw:
+    """One sampled throw. Positions in metres (world frame), velocities in m/s."""
+
+    release_pos: np.ndarray
+    release_vel: np.ndarray
+    arrival_pos: np.ndarray  # where the ball centre is at ``flight_time`` (after any bounce)
+    flight_time: float  # s, a whole number of physics steps
+    gaze_offset: np.ndarray  # initial gaze offset from the release point (azimuth, elevation), rad
+    wall_y: float | None = None  # Bounce: y of the wall surface the ball centre reflects from
+    wall_side: float = 0.0  # +1: wall on the left of the flight, -1: on the right
+
+
+def launch_velocity(release: np.ndarray, arrival: np.ndarray, n_steps: int, dt: float) -> np.ndarray:
+    """Initial velocity that lands exactly on ``arrival`` after ``n_steps`` semi-implicit Euler steps."""
+    return (arrival - release - GRAVITY * dt * dt * n_steps * (n_steps + 1) / 2.0) / (n_steps * dt)
+
+
+def sample_throw(
+    rng: np.random.Generator, dist: ThrowDistribution, dt: float, bounce: bool = False
+) -> Throw:
+    """Draw one throw; ``dt`` is the physics timestep the ball is integrated with."""
+    u = rng.random(10)  # always ten numbers, in this order, for every variant
+
+    def lerp(rng_range, x):
+        return rng_range[0] + (rng_range[1] - rng_range[0]) * x
+
+    release = np.array([lerp(dist.release_x_m, u[0]), lerp(dist.release_y_m, u[1]), lerp(dist.release_z_m, u[2])])
+    arrival = np.array([lerp(dist.arrival_x_m, u[3]), lerp(dist.arrival_y_m, u[4]), lerp(dist.arrival_z_m, u[5])])
+    n_steps = max(1, int(round(lerp(dist.flight_time_s, u[6]) / dt)))
+    gaze_offset = np.deg2rad(dist.gaze_jitter_deg) * np.sqrt(-2.0 * np.log(1.0 - u[7] * 0.999)) * np.array(
+        [np.cos(2 * np.pi * u[8]), np.sin(2 * np.pi * u[8])]
+    )  # Box-Muller: an isotropic Gaussian offset from two uniforms
+    wall_y = None
+    side = 0.0
+    aim = arrival
+    if bounce:
+        side = 1.0 if u[9] < 0.5 else -1.0
+        clearance = lerp(dist.wall_clearance_m, u[9] * 2.0 % 1.0)
+        if side > 0:
+            wall_y = max(release[1], arrival[1]) + clearance
+        else:
+            wall_y = min(release[1], arrival[1]) - clearance
+        # Aim at the mirror image of the arrival point in the plane the ball centre reflects from.
+        aim = arrival.copy()
+        aim[1] = 2.0 * wall_y - arrival[1]
+    velocity = launch_velocity(release, aim, n_steps, dt)
+    return Throw(release, velocity, arrival, n_steps * dt, gaze_offset, wall_y, side)
