@@ -22,6 +22,8 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from visuomotor_gym.geometry import norm, solve3
+
 
 @dataclass(frozen=True)
 class HandControlParams:
@@ -56,17 +58,18 @@ class HandController:
     ):
         self.model = model
         self.site_id = site_id
-        self.dof_ids = np.asarray(dof_ids)
-        self.qpos_ids = np.asarray(qpos_ids)
+        self.dof_ids = dof_ids  # slices or index arrays
+        self.qpos_ids = qpos_ids
         self.params = params or HandControlParams()
         margin = 1e-3
         self.lower = joint_ranges[:, 0] + margin
         self.upper = joint_ranges[:, 1] - margin
         self.nominal = np.asarray(nominal, dtype=float)
-        weights = np.ones(len(dof_ids))
+        weights = np.ones(len(joint_ranges))
         weights[:n_torso] = self.params.torso_weight
         self.weights = weights
         self._jacp = np.zeros((3, model.nv))
+        self._damping_eye = np.eye(3) * self.params.damping**2
         self.reference = np.zeros(3)
 
     def reset(self, hand_pos: np.ndarray) -> None:
@@ -76,7 +79,7 @@ class HandController:
     def advance_reference(self, target: np.ndarray, dt: float) -> np.ndarray:
         """Move the reference toward ``target`` by at most ``max_speed * dt``; return it."""
         delta = target - self.reference
-        dist = math.sqrt(float(delta @ delta))
+        dist = norm(delta)
         limit = self.params.max_speed_m_s * dt
         if dist > limit:
             delta *= limit / dist
@@ -92,20 +95,14 @@ class HandController:
         p = self.params
         mujoco.mj_jacSite(self.model, data, self._jacp, None, self.site_id)
         jac = self._jacp[:, self.dof_ids]
-        q = data.qpos[self.qpos_ids]
-        hand = data.site_xpos[self.site_id]
-        error = self.reference - (hand + jac @ (setpoint - q))
-        jw = jac * self.weights  # J W
-        gram = jw @ jw.T
-        gram[0, 0] += p.damping**2
-        gram[1, 1] += p.damping**2
-        gram[2, 2] += p.damping**2
-        gram_inv = np.linalg.inv(gram)
-        pinv = self.weights[:, None] * (jw.T @ gram_inv)  # W (JW)^T (JW (JW)^T + l^2 I)^-1
-        dq = pinv @ error
+        offset = setpoint - data.qpos[self.qpos_ids]
         posture = p.posture_gain * (self.nominal - setpoint)
-        dq += posture - pinv @ (jac @ posture)  # null-space projection (I - J+ J)
-        step = float(np.max(np.abs(dq)))
+        # Error of the hand the setpoints would give, minus what the posture step already moves.
+        error = self.reference - data.site_xpos[self.site_id] - jac @ (offset + posture)
+        jw = jac * self.weights  # J W
+        # W (JW)^T (JW (JW)^T + l^2 I)^-1 e
+        dq = self.weights * (jw.T @ solve3(jw @ jw.T + self._damping_eye, error)) + posture
+        step = float(np.abs(dq).max())
         if step > p.max_joint_step_rad:
             dq *= p.max_joint_step_rad / step
-        return np.clip(setpoint + dq, self.lower, self.upper)
+        return np.minimum(np.maximum(setpoint + dq, self.lower), self.upper)

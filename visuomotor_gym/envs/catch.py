@@ -18,6 +18,7 @@ from visuomotor_gym.assets import asset_path
 from visuomotor_gym.body import names
 from visuomotor_gym.control.hand import HandControlParams, HandController
 from visuomotor_gym.envs.observation import ObservationLayout
+from visuomotor_gym.geometry import cross, norm
 from visuomotor_gym.envs.rewards import REWARD_TERMS, SHAPED_WEIGHTS, SPARSE_WEIGHTS, catch_reward
 from visuomotor_gym.oculomotor.plant import (
     DEG,
@@ -67,6 +68,14 @@ def _coerce(cls, value, arg_name):
             raise TypeError(f"{arg_name}: unknown field(s) {unknown}; allowed: {sorted(allowed)}")
         return cls(**value)
     raise TypeError(f"{arg_name} must be a {cls.__name__}, a dict of its fields or None; got {type(value).__name__}")
+
+
+def _index(ids) -> slice | np.ndarray:
+    """A slice when ``ids`` are consecutive (a view, cheaper than fancy indexing), else the array."""
+    ids = np.asarray(ids, dtype=int)
+    if len(ids) and np.all(np.diff(ids) == 1):
+        return slice(int(ids[0]), int(ids[-1]) + 1)
+    return ids
 
 
 def _choice(value, allowed, arg_name):
@@ -259,27 +268,30 @@ class EyeCatchEnv(gym.Env):
             return mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, name)
 
         body_j = [jid(n) for n in names.BODY_JOINTS]
-        self._body_qpos = np.array([m.jnt_qposadr[j] for j in body_j])
-        self._body_dof = np.array([m.jnt_dofadr[j] for j in body_j])
+        self._body_qpos = _index([m.jnt_qposadr[j] for j in body_j])
+        self._body_dof = _index([m.jnt_dofadr[j] for j in body_j])
         self._body_range = m.jnt_range[body_j].copy()
-        self._body_act = np.array([aid(n) for n in names.BODY_ACTUATORS])
-        self._body_actadr = np.array([m.actuator_actadr[a] for a in self._body_act])
+        body_act = [aid(n) for n in names.BODY_ACTUATORS]
+        self._body_act = _index(body_act)
+        self._body_actadr = _index([m.actuator_actadr[a] for a in body_act])
         neck_j = [jid(n) for n in names.NECK_JOINTS]
-        self._neck_qpos = np.array([m.jnt_qposadr[j] for j in neck_j])
-        self._neck_dof = np.array([m.jnt_dofadr[j] for j in neck_j])
+        self._neck_qpos = _index([m.jnt_qposadr[j] for j in neck_j])
+        self._neck_dof = _index([m.jnt_dofadr[j] for j in neck_j])
         self._neck_range = m.jnt_range[neck_j].copy()
-        self._neck_act = np.array([aid(n) for n in names.NECK_ACTUATORS])
-        self._neck_actadr = np.array([m.actuator_actadr[a] for a in self._neck_act])
+        self._neck_range_list = self._neck_range.tolist()
+        self._neck_act = [aid(n) for n in names.NECK_ACTUATORS]
+        self._neck_actadr = [int(m.actuator_actadr[a]) for a in self._neck_act]
         self._grasp_act = aid(names.GRASP_ACTUATOR)
         grasp_j = jid(names.GRASP)
-        self._grasp_qpos = m.jnt_qposadr[grasp_j]
+        self._grasp_qpos = int(m.jnt_qposadr[grasp_j])
         self._grasp_max = float(m.jnt_range[grasp_j, 1])
         self._eye_qpos = np.array([m.jnt_qposadr[jid(n)] for n in (names.EYE_AZIMUTH, names.EYE_ELEVATION)])
-        self._eye_dof = np.array([m.jnt_dofadr[jid(n)] for n in (names.EYE_AZIMUTH, names.EYE_ELEVATION)])
-        self._fix_qpos = m.jnt_qposadr[jid(names.EYE_FIXATION)]
+        self._eye_dof = _index([m.jnt_dofadr[jid(n)] for n in (names.EYE_AZIMUTH, names.EYE_ELEVATION)])
+        self._eye_qpos_az, self._eye_qpos_el = (int(i) for i in self._eye_qpos)
+        self._fix_qpos = int(m.jnt_qposadr[jid(names.EYE_FIXATION)])
         ball_j = jid(names.BALL_JOINT)
-        self._ball_qpos = m.jnt_qposadr[ball_j]
-        self._ball_dof = m.jnt_dofadr[ball_j]
+        self._ball_qpos = int(m.jnt_qposadr[ball_j])
+        self._ball_dof = int(m.jnt_dofadr[ball_j])
         self._head_body = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, names.HEAD)
         self._hand_body = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, names.HAND)
         self._ball_body = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, names.BALL)
@@ -291,6 +303,10 @@ class EyeCatchEnv(gym.Env):
         self._ready = np.array(
             [0.0, 0.0, 0.0] + [READY_POSTURE_DEG[n] * DEG for n in names.ARM_JOINTS]
         )
+        if not np.all(m.actuator_ctrllimited[body_act]):
+            raise ValueError("the body servos must have a ctrlrange (it is their speed limit)")
+        self._ws_lo = HAND_WORKSPACE[:, 0] + SEAT_ORIGIN  # world frame
+        self._ws_half = 0.5 * (HAND_WORKSPACE[:, 1] - HAND_WORKSPACE[:, 0])
         self.hand = HandController(
             m, self._catch_site, self._body_dof, self._body_qpos, self._body_range, self._ready,
             n_torso=len(names.TORSO_JOINTS), params=self.hand_params,
@@ -299,12 +315,8 @@ class EyeCatchEnv(gym.Env):
         op = self.oculomotor_params
         self._az_range = (op.eye_azimuth_range_deg[0] * DEG, op.eye_azimuth_range_deg[1] * DEG)
         self._el_range = (op.eye_elevation_range_deg[0] * DEG, op.eye_elevation_range_deg[1] * DEG)
+        self._head_vmax = op.head_max_deg_s * DEG
         self._log_fix = (math.log(op.fixation_range_m[0]), math.log(op.fixation_range_m[1]))
-        self._bad_warnings = (
-            int(mujoco.mjtWarning.mjWARN_BADQACC),
-            int(mujoco.mjtWarning.mjWARN_BADQPOS),
-            int(mujoco.mjtWarning.mjWARN_BADQVEL),
-        )
 
         # --- spaces -----------------------------------------------------------------------------
         if self.control == "hand":
@@ -318,6 +330,10 @@ class EyeCatchEnv(gym.Env):
         self.observation_structure = self.layout.structure
         self.observation_space = self.layout.flat_space() if obs_mode == "flat" else self.layout.dict_space()
         self._s = self.layout.slices
+        expected = ("ball_pos", "ball_vel", "ball_visible", "ball_age", "eye_pos", "eye_rot", "eye_in_head",
+                    "fixation", "saccade", "head_qpos", "head_qvel", "body_qpos", "body_qvel", "hand_pos",
+                    "hand_vel", "grasp", "time")
+        assert tuple(b.name for b in self.layout.blocks) == expected, "update _observe with the layout"
 
         self._renderers: dict[str, mujoco.Renderer] = {}
         self._viewer = None
@@ -358,7 +374,6 @@ class EyeCatchEnv(gym.Env):
         self._place_wall(throw)
         d.eq_active[self._weld] = 0
         mujoco.mj_forward(m, d)
-        self._warning_counts = [d.warning[w].number for w in self._bad_warnings]
 
         # Gaze on the release point (the thrower's hand), with a small jitter.
         eye_pos = d.xpos[self._head_body] + d.xmat[self._head_body].reshape(3, 3) @ self._eye_offset
@@ -372,7 +387,7 @@ class EyeCatchEnv(gym.Env):
         self._hand_prev = d.site_xpos[self._catch_site].copy()
         obs = self._observe(saccading=False)
         self._last_obs = obs
-        info = self._info(caught=False, missed=False, diverged=False, terms={}, visible=bool(obs[self._s["ball_visible"]][0]))
+        info = self._info(caught=False, missed=False, diverged=False, terms={}, visible=self._visible)
         info.update(
             release_pos=throw.release_pos.copy(),
             release_vel=throw.release_vel.copy(),
@@ -389,35 +404,35 @@ class EyeCatchEnv(gym.Env):
         nb = self._n_body_act
 
         # --- eye: requested gaze change, in retinal coordinates of the current eye frame --------
-        q_az = float(a[nb + 1]) * self.gaze_action_range
-        q_el = float(a[nb + 2]) * self.gaze_action_range
-        target = self._eye_rot @ direction_from_angles(q_az, q_el)
+        g_az, g_el, g_fix = a[nb + 1 : nb + 4].tolist()
+        target = self._eye_rot @ direction_from_angles(g_az * self.gaze_action_range, g_el * self.gaze_action_range)
         plant_step = self.plant.step(target, dt, self.n_substeps, self.np_random)
         lo, hi = self._log_fix
-        fix_target = math.exp(lo + (float(a[nb + 3]) + 1.0) * 0.5 * (hi - lo))
+        fix_target = math.exp(lo + (g_fix + 1.0) * 0.5 * (hi - lo))
         vergence = self.oculomotor_params.vergence_max_diopter_s * dt  # rate limit in diopters
         inv = min(max(1.0 / fix_target, 1.0 / self._fixation - vergence), 1.0 / self._fixation + vergence)
         self._fixation = 1.0 / inv
 
         # --- head: velocity-limited position servo -------------------------------------------
-        head_a = a[nb + 4 : nb + 6].astype(float)
-        head_target = np.where(head_a >= 0, head_a * self._neck_range[:, 1], -head_a * self._neck_range[:, 0])
-        vmax = self.oculomotor_params.head_max_deg_s * DEG
-        d.ctrl[self._neck_act] = np.clip((head_target - d.act[self._neck_actadr]) / dt, -vmax, vmax)
+        vmax = self._head_vmax
+        act, ctrl = d.act, d.ctrl
+        head_a = a[nb + 4 : nb + 6].tolist()
+        for k in range(2):
+            h = head_a[k]
+            lo_h, hi_h = self._neck_range_list[k]
+            v = ((h * hi_h if h >= 0 else -h * lo_h) - act[self._neck_actadr[k]]) / dt
+            ctrl[self._neck_act[k]] = min(max(v, -vmax), vmax)
 
         # --- torso and arm ----------------------------------------------------------------------
         setpoint = d.act[self._body_actadr]
         if self.control == "hand":
-            lo_ws, hi_ws = HAND_WORKSPACE[:, 0], HAND_WORKSPACE[:, 1]
-            target_seat = lo_ws + (a[:3].astype(float) + 1.0) * 0.5 * (hi_ws - lo_ws)
-            self.hand.advance_reference(target_seat + SEAT_ORIGIN, dt)
+            target = self._ws_lo + (a[:3] + 1.0) * self._ws_half
+            self.hand.advance_reference(target, dt)
             new_setpoint = self.hand.setpoints(d, setpoint)
         else:
             r = self._body_range
             new_setpoint = r[:, 0] + (a[:10].astype(float) + 1.0) * 0.5 * (r[:, 1] - r[:, 0])
-        ctrl_lo = m.actuator_ctrlrange[self._body_act, 0]
-        ctrl_hi = m.actuator_ctrlrange[self._body_act, 1]
-        d.ctrl[self._body_act] = np.clip((new_setpoint - setpoint) / dt, ctrl_lo, ctrl_hi)
+        d.ctrl[self._body_act] = (new_setpoint - setpoint) / dt  # MuJoCo clamps to ctrlrange: a rate limit
         d.ctrl[self._grasp_act] = (float(a[nb]) + 1.0) * 0.5 * self._grasp_max
 
         # --- physics ---------------------------------------------------------------------------
@@ -436,12 +451,12 @@ class EyeCatchEnv(gym.Env):
         # --- outcome and reward --------------------------------------------------------------
         ball = d.qpos[self._ball_qpos : self._ball_qpos + 3]
         missed = (not caught) and self._is_missed(ball)
-        hand_ball = float(np.linalg.norm(d.site_xpos[self._catch_site] - ball))
-        visible = bool(obs[self._s["ball_visible"]][0])
-        ecc = foveation.eccentricity(self._true_ball_eye()[0]) if visible else None
-        reward, terms = catch_reward(
-            self.reward_weights, caught, missed, hand_ball, ecc, float(np.mean(np.square(a)))
-        )
+        visible = self._visible
+        weights = self.reward_weights
+        hand_ball = norm(d.site_xpos[self._catch_site] - ball) if weights.get("approach") else 0.0
+        ecc = foveation.eccentricity(self._true_ball_eye()[0]) if visible and weights.get("foveation") else None
+        effort = float(a @ a) / a.size if weights.get("effort") else 0.0
+        reward, terms = catch_reward(weights, caught, missed, hand_ball, ecc, effort)
         info = self._info(caught=caught, missed=missed, diverged=False, terms=terms, visible=visible)
         info["saccade_onset"] = plant_step.saccade_started
         if self.render_mode == "human":
@@ -490,15 +505,19 @@ class EyeCatchEnv(gym.Env):
         self._eye_in_head = (0.0, 0.0)
 
     def _check_action(self, action) -> np.ndarray:
-        a = np.asarray(action, dtype=np.float64)
+        try:
+            a = np.asarray(action, dtype=np.float64)
+        except (TypeError, ValueError) as exc:
+            raise ValueError(f"action must be a numeric array of shape {self.action_space.shape}; got {action!r}") from exc
         if a.shape != self.action_space.shape:
             raise ValueError(
                 f"action must have shape {self.action_space.shape} (blocks {self.action_structure}), got shape {a.shape}"
             )
-        if not np.all(np.isfinite(a)):
+        peak = float(np.abs(a).max())
+        if not math.isfinite(peak):
             bad = np.flatnonzero(~np.isfinite(a)).tolist()
             raise ValueError(f"action contains NaN or inf at index {bad}: {a.tolist()}; actions must be finite in [-1, 1]")
-        return np.clip(a, -1.0, 1.0)
+        return np.clip(a, -1.0, 1.0) if peak > 1.0 else a
 
     def _place_wall(self, throw) -> None:
         m = self.model
@@ -515,26 +534,35 @@ class EyeCatchEnv(gym.Env):
     def _simulate(self) -> tuple[bool, bool]:
         """Run the physics substeps; return (caught, diverged)."""
         m, d = self.model, self.data
-        ball_q = self._ball_qpos
         caught = False
-        if self._caught or not self._ball_near_hand():
+        t_expected = d.time + self.dt
+        if self._caught or not self._catch_possible():
             mujoco.mj_step(m, d, nstep=self.n_substeps)
         else:  # the ball may cross the catch volume within this step: check every substep
             for _ in range(self.n_substeps):
                 mujoco.mj_step(m, d)
                 if not caught and self._catch_now(d.xpos[self._ball_body]):
                     caught = True
-        diverged = any(d.warning[w].number != c for w, c in zip(self._bad_warnings, self._warning_counts))
-        if not diverged:
-            diverged = not (np.all(np.isfinite(d.qpos)) and np.all(np.isfinite(d.qvel)))
-            diverged = diverged or not np.all(np.abs(d.qpos[ball_q : ball_q + 3]) < 1e3)
-        return caught, diverged
+        # MuJoCo resets the data (time goes back to 0) when it meets a bad qpos/qvel/qacc; anything
+        # non-finite or huge that slipped through is divergence too.
+        if abs(d.time - t_expected) > 0.5 * self.model.opt.timestep:
+            return caught, True
+        total = float(d.qvel.sum())
+        return caught, not (math.isfinite(total) and abs(total) < 1e6)
+
+    def _catch_possible(self) -> bool:
+        """Whether a catch could happen during the coming control step (else skip substep checks)."""
+        d = self.data
+        closing = self.grasp_closed_fraction * self._grasp_max
+        if d.qpos[self._grasp_qpos] < closing and d.ctrl[self._grasp_act] < closing:
+            return False
+        return self._ball_near_hand()
 
     def _ball_near_hand(self) -> bool:
         d = self.data
         ball = d.qpos[self._ball_qpos : self._ball_qpos + 3]
-        speed = float(np.linalg.norm(d.qvel[self._ball_dof : self._ball_dof + 3]))
-        gap = float(np.linalg.norm(ball - d.site_xpos[self._catch_site])) - self.catch_radius
+        speed = norm(d.qvel[self._ball_dof : self._ball_dof + 3])
+        gap = norm(ball - d.site_xpos[self._catch_site]) - self.catch_radius
         return gap < (speed + 2.0 * self.hand_params.max_speed_m_s) * self.dt + 0.05
 
     def _catch_now(self, ball_pos: np.ndarray) -> bool:
@@ -545,8 +573,7 @@ class EyeCatchEnv(gym.Env):
         closed = d.qpos[self._grasp_qpos] >= self.grasp_closed_fraction * self._grasp_max
         if not closed:
             return False
-        diff = ball_pos - d.site_xpos[self._catch_site]
-        if float(diff @ diff) > self.catch_radius**2:
+        if norm(ball_pos - d.site_xpos[self._catch_site]) > self.catch_radius:
             return False
         self._caught = True
         self._activate_weld()
@@ -578,29 +605,32 @@ class EyeCatchEnv(gym.Env):
         """
         d = self.data
         head_rot = d.xmat[self._head_body].reshape(3, 3)
-        gaze_head = head_rot.T @ self.plant.gaze
-        az, el = angles_from_direction(gaze_head)
+        gx, gy, gz = (self.plant.gaze @ head_rot).tolist()  # gaze in head coordinates
+        az = math.atan2(gy, gx)
+        el = math.atan2(gz, math.hypot(gx, gy))
         az_c = min(max(az, self._az_range[0]), self._az_range[1])
         el_c = min(max(el, self._el_range[0]), self._el_range[1])
         ca, sa, ce, se = math.cos(az_c), math.sin(az_c), math.cos(el_c), math.sin(el_c)
+        # Eye in head: Rz(azimuth) Ry(-elevation) (Donders/Fick order of the eye joints).
         eye_in_head = np.array([[ca * ce, -sa, -ca * se], [sa * ce, ca, -sa * se], [se, 0.0, ce]])
         self._eye_rot = head_rot @ eye_in_head
         if az_c != az or el_c != el:
             self.plant.constrain(self._eye_rot[:, 0].copy())
         self._eye_pos = d.xpos[self._head_body] + head_rot @ self._eye_offset
         self._eye_in_head = (az_c, el_c)
-        d.qpos[self._eye_qpos[0]] = az_c
-        d.qpos[self._eye_qpos[1]] = el_c
+        qpos = d.qpos
+        qpos[self._eye_qpos_az] = az_c
+        qpos[self._eye_qpos_el] = el_c
+        qpos[self._fix_qpos] = self._fixation
         d.qvel[self._eye_dof] = 0.0
-        d.qpos[self._fix_qpos] = self._fixation
 
     def _true_ball_eye(self) -> tuple[np.ndarray, np.ndarray]:
         """True ball position and velocity in the current eye frame (Eyecatch Eq. 6-7, no noise)."""
         d = self.data
         ball = d.qpos[self._ball_qpos : self._ball_qpos + 3]
         vel = d.qvel[self._ball_dof : self._ball_dof + 3]
-        rt = self._eye_rot.T
-        return rt @ (ball - self._eye_pos), rt @ vel
+        rot = self._eye_rot
+        return (ball - self._eye_pos) @ rot, vel @ rot  # R^T v
 
     def _see_ball(self, saccading: bool) -> tuple[np.ndarray, np.ndarray, bool]:
         """One visual sample of the ball: (position, velocity, visible), eye frame."""
@@ -608,23 +638,20 @@ class EyeCatchEnv(gym.Env):
         if self.vision == "oracle":
             return pos_eye, vel_eye, True
         vp = self.vision_params
-        if vp.foveated and (saccading or not foveation.is_in_field_of_view(pos_eye, vp)):
+        if vp.foveated and saccading:  # saccadic suppression
             return np.zeros(3), np.zeros(3), False
         d = self.data
         # Retinal slip: line-of-sight angular velocity minus the eye's own (world) angular velocity.
         rel = d.qpos[self._ball_qpos : self._ball_qpos + 3] - self._eye_pos
         rel_vel = d.qvel[self._ball_dof : self._ball_dof + 3] - (self._eye_pos - self._prev_eye_pos) / self.dt
         dist2 = float(rel @ rel)
-        slip = np.cross(rel, rel_vel) / dist2 - self.plant.angular_velocity
+        slip = cross(rel, rel_vel) / dist2 - self.plant.angular_velocity
         along = rel * (float(slip @ rel) / dist2)
-        retinal_speed = float(np.linalg.norm(slip - along))
-        pos, vel = foveation.sample(pos_eye, vel_eye, retinal_speed, vp, self.np_random)
-        return pos, vel, True
+        retinal_speed = norm(slip - along)
+        return foveation.perceive(pos_eye, vel_eye, retinal_speed, vp, self.np_random)
 
     def _observe(self, saccading: bool) -> np.ndarray:
         d = self.data
-        s = self._s
-        obs = np.empty(self.layout.size, dtype=np.float32)
         sample = self._see_ball(saccading)
         if self.delay_steps:
             self._delay_buffer.append(sample)
@@ -633,27 +660,31 @@ class EyeCatchEnv(gym.Env):
             else:
                 sample = self._delay_buffer[0]
         pos, vel, visible = sample
-        obs[s["ball_pos"]] = pos
-        obs[s["ball_vel"]] = vel
-        obs[s["ball_visible"]] = 1.0 if visible else 0.0
-        obs[s["ball_age"]] = self.visual_delay_s
-        obs[s["eye_pos"]] = self._eye_pos - SEAT_ORIGIN
-        obs[s["eye_rot"]] = self._eye_rot.ravel()
-        obs[s["eye_in_head"]] = self._eye_in_head
-        obs[s["fixation"]] = self._fixation
-        since = self.plant.time - self.plant.last_onset
-        obs[s["saccade"]] = (1.0 if self.plant.saccade is not None else 0.0, min(since, GAZE_AGE_CAP_S))
-        obs[s["head_qpos"]] = d.qpos[self._neck_qpos]
-        obs[s["head_qvel"]] = d.qvel[self._neck_dof]
-        obs[s["body_qpos"]] = d.qpos[self._body_qpos]
-        obs[s["body_qvel"]] = d.qvel[self._body_dof]
-        obs[s["hand_pos"]] = d.site_xpos[self._catch_site] - SEAT_ORIGIN
+        self._visible = visible
         hand = d.site_xpos[self._catch_site]
-        obs[s["hand_vel"]] = (hand - self._hand_prev) / self.dt
-        self._hand_prev = hand.copy()
-        obs[s["grasp"]] = d.qpos[self._grasp_qpos] / self._grasp_max
-        obs[s["time"]] = d.time
-        return obs
+        plant = self.plant
+        qpos, qvel = d.qpos, d.qvel
+        values = [
+            *pos.tolist(),
+            *vel.tolist(),
+            1.0 if visible else 0.0,
+            self.visual_delay_s,
+            *(self._eye_pos - SEAT_ORIGIN).tolist(),
+            *self._eye_rot.ravel().tolist(),
+            *self._eye_in_head,
+            self._fixation,
+            1.0 if plant.saccade is not None else 0.0,
+            min(plant.time - plant.last_onset, GAZE_AGE_CAP_S),
+            *qpos[self._neck_qpos].tolist(),
+            *qvel[self._neck_dof].tolist(),
+            *qpos[self._body_qpos].tolist(),
+            *qvel[self._body_dof].tolist(),
+            *(hand - SEAT_ORIGIN).tolist(),
+            *((hand - self._hand_prev) / self.dt).tolist(),
+            qpos[self._grasp_qpos] / self._grasp_max,
+            d.time,
+        ]
+        return np.array(values, dtype=np.float32)
 
     def _format(self, obs: np.ndarray):
         if self.obs_mode == "flat":

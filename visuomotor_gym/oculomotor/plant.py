@@ -28,6 +28,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from visuomotor_gym.geometry import angle_between, rotation_axis
+
 DEG = math.pi / 180.0
 
 
@@ -79,12 +81,6 @@ def minimum_jerk(u: np.ndarray | float):
     return u * u * u * (10.0 + u * (-15.0 + 6.0 * u))
 
 
-def angle_between(a: np.ndarray, b: np.ndarray) -> float:
-    """Angle (rad) between two unit vectors, accurate for small and large angles."""
-    cross = np.cross(a, b)
-    return math.atan2(math.sqrt(float(cross @ cross)), float(a @ b))
-
-
 def direction_from_angles(azimuth: float, elevation: float) -> np.ndarray:
     """Unit vector for (azimuth about z, then elevation up): x forward, y left, z up."""
     ce = math.cos(elevation)
@@ -99,14 +95,17 @@ def angles_from_direction(direction: np.ndarray) -> tuple[float, float]:
 
 def _slerp(a: np.ndarray, b: np.ndarray, angle: float, fractions):
     """Points at ``fractions`` of the great-circle arc from ``a`` to ``b`` (``angle`` apart)."""
+    if isinstance(fractions, float):
+        if angle < 1e-9:
+            return np.array(b, dtype=float)
+        s = math.sin(angle)
+        return (math.sin((1.0 - fractions) * angle) / s) * a + (math.sin(fractions * angle) / s) * b
     if angle < 1e-9:
-        return np.broadcast_to(b, (np.size(fractions), 3)).copy() if np.ndim(fractions) else b.copy()
+        return np.broadcast_to(b, (np.size(fractions), 3)).copy()
     s = math.sin(angle)
     f = np.asarray(fractions, dtype=float)
     wa = np.sin((1.0 - f) * angle) / s
     wb = np.sin(f * angle) / s
-    if f.ndim == 0:
-        return float(wa) * a + float(wb) * b
     return wa[:, None] * a + wb[:, None] * b
 
 
@@ -119,6 +118,7 @@ class Saccade:
     start: np.ndarray  # unit gaze direction at onset
     end: np.ndarray  # unit gaze direction at landing
     amplitude: float  # rad
+    axis: np.ndarray  # unit rotation axis (world) from start to end
 
 
 @dataclass
@@ -178,22 +178,26 @@ class OculomotorPlant:
                 if p.saccade_endpoint_noise > 0.0 and rng is not None:
                     end = _perturb(end, rng.standard_normal(2) * p.saccade_endpoint_noise * amplitude)
                     amplitude = angle_between(self.gaze, end)
-                self.saccade = Saccade(t0, p.saccade_duration(amplitude), self.gaze.copy(), end, amplitude)
+                self.saccade = Saccade(
+                    t0, p.saccade_duration(amplitude), self.gaze.copy(), end, amplitude, rotation_axis(self.gaze, end)
+                )
                 self.saccades.append(self.saccade)
                 self.last_onset = t0
                 started = True
 
-        sub_t = t0 + dt * np.arange(1, n_substeps + 1) / n_substeps
+        t_end = t0 + dt
         saccading = self.saccade is not None
+        if self.record:
+            sub_t = t0 + dt * np.arange(1, n_substeps + 1) / n_substeps
         if self.saccade is not None:
             sac = self.saccade
-            u = np.clip((sub_t - sac.onset) / sac.duration, 0.0, 1.0)
             if self.record:
+                u = np.clip((sub_t - sac.onset) / sac.duration, 0.0, 1.0)
                 points = _slerp(sac.start, sac.end, sac.amplitude, minimum_jerk(u))
-            u_end = float(u[-1])
-            self.gaze = _slerp(sac.start, sac.end, sac.amplitude, float(minimum_jerk(u_end)))
+            u_end = min(max((t_end - sac.onset) / sac.duration, 0.0), 1.0)
+            self.gaze = _slerp(sac.start, sac.end, sac.amplitude, minimum_jerk(u_end))
             speed = sac.amplitude * 30.0 * u_end**2 * (1.0 - u_end) ** 2 / sac.duration  # Eq. 15
-            self.angular_velocity = _rotation_axis(sac.start, sac.end) * speed
+            self.angular_velocity = sac.axis * speed
             if u_end >= 1.0:
                 self.saccade = None
         else:
@@ -201,17 +205,18 @@ class OculomotorPlant:
             travel = min(amplitude, p.pursuit_max_deg_s * DEG * dt)
             start = self.gaze
             if amplitude > 1e-12:
-                fractions = np.arange(1, n_substeps + 1) / n_substeps * (travel / amplitude)
                 if self.record:
+                    fractions = np.arange(1, n_substeps + 1) / n_substeps * (travel / amplitude)
                     points = _slerp(start, target, amplitude, fractions)
-                self.gaze = _slerp(start, target, amplitude, float(fractions[-1]))
-                self.angular_velocity = _rotation_axis(start, target) * (travel / dt)
+                self.gaze = _slerp(start, target, amplitude, travel / amplitude)
+                self.angular_velocity = rotation_axis(start, target) * (travel / dt)
             else:
                 if self.record:
                     points = np.broadcast_to(start, (n_substeps, 3)).copy()
                 self.angular_velocity = np.zeros(3)
-        self.gaze = self.gaze / math.sqrt(float(self.gaze @ self.gaze))
-        self.time = float(sub_t[-1])
+        gx, gy, gz = self.gaze.tolist()
+        self.gaze = self.gaze / math.sqrt(gx * gx + gy * gy + gz * gz)
+        self.time = t_end
         if self.record:
             self.trace_t.extend(sub_t.tolist())
             self.trace_gaze.extend(points)
@@ -231,13 +236,6 @@ class OculomotorPlant:
         if not self.record:
             raise RuntimeError("construct the plant with record=True to keep a substep trace")
         return np.asarray(self.trace_t), np.asarray(self.trace_gaze)
-
-
-def _rotation_axis(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Unit axis of the shortest rotation from ``a`` to ``b`` (zero if they are parallel)."""
-    c = np.cross(a, b)
-    n = math.sqrt(float(c @ c))
-    return c / n if n > 1e-12 else np.zeros(3)
 
 
 def _perturb(direction: np.ndarray, offsets_rad: np.ndarray) -> np.ndarray:

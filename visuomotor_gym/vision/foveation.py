@@ -126,15 +126,13 @@ def standard_deviations(distance: float, eccentricity_rad: float, retinal_speed:
     velocity minus the eye's own angular velocity, so pursuit that stabilises the image sharpens the
     velocity estimate.
     """
-    scale = params.noise_scale / acuity(eccentricity_rad, params)
-    lateral = distance * params.retinal_position_std_arcmin * ARCMIN
-    lateral_rate = distance * (
+    k = distance * params.noise_scale / acuity(eccentricity_rad, params)
+    lateral = k * params.retinal_position_std_arcmin * ARCMIN
+    lateral_rate = k * (
         params.retinal_velocity_weber * abs(retinal_speed) + params.retinal_velocity_floor_deg_s * DEG
     )
-    depth = params.depth_std_fraction * distance
-    depth_rate = params.depth_rate_std_fraction * distance
-    return (
-        np.array([depth, lateral, lateral, depth_rate, lateral_rate, lateral_rate]) * scale
+    return np.array(
+        [k * params.depth_std_fraction, lateral, lateral, k * params.depth_rate_std_fraction, lateral_rate, lateral_rate]
     )
 
 
@@ -157,11 +155,39 @@ def sample(
     params: VisionParams,
     rng: np.random.Generator,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Draw one perceived (position, velocity) in the eye frame; the caller checks visibility."""
+    """Draw one perceived (position, velocity) in the eye frame, ignoring the field of view."""
     d = math.sqrt(float(position_eye @ position_eye))
     if d <= 0.0:
         return position_eye.copy(), velocity_eye.copy()
-    sig = standard_deviations(d, eccentricity(position_eye), retinal_speed, params)
+    ecc = math.acos(max(-1.0, min(1.0, float(position_eye[0]) / d)))
+    return _draw(position_eye, velocity_eye, d, ecc, retinal_speed, params, rng)
+
+
+def perceive(
+    position_eye: np.ndarray,
+    velocity_eye: np.ndarray,
+    retinal_speed: float,
+    params: VisionParams,
+    rng: np.random.Generator,
+) -> tuple[np.ndarray, np.ndarray, bool]:
+    """One look at a point: ``(position, velocity, visible)`` in the eye frame.
+
+    Outside the field of view nothing is drawn and zeros are returned with ``visible=False``
+    (saccadic suppression is the caller's business: it knows when the eye moved).
+    """
+    d = math.sqrt(float(position_eye @ position_eye))
+    ecc = math.acos(max(-1.0, min(1.0, float(position_eye[0]) / d))) if d > 0.0 else 0.0
+    if params.foveated and ecc > params.field_of_view_deg * DEG:
+        return np.zeros(3), np.zeros(3), False
+    if d <= 0.0:
+        return position_eye.copy(), velocity_eye.copy(), True
+    pos, vel = _draw(position_eye, velocity_eye, d, ecc, retinal_speed, params, rng)
+    return pos, vel, True
+
+
+def _draw(position_eye, velocity_eye, d, ecc, retinal_speed, params, rng):
+    """Noise A Sigma eps, eps ~ N(0, I6) (Eyecatch Eq. 1-3), added to the true state."""
+    sig = standard_deviations(d, ecc, retinal_speed, params)
     rot = line_of_sight_rotation(position_eye / d)
-    eps = rng.standard_normal(6) * sig
-    return position_eye + rot @ eps[:3], velocity_eye + rot @ eps[3:]
+    eps = (rng.standard_normal(6) * sig).reshape(2, 3) @ rot.T  # rows: R (Sigma eps)_pos, R (Sigma eps)_vel
+    return position_eye + eps[0], velocity_eye + eps[1]

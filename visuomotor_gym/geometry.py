@@ -1,0 +1,68 @@
+"""Small 3-vector helpers for the per-step hot path.
+
+``numpy.cross`` and ``numpy.linalg.norm`` cost microseconds each on 3-vectors (argument handling
+dominates); these scalar versions cost a fraction of that and return the same values.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+
+def cross(a, b) -> np.ndarray:
+    """Cross product of two 3-vectors."""
+    ax, ay, az = a.tolist() if isinstance(a, np.ndarray) else a
+    bx, by, bz = b.tolist() if isinstance(b, np.ndarray) else b
+    return np.array([ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx])
+
+
+def norm(a) -> float:
+    """Euclidean norm of a 3-vector."""
+    x, y, z = a.tolist() if isinstance(a, np.ndarray) else a
+    return math.sqrt(x * x + y * y + z * z)
+
+
+def angle_between(a, b) -> float:
+    """Angle (rad) between two vectors, accurate for small and large angles."""
+    ax, ay, az = a.tolist() if isinstance(a, np.ndarray) else a
+    bx, by, bz = b.tolist() if isinstance(b, np.ndarray) else b
+    cx, cy, cz = ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
+    return math.atan2(math.sqrt(cx * cx + cy * cy + cz * cz), ax * bx + ay * by + az * bz)
+
+
+def rotation_axis(a, b) -> np.ndarray:
+    """Unit axis of the shortest rotation from ``a`` to ``b`` (zero if they are parallel)."""
+    c = cross(a, b)
+    n = norm(c)
+    return c / n if n > 1e-12 else np.zeros(3)
+
+
+def inv3(m: np.ndarray) -> np.ndarray:
+    """Inverse of a 3x3 matrix by the adjugate (for well-conditioned, e.g. damped, matrices)."""
+    (a, b, c), (d, e, f), (g, h, i) = m.tolist()
+    A, B, C = e * i - f * h, f * g - d * i, d * h - e * g
+    det = a * A + b * B + c * C
+    return np.array(
+        [
+            [A, c * h - b * i, b * f - c * e],
+            [B, a * i - c * g, c * d - a * f],
+            [C, b * g - a * h, a * e - b * d],
+        ]
+    ) / det
+
+
+def solve3(m: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Solve the 3x3 system ``m x = v`` by Cramer's rule (for well-conditioned, e.g. damped, ``m``)."""
+    (a, b, c), (d, e, f), (g, h, i) = m.tolist()
+    x, y, z = v.tolist()
+    ei_fh, fg_di, dh_eg = e * i - f * h, f * g - d * i, d * h - e * g
+    det = a * ei_fh + b * fg_di + c * dh_eg
+    return np.array(
+        [
+            (x * ei_fh + b * (f * z - y * i) + c * (y * h - e * z)) / det,
+            (a * (y * i - f * z) + x * fg_di + c * (d * z - y * g)) / det,
+            (a * (e * z - y * h) + b * (y * g - d * z) + x * dh_eg) / det,
+        ]
+    )
