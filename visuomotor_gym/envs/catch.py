@@ -721,7 +721,21 @@ class EyeCatchEnv(gym.Env):
             renderer = mujoco.Renderer(self.model, self.height, self.width)
             self._renderers[camera] = renderer
         renderer.update_scene(self.data, camera=camera)
+        if camera != names.EYE_CAMERA:
+            self._draw_gaze(renderer.scene)
         return renderer.render().copy()
+
+    def _draw_gaze(self, scene: mujoco.MjvScene) -> None:
+        """Draw the line of sight, eye to fixation point, into a rendered scene (not the physics)."""
+        if scene.ngeom >= scene.maxgeom:
+            return
+        start = self._eye_pos
+        end = start + self.plant.gaze * self._fixation
+        geom = scene.geoms[scene.ngeom]
+        mujoco.mjv_initGeom(geom, mujoco.mjtGeom.mjGEOM_CAPSULE, np.zeros(3), np.zeros(3), np.eye(3).ravel(),
+                            np.array([0.1, 0.9, 0.2, 0.6], dtype=np.float32))
+        mujoco.mjv_connector(geom, mujoco.mjtGeom.mjGEOM_CAPSULE, 0.004, start, end)
+        scene.ngeom += 1
 
     def _render_human(self):
         headless = not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))

@@ -1,0 +1,39 @@
+# visuomotor_gym developer commands. Everything runs inside .venv, created on first use.
+#   make demo   set up, then run the main demo (writes outputs/demo/)
+#   make test   set up, then run the whole test suite
+#   make bench  set up, then run the benchmarks in benchmarks/
+
+PYTHON ?= python3
+VENV ?= .venv
+# The CPU build of PyTorch must be installed before stable-baselines3, or pip pulls a multi-GB CUDA build.
+TORCH_SPEC ?= torch==2.13.0
+PY := $(VENV)/bin/python
+PIP := $(PY) -m pip
+STAMP := $(VENV)/.installed
+export MUJOCO_GL ?= egl
+
+.PHONY: setup demo test test-fast bench clean
+
+$(STAMP): pyproject.toml Makefile
+	$(PYTHON) -m venv $(VENV)
+	$(PIP) install --quiet --upgrade pip
+	$(PIP) install --quiet "$(TORCH_SPEC)"
+	$(PIP) install --quiet -e ".[rl,viz,dev]"
+	touch $(STAMP)
+
+setup: $(STAMP)
+
+demo: setup
+	$(VENV)/bin/vmgym demo
+
+test: setup
+	$(PY) -m pytest -n 2 --durations=15
+
+test-fast: setup
+	$(PY) -m pytest -n 2 -m "not slow"
+
+bench: setup
+	$(PY) benchmarks/env_throughput.py
+
+clean:
+	rm -rf $(VENV) build dist *.egg-info outputs .pytest_cache
