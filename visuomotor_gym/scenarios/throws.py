@@ -15,7 +15,9 @@ Every throw consumes the same random numbers in the same order whatever the vari
 gives the same throw across the whole observability ladder. ``EyeCatchBounce-v0`` additionally
 places an invisible vertical wall beside the flight and aims the ball at the arrival point's mirror
 image, so that after an elastic, frictionless bounce it still reaches the arrival point
-(Eyecatch section 5).
+(Eyecatch section 5). MuJoCo's soft contact delays the bounce by a few milliseconds, so in that
+variant the ball passes 4-9 cm from ``arrival_pos`` (measured over 30 seeds: median 4.5 cm); it is
+still catchable, and scoring always uses the simulated ball, never ``arrival_pos``.
 """
 
 from __future__ import annotations
