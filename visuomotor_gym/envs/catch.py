@@ -684,6 +684,7 @@ class EyeCatchEnv(gym.Env):
             qpos[self._grasp_qpos] / self._grasp_max,
             d.time,
         ]
+        self._hand_prev = hand.copy()
         return np.array(values, dtype=np.float32)
 
     def _format(self, obs: np.ndarray):
