@@ -39,20 +39,6 @@ def rotation_axis(a, b) -> np.ndarray:
     return c / n if n > 1e-12 else np.zeros(3)
 
 
-def inv3(m: np.ndarray) -> np.ndarray:
-    """Inverse of a 3x3 matrix by the adjugate (for well-conditioned, e.g. damped, matrices)."""
-    (a, b, c), (d, e, f), (g, h, i) = m.tolist()
-    A, B, C = e * i - f * h, f * g - d * i, d * h - e * g
-    det = a * A + b * B + c * C
-    return np.array(
-        [
-            [A, c * h - b * i, b * f - c * e],
-            [B, a * i - c * g, c * d - a * f],
-            [C, b * g - a * h, a * e - b * d],
-        ]
-    ) / det
-
-
 def solve3(m: np.ndarray, v: np.ndarray) -> np.ndarray:
     """Solve the 3x3 system ``m x = v`` by Cramer's rule (for well-conditioned, e.g. damped, ``m``)."""
     (a, b, c), (d, e, f), (g, h, i) = m.tolist()

@@ -18,7 +18,7 @@ from visuomotor_gym.assets import asset_path
 from visuomotor_gym.body import names
 from visuomotor_gym.control.hand import HandControlParams, HandController
 from visuomotor_gym.envs.observation import ObservationLayout
-from visuomotor_gym.geometry import cross, norm
+from visuomotor_gym.geometry import norm
 from visuomotor_gym.envs.rewards import REWARD_TERMS, SHAPED_WEIGHTS, SPARSE_WEIGHTS, catch_reward
 from visuomotor_gym.oculomotor.plant import (
     DEG,
@@ -543,12 +543,9 @@ class EyeCatchEnv(gym.Env):
                 mujoco.mj_step(m, d)
                 if not caught and self._catch_now(d.xpos[self._ball_body]):
                     caught = True
-        # MuJoCo resets the data (time goes back to 0) when it meets a bad qpos/qvel/qacc; anything
-        # non-finite or huge that slipped through is divergence too.
-        if abs(d.time - t_expected) > 0.5 * self.model.opt.timestep:
-            return caught, True
-        total = float(d.qvel.sum())
-        return caught, not (math.isfinite(total) and abs(total) < 1e6)
+        # MuJoCo checks qpos/qvel/qacc every substep (NaN, inf or > 1e10) and resets the data when one is
+        # bad, which sends the time back to 0 (data.warning records it): that is our divergence signal.
+        return caught, abs(d.time - t_expected) > 0.5 * m.opt.timestep
 
     def _catch_possible(self) -> bool:
         """Whether a catch could happen during the coming control step (else skip substep checks)."""
@@ -632,22 +629,34 @@ class EyeCatchEnv(gym.Env):
         rot = self._eye_rot
         return (ball - self._eye_pos) @ rot, vel @ rot  # R^T v
 
-    def _see_ball(self, saccading: bool) -> tuple[np.ndarray, np.ndarray, bool]:
-        """One visual sample of the ball: (position, velocity, visible), eye frame."""
-        pos_eye, vel_eye = self._true_ball_eye()
+    def _see_ball(self, saccading: bool) -> tuple[list, list, bool]:
+        """One visual sample of the ball: (position, velocity, visible), eye frame, float lists."""
         if self.vision == "oracle":
-            return pos_eye, vel_eye, True
+            pos_eye, vel_eye = self._true_ball_eye()
+            return pos_eye.tolist(), vel_eye.tolist(), True
         vp = self.vision_params
         if vp.foveated and saccading:  # saccadic suppression
-            return np.zeros(3), np.zeros(3), False
+            return [0.0, 0.0, 0.0], [0.0, 0.0, 0.0], False
         d = self.data
-        # Retinal slip: line-of-sight angular velocity minus the eye's own (world) angular velocity.
-        rel = d.qpos[self._ball_qpos : self._ball_qpos + 3] - self._eye_pos
-        rel_vel = d.qvel[self._ball_dof : self._ball_dof + 3] - (self._eye_pos - self._prev_eye_pos) / self.dt
-        dist2 = float(rel @ rel)
-        slip = cross(rel, rel_vel) / dist2 - self.plant.angular_velocity
-        along = rel * (float(slip @ rel) / dist2)
-        retinal_speed = norm(slip - along)
+        bq, bd = self._ball_qpos, self._ball_dof
+        ball = d.qpos[bq : bq + 3]
+        ball_vel = d.qvel[bd : bd + 3]
+        rot = self._eye_rot
+        rel = ball - self._eye_pos
+        pos_eye = (rel @ rot).tolist()  # R^T (p - r): Eyecatch Eq. 6-7
+        vel_eye = (ball_vel @ rot).tolist()
+        # Retinal slip: line-of-sight angular velocity minus the eye's own (world) angular velocity,
+        # perpendicular to the line of sight.
+        rx, ry, rz = rel.tolist()
+        ux, uy, uz = (ball_vel - (self._eye_pos - self._prev_eye_pos) / self.dt).tolist()
+        wx, wy, wz = self.plant.angular_velocity.tolist()
+        dist2 = rx * rx + ry * ry + rz * rz
+        sx = (ry * uz - rz * uy) / dist2 - wx
+        sy = (rz * ux - rx * uz) / dist2 - wy
+        sz = (rx * uy - ry * ux) / dist2 - wz
+        along = (sx * rx + sy * ry + sz * rz) / dist2
+        sx, sy, sz = sx - along * rx, sy - along * ry, sz - along * rz
+        retinal_speed = math.sqrt(sx * sx + sy * sy + sz * sz)
         return foveation.perceive(pos_eye, vel_eye, retinal_speed, vp, self.np_random)
 
     def _observe(self, saccading: bool) -> np.ndarray:
@@ -656,7 +665,7 @@ class EyeCatchEnv(gym.Env):
         if self.delay_steps:
             self._delay_buffer.append(sample)
             if len(self._delay_buffer) <= self.delay_steps:
-                sample = (np.zeros(3), np.zeros(3), False)  # nothing has reached the brain yet
+                sample = ([0.0, 0.0, 0.0], [0.0, 0.0, 0.0], False)  # nothing has reached the brain yet
             else:
                 sample = self._delay_buffer[0]
         pos, vel, visible = sample
@@ -665,8 +674,8 @@ class EyeCatchEnv(gym.Env):
         plant = self.plant
         qpos, qvel = d.qpos, d.qvel
         values = [
-            *pos.tolist(),
-            *vel.tolist(),
+            *pos,
+            *vel,
             1.0 if visible else 0.0,
             self.visual_delay_s,
             *(self._eye_pos - SEAT_ORIGIN).tolist(),

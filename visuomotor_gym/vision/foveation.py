@@ -89,18 +89,20 @@ def line_of_sight_rotation(direction: np.ndarray) -> np.ndarray:
 
     Rodrigues' formula with w = x_hat cross u, theta = angle(x_hat, u) (Eyecatch Eq. 3).
     """
-    ux, uy, uz = float(direction[0]), float(direction[1]), float(direction[2])
+    return np.array(_los_rows(float(direction[0]), float(direction[1]), float(direction[2])))
+
+
+def _los_rows(ux: float, uy: float, uz: float):
+    """Rows of :func:`line_of_sight_rotation` as tuples of floats (the per-step path)."""
     c = ux
     if c < -1.0 + 1e-12:  # exactly behind: any half-turn about an axis perpendicular to x
-        return np.diag([-1.0, -1.0, 1.0])
+        return ((-1.0, 0.0, 0.0), (0.0, -1.0, 0.0), (0.0, 0.0, 1.0))
     # k = (1,0,0) x u = (0, -uz, uy); R = I + [k] + [k]^2 / (1 + c)
     f = 1.0 / (1.0 + c)
-    return np.array(
-        [
-            [c, -uy, -uz],
-            [uy, 1.0 - f * uy * uy, -f * uy * uz],
-            [uz, -f * uy * uz, 1.0 - f * uz * uz],
-        ]
+    return (
+        (c, -uy, -uz),
+        (uy, 1.0 - f * uy * uy, -f * uy * uz),
+        (uz, -f * uy * uz, 1.0 - f * uz * uz),
     )
 
 
@@ -126,14 +128,18 @@ def standard_deviations(distance: float, eccentricity_rad: float, retinal_speed:
     velocity minus the eye's own angular velocity, so pursuit that stabilises the image sharpens the
     velocity estimate.
     """
+    return np.array(_sigmas(distance, eccentricity_rad, retinal_speed, params))
+
+
+def _sigmas(distance, eccentricity_rad, retinal_speed, params):
+    """``standard_deviations`` as a tuple of floats (the per-step path)."""
     k = distance * params.noise_scale / acuity(eccentricity_rad, params)
     lateral = k * params.retinal_position_std_arcmin * ARCMIN
     lateral_rate = k * (
         params.retinal_velocity_weber * abs(retinal_speed) + params.retinal_velocity_floor_deg_s * DEG
     )
-    return np.array(
-        [k * params.depth_std_fraction, lateral, lateral, k * params.depth_rate_std_fraction, lateral_rate, lateral_rate]
-    )
+    return (k * params.depth_std_fraction, lateral, lateral, k * params.depth_rate_std_fraction, lateral_rate,
+            lateral_rate)
 
 
 def covariance(position_eye: np.ndarray, retinal_speed: float, params: VisionParams) -> np.ndarray:
@@ -156,38 +162,37 @@ def sample(
     rng: np.random.Generator,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Draw one perceived (position, velocity) in the eye frame, ignoring the field of view."""
-    d = math.sqrt(float(position_eye @ position_eye))
-    if d <= 0.0:
-        return position_eye.copy(), velocity_eye.copy()
-    ecc = math.acos(max(-1.0, min(1.0, float(position_eye[0]) / d)))
-    return _draw(position_eye, velocity_eye, d, ecc, retinal_speed, params, rng)
+    pos, vel = _draw(list(map(float, position_eye)), list(map(float, velocity_eye)), retinal_speed, params, rng)
+    return np.array(pos), np.array(vel)
 
 
-def perceive(
-    position_eye: np.ndarray,
-    velocity_eye: np.ndarray,
-    retinal_speed: float,
-    params: VisionParams,
-    rng: np.random.Generator,
-) -> tuple[np.ndarray, np.ndarray, bool]:
-    """One look at a point: ``(position, velocity, visible)`` in the eye frame.
+def perceive(position_eye, velocity_eye, retinal_speed: float, params: VisionParams, rng: np.random.Generator):
+    """One look at a point: ``(position, velocity, visible)`` in the eye frame, as float lists.
 
     Outside the field of view nothing is drawn and zeros are returned with ``visible=False``
     (saccadic suppression is the caller's business: it knows when the eye moved).
     """
-    d = math.sqrt(float(position_eye @ position_eye))
-    ecc = math.acos(max(-1.0, min(1.0, float(position_eye[0]) / d))) if d > 0.0 else 0.0
-    if params.foveated and ecc > params.field_of_view_deg * DEG:
-        return np.zeros(3), np.zeros(3), False
-    if d <= 0.0:
-        return position_eye.copy(), velocity_eye.copy(), True
-    pos, vel = _draw(position_eye, velocity_eye, d, ecc, retinal_speed, params, rng)
+    x, y, z = position_eye
+    d = math.sqrt(x * x + y * y + z * z)
+    if params.foveated and d > 0.0 and math.acos(max(-1.0, min(1.0, x / d))) > params.field_of_view_deg * DEG:
+        return [0.0, 0.0, 0.0], [0.0, 0.0, 0.0], False
+    pos, vel = _draw(position_eye, velocity_eye, retinal_speed, params, rng)
     return pos, vel, True
 
 
-def _draw(position_eye, velocity_eye, d, ecc, retinal_speed, params, rng):
-    """Noise A Sigma eps, eps ~ N(0, I6) (Eyecatch Eq. 1-3), added to the true state."""
-    sig = standard_deviations(d, ecc, retinal_speed, params)
-    rot = line_of_sight_rotation(position_eye / d)
-    eps = (rng.standard_normal(6) * sig).reshape(2, 3) @ rot.T  # rows: R (Sigma eps)_pos, R (Sigma eps)_vel
-    return position_eye + eps[0], velocity_eye + eps[1]
+def _draw(position_eye, velocity_eye, retinal_speed, params, rng):
+    """True state + A Sigma eps with eps ~ N(0, I6) (Eyecatch Eq. 1-3); float lists in and out."""
+    x, y, z = position_eye
+    d = math.sqrt(x * x + y * y + z * z)
+    if d <= 0.0:
+        return list(position_eye), list(velocity_eye)
+    ecc = math.acos(max(-1.0, min(1.0, x / d)))
+    s0, s1, s2, s3, s4, s5 = _sigmas(d, ecc, retinal_speed, params)
+    e0, e1, e2, e3, e4, e5 = rng.standard_normal(6).tolist()
+    n0, n1, n2, n3, n4, n5 = s0 * e0, s1 * e1, s2 * e2, s3 * e3, s4 * e4, s5 * e5
+    (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = _los_rows(x / d, y / d, z / d)
+    vx, vy, vz = velocity_eye
+    return (
+        [x + r00 * n0 + r01 * n1 + r02 * n2, y + r10 * n0 + r11 * n1 + r12 * n2, z + r20 * n0 + r21 * n1 + r22 * n2],
+        [vx + r00 * n3 + r01 * n4 + r02 * n5, vy + r10 * n3 + r11 * n4 + r12 * n5, vz + r20 * n3 + r21 * n4 + r22 * n5],
+    )
