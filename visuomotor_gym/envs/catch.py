@@ -316,6 +316,10 @@ class EyeCatchEnv(gym.Env):
         self._az_range = (op.eye_azimuth_range_deg[0] * DEG, op.eye_azimuth_range_deg[1] * DEG)
         self._el_range = (op.eye_elevation_range_deg[0] * DEG, op.eye_elevation_range_deg[1] * DEG)
         self._head_vmax = op.head_max_deg_s * DEG
+        self._bad_warnings = [
+            int(w) for w in (mujoco.mjtWarning.mjWARN_BADQPOS, mujoco.mjtWarning.mjWARN_BADQVEL,
+                             mujoco.mjtWarning.mjWARN_BADQACC)
+        ]
         self._log_fix = (math.log(op.fixation_range_m[0]), math.log(op.fixation_range_m[1]))
 
         # --- spaces -----------------------------------------------------------------------------
@@ -374,6 +378,7 @@ class EyeCatchEnv(gym.Env):
         self._place_wall(throw)
         d.eq_active[self._weld] = 0
         mujoco.mj_forward(m, d)
+        self._warning_counts = [d.warning[i].number for i in self._bad_warnings]
 
         # Gaze on the release point (the thrower's hand), with a small jitter.
         eye_pos = d.xpos[self._head_body] + d.xmat[self._head_body].reshape(3, 3) @ self._eye_offset
@@ -543,9 +548,11 @@ class EyeCatchEnv(gym.Env):
                 mujoco.mj_step(m, d)
                 if not caught and self._catch_now(d.xpos[self._ball_body]):
                     caught = True
-        # MuJoCo checks qpos/qvel/qacc every substep (NaN, inf or > 1e10) and resets the data when one is
-        # bad, which sends the time back to 0 (data.warning records it): that is our divergence signal.
-        return caught, abs(d.time - t_expected) > 0.5 * m.opt.timestep
+        # MuJoCo checks qpos/qvel/qacc every substep (NaN, inf or > 1e10), counts a warning and resets
+        # the data (time back to 0) when one is bad: either sign is our divergence signal.
+        warn = d.warning
+        counts = [warn[i].number for i in self._bad_warnings]
+        return caught, counts != self._warning_counts or abs(d.time - t_expected) > 0.5 * m.opt.timestep
 
     def _catch_possible(self) -> bool:
         """Whether a catch could happen during the coming control step (else skip substep checks)."""
