@@ -32,13 +32,6 @@ def angle_between(a, b) -> float:
     return math.atan2(math.sqrt(cx * cx + cy * cy + cz * cz), ax * bx + ay * by + az * bz)
 
 
-def rotation_axis(a, b) -> np.ndarray:
-    """Unit axis of the shortest rotation from ``a`` to ``b`` (zero if they are parallel)."""
-    c = cross(a, b)
-    n = norm(c)
-    return c / n if n > 1e-12 else np.zeros(3)
-
-
 def solve3(m: np.ndarray, v: np.ndarray) -> np.ndarray:
     """Solve the 3x3 system ``m x = v`` by Cramer's rule (for well-conditioned, e.g. damped, ``m``)."""
     (a, b, c), (d, e, f), (g, h, i) = m.tolist()

@@ -388,10 +388,11 @@ class EyeCatchEnv(gym.Env):
         self._fixation = float(np.linalg.norm(throw.release_pos - eye_pos))
         self._apply_gaze()
         self._prev_eye_pos = self._eye_pos.copy()
+        self._prev_gaze = self._eye_rot[:, 0].tolist()
         self.hand.reset(d.site_xpos[self._catch_site])
         self._hand_prev = d.site_xpos[self._catch_site].copy()
         obs = self._observe(saccading=False)
-        self._last_obs = obs
+        self._last_obs = obs.copy()
         info = self._info(caught=False, missed=False, diverged=False, terms={}, visible=self._visible)
         info.update(
             release_pos=throw.release_pos.copy(),
@@ -450,8 +451,9 @@ class EyeCatchEnv(gym.Env):
         caught = caught or self._catch_now(d.xpos[self._ball_body])
         self._apply_gaze()
         obs = self._observe(saccading=plant_step.saccading)
-        self._last_obs = obs
+        self._last_obs = obs.copy()  # the fallback after divergence; the caller may edit ``obs``
         self._prev_eye_pos = self._eye_pos.copy()
+        self._prev_gaze = self._eye_rot[:, 0].tolist()
 
         # --- outcome and reward --------------------------------------------------------------
         ball = d.qpos[self._ball_qpos : self._ball_qpos + 3]
@@ -652,11 +654,14 @@ class EyeCatchEnv(gym.Env):
         rel = ball - self._eye_pos
         pos_eye = (rel @ rot).tolist()  # R^T (p - r): Eyecatch Eq. 6-7
         vel_eye = (ball_vel @ rot).tolist()
-        # Retinal slip: line-of-sight angular velocity minus the eye's own (world) angular velocity,
-        # perpendicular to the line of sight.
+        # Retinal slip: line-of-sight angular velocity minus the gaze's own angular velocity over the
+        # step (pursuit, or the head carrying a clamped eye), perpendicular to the line of sight.
         rx, ry, rz = rel.tolist()
         ux, uy, uz = (ball_vel - (self._eye_pos - self._prev_eye_pos) / self.dt).tolist()
-        wx, wy, wz = self.plant.angular_velocity.tolist()
+        ax, ay, az = self._prev_gaze
+        bx, by, bz = rot[:, 0].tolist()
+        inv_dt = 1.0 / self.dt
+        wx, wy, wz = (ay * bz - az * by) * inv_dt, (az * bx - ax * bz) * inv_dt, (ax * by - ay * bx) * inv_dt
         dist2 = rx * rx + ry * ry + rz * rz
         sx = (ry * uz - rz * uy) / dist2 - wx
         sy = (rz * ux - rx * uz) / dist2 - wy

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from visuomotor_gym.geometry import angle_between, rotation_axis
+from visuomotor_gym.geometry import angle_between, cross
 
 DEG = math.pi / 180.0
 
@@ -63,6 +63,12 @@ class OculomotorParams:
             value = getattr(self, name)
             if not (math.isfinite(value) and value > 0.0):
                 raise ValueError(f"OculomotorParams.{name} must be finite and > 0, got {value!r}")
+        for name in ("eye_azimuth_range_deg", "eye_elevation_range_deg", "fixation_range_m"):
+            lo, hi = getattr(self, name)
+            if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
+                raise ValueError(f"OculomotorParams.{name} must be (low, high) with low < high, got {(lo, hi)!r}")
+        if self.fixation_range_m[0] <= 0:
+            raise ValueError("OculomotorParams.fixation_range_m must be positive")
         for name in ("saccade_refractory_s", "main_sequence_intercept_s", "saccade_endpoint_noise"):
             value = getattr(self, name)
             if not (math.isfinite(value) and value >= 0.0):
@@ -93,20 +99,32 @@ def angles_from_direction(direction: np.ndarray) -> tuple[float, float]:
     return math.atan2(y, x), math.atan2(z, math.hypot(x, y))
 
 
+def _tangent(a: np.ndarray, b: np.ndarray, angle: float) -> np.ndarray:
+    """Unit vector perpendicular to ``a`` in the plane of the great circle from ``a`` toward ``b``.
+
+    For exactly opposite ``a`` and ``b`` every great circle qualifies; we take the horizontal one
+    (rotation about the world z axis), or one about y if ``a`` is vertical.
+    """
+    s = math.sin(angle)
+    if s > 1e-9:
+        return (b - math.cos(angle) * a) / s
+    ax, ay, az = a.tolist()
+    w = np.array([-ay, ax, 0.0]) if abs(az) < 0.9 else np.array([az, 0.0, -ax])
+    return w / math.sqrt(float(w @ w))
+
+
 def _slerp(a: np.ndarray, b: np.ndarray, angle: float, fractions):
     """Points at ``fractions`` of the great-circle arc from ``a`` to ``b`` (``angle`` apart)."""
-    if isinstance(fractions, float):
-        if angle < 1e-9:
+    if angle < 1e-12:
+        if isinstance(fractions, float):
             return np.array(b, dtype=float)
-        s = math.sin(angle)
-        return (math.sin((1.0 - fractions) * angle) / s) * a + (math.sin(fractions * angle) / s) * b
-    if angle < 1e-9:
         return np.broadcast_to(b, (np.size(fractions), 3)).copy()
-    s = math.sin(angle)
-    f = np.asarray(fractions, dtype=float)
-    wa = np.sin((1.0 - f) * angle) / s
-    wb = np.sin(f * angle) / s
-    return wa[:, None] * a + wb[:, None] * b
+    w = _tangent(a, b, angle)
+    if isinstance(fractions, float):
+        t = fractions * angle
+        return math.cos(t) * a + math.sin(t) * w
+    t = np.asarray(fractions, dtype=float) * angle
+    return np.cos(t)[:, None] * a + np.sin(t)[:, None] * w
 
 
 @dataclass
@@ -178,9 +196,8 @@ class OculomotorPlant:
                 if p.saccade_endpoint_noise > 0.0 and rng is not None:
                     end = _perturb(end, rng.standard_normal(2) * p.saccade_endpoint_noise * amplitude)
                     amplitude = angle_between(self.gaze, end)
-                self.saccade = Saccade(
-                    t0, p.saccade_duration(amplitude), self.gaze.copy(), end, amplitude, rotation_axis(self.gaze, end)
-                )
+                axis = cross(self.gaze, _tangent(self.gaze, end, amplitude))
+                self.saccade = Saccade(t0, p.saccade_duration(amplitude), self.gaze.copy(), end, amplitude, axis)
                 self.saccades.append(self.saccade)
                 self.last_onset = t0
                 started = True
@@ -209,7 +226,7 @@ class OculomotorPlant:
                     fractions = np.arange(1, n_substeps + 1) / n_substeps * (travel / amplitude)
                     points = _slerp(start, target, amplitude, fractions)
                 self.gaze = _slerp(start, target, amplitude, travel / amplitude)
-                self.angular_velocity = rotation_axis(start, target) * (travel / dt)
+                self.angular_velocity = cross(start, _tangent(start, target, amplitude)) * (travel / dt)
             else:
                 if self.record:
                     points = np.broadcast_to(start, (n_substeps, 3)).copy()
