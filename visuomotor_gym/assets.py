@@ -28,9 +28,9 @@ def assets_dir() -> Path:
             raise FileNotFoundError(f"{ASSETS_ENV_VAR}={override!r} is not a directory")
         return path
     try:
-        installed = Path(str(resources.files("visuomotor_gym.envs_assets")))
-        if (installed / "catch.xml").is_file():
-            return installed
+        installed = resources.files("visuomotor_gym.envs_assets").joinpath("catch.xml")
+        if installed.is_file():
+            return Path(str(installed)).parent
     except (ModuleNotFoundError, TypeError):
         pass
     source = Path(__file__).resolve().parent.parent / "envs_assets"

@@ -513,9 +513,14 @@ class EyeCatchEnv(gym.Env):
 
     def _check_action(self, action) -> np.ndarray:
         try:
-            a = np.asarray(action, dtype=np.float64)
+            a = np.asarray(action)
         except (TypeError, ValueError) as exc:
             raise ValueError(f"action must be a numeric array of shape {self.action_space.shape}; got {action!r}") from exc
+        if a.dtype.kind not in "biuf":
+            raise ValueError(
+                f"action must be a real numeric array of shape {self.action_space.shape}; got dtype {a.dtype}"
+            )
+        a = a.astype(np.float64)
         if a.shape != self.action_space.shape:
             raise ValueError(
                 f"action must have shape {self.action_space.shape} (blocks {self.action_structure}), got shape {a.shape}"

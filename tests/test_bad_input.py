@@ -1,0 +1,245 @@
+"""Bad actions, constructor arguments and reset options fail loudly, with a message naming the problem."""
+
+from __future__ import annotations
+
+import inspect
+import re
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import visuomotor_gym  # noqa: F401  (registers the ids)
+from visuomotor_gym.envs.catch import EyeCatchEnv
+
+N_ACT = 9
+
+
+@pytest.fixture
+def env():
+    env = gym.make("EyeCatch-v0").unwrapped  # unwrapped: the env itself must validate, not a wrapper
+    env.reset(seed=0)
+    return env
+
+
+def _valid() -> np.ndarray:
+    return np.zeros(N_ACT, np.float32)
+
+
+# ----------------------------------------------------------------------------------------------
+# actions
+# ----------------------------------------------------------------------------------------------
+def _with(index: int, value: float) -> np.ndarray:
+    a = _valid()
+    a[index] = value
+    return a
+
+
+@pytest.mark.parametrize(
+    "action",
+    [
+        _with(0, np.nan),
+        _with(4, np.inf),
+        _with(8, -np.inf),
+        np.full(N_ACT, np.nan),
+        [0.0] * 8 + [float("nan")],
+    ],
+    ids=["nan", "inf", "-inf", "all-nan", "list-with-nan"],
+)
+def test_non_finite_action_raises(env, action):
+    with pytest.raises(ValueError, match=r"(?i)nan|inf|finite"):
+        env.step(action)
+
+
+@pytest.mark.parametrize(
+    "action",
+    [
+        np.zeros(8, np.float32),
+        np.zeros(10, np.float32),
+        np.zeros((1, N_ACT), np.float32),
+        np.zeros((N_ACT, 1), np.float32),
+        np.zeros((3, 3), np.float32),
+        np.float32(0.0),
+        [],
+        [0.0] * 8,
+        None,
+    ],
+    ids=["8", "10", "1x9", "9x1", "3x3", "scalar", "empty", "list-8", "None"],
+)
+def test_wrong_shape_action_raises(env, action):
+    with pytest.raises(ValueError, match=r"shape") as excinfo:
+        env.step(action)
+    assert "(9,)" in str(excinfo.value), "the message should say which shape is expected"
+
+
+@pytest.mark.parametrize(
+    "action",
+    [["a"] * N_ACT, "abc", {"hand": 1}, [object()] * N_ACT, [0.0, [1.0, 2.0]] + [0.0] * 7, b"abcdefghi"],
+    ids=["strings", "str", "dict", "objects", "ragged", "bytes"],
+)
+def test_non_numeric_action_raises(env, action):
+    with pytest.raises(ValueError, match=r"(?i)action.*numeric|numeric.*action"):
+        env.step(action)
+
+
+@pytest.mark.parametrize(
+    "action",
+    [np.array(["0.1"] * N_ACT), np.zeros(N_ACT, dtype="datetime64[s]")],
+    ids=["numeric-strings", "datetime64"],
+)
+def test_non_numeric_dtype_action_raises(env, action):
+    with pytest.raises(ValueError, match=r"(?i)numeric"):
+        env.step(action)
+
+
+def test_bad_action_does_not_advance_the_env(env):
+    before = env.data.time
+    with pytest.raises(ValueError):
+        env.step(_with(0, np.nan))
+    assert env.data.time == before
+    obs, *_ = env.step(_valid())  # still usable
+    assert np.all(np.isfinite(obs))
+
+
+@pytest.mark.parametrize("scale", [1.5, 5.0, 1e30, np.finfo(np.float64).max])
+def test_out_of_range_finite_actions_are_clipped(scale):
+    rng = np.random.default_rng(1)
+    base = rng.uniform(-1, 1, N_ACT)
+    base[np.abs(base) < 0.3] = 0.7  # every component well away from zero
+    big = np.sign(base) * scale  # far outside [-1, 1]
+    env_big = gym.make("EyeCatch-v0").unwrapped
+    env_clip = gym.make("EyeCatch-v0").unwrapped
+    env_big.reset(seed=2)
+    env_clip.reset(seed=2)
+    for _ in range(10):
+        obs_big, r_big, term_big, _, info_big = env_big.step(big)  # float64, out of range: no error
+        obs_clip, r_clip, term_clip, _, info_clip = env_clip.step(np.sign(base).astype(np.float32))
+        np.testing.assert_array_equal(obs_big, obs_clip)
+        assert term_big == term_clip
+        if term_big:
+            break
+    # effort is computed on the clipped action too
+    env_big = gym.make("EyeCatch-v0", reward="shaped").unwrapped
+    env_big.reset(seed=2)
+    _, _, _, _, info = env_big.step(big)
+    assert info["reward_terms"]["effort"] == pytest.approx(-0.001 * 1.0, rel=1e-9)
+
+
+def test_equivalent_action_containers_give_the_same_step():
+    action = np.random.default_rng(5).uniform(-1, 1, N_ACT)
+    results = []
+    for container in (action.astype(np.float32), action.astype(np.float32).astype(np.float64),
+                      action.astype(np.float32).tolist(), tuple(action.astype(np.float32).tolist())):
+        e = gym.make("EyeCatch-v0").unwrapped
+        e.reset(seed=4)
+        results.append(e.step(container)[0])
+    for obs in results[1:]:
+        np.testing.assert_array_equal(obs, results[0])
+
+
+# ----------------------------------------------------------------------------------------------
+# constructor arguments
+# ----------------------------------------------------------------------------------------------
+def _allowed() -> list[str]:
+    params = inspect.signature(EyeCatchEnv.__init__).parameters
+    return [n for n, p in params.items() if n != "self" and p.kind is not inspect.Parameter.VAR_KEYWORD]
+
+
+@pytest.mark.parametrize("via", ["gym.make", "direct"])
+@pytest.mark.parametrize(
+    "kwargs", [{"foo": 1}, {"visual_delay": 0.1}, {"foo": 1, "bar": 2, "vision": "oracle"}]
+)
+def test_unknown_kwargs_raise_type_error_listing_allowed_names(via, kwargs):
+    with pytest.raises(TypeError) as excinfo:
+        if via == "gym.make":
+            gym.make("EyeCatch-v0", **kwargs)
+        else:
+            EyeCatchEnv(**kwargs)
+    message = str(excinfo.value)
+    for name in kwargs:
+        if name not in _allowed():
+            assert name in message, f"the unknown name {name!r} is not named"
+    for name in _allowed():
+        assert re.search(rf"\b{name}\b", message), f"allowed argument {name!r} not listed in: {message}"
+
+
+BAD_VALUES = [
+    ({"vision": "x"}, "vision"),
+    ({"vision": None}, "vision"),
+    ({"control": "x"}, "control"),
+    ({"obs_mode": "x"}, "obs_mode"),
+    ({"reward": "x"}, "reward"),
+    ({"render_mode": "x"}, "render_mode"),
+    ({"render_camera": "x"}, "render_camera"),
+    ({"control_dt": 0.003}, "control_dt"),
+    ({"control_dt": 0.0}, "control_dt"),
+    ({"control_dt": -0.02}, "control_dt"),
+    ({"visual_delay_s": 0.03}, "visual_delay_s"),
+    ({"visual_delay_s": -0.02}, "visual_delay_s"),
+    ({"reward_weights": {"nope": 1}}, "nope"),
+    ({"vision_params": {"nope": 1}}, "nope"),
+    ({"vision_params": 3}, "vision_params"),
+    ({"oculomotor_params": {"nope": 1}}, "nope"),
+    ({"hand_params": {"nope": 1}}, "nope"),
+    ({"throw_distribution": {"nope": 1}}, "nope"),
+    ({"throw_distribution": {"flight_time_s": (1.4, 0.8)}}, "flight_time_s"),
+    ({"vision_noise_scale": -1.0}, "vision_noise_scale"),
+    ({"vision_noise_scale": float("nan")}, "vision_noise_scale"),
+    ({"catch_radius": 0.0}, "catch_radius"),
+    ({"grasp_closed_fraction": 1.5}, "grasp_closed_fraction"),
+]
+
+
+# gym.make's own warning about render_mode="x", before the env raises
+@pytest.mark.filterwarnings("ignore:.*not in the possible render_modes")
+@pytest.mark.parametrize("via", ["gym.make", "direct"])
+@pytest.mark.parametrize(
+    "kwargs,named", BAD_VALUES, ids=[f"{k}={v!r}" for (kw, _) in BAD_VALUES for k, v in kw.items()]
+)
+def test_bad_constructor_values_raise_clear_error(via, kwargs, named):
+    with pytest.raises((ValueError, TypeError)) as excinfo:
+        if via == "gym.make":
+            gym.make("EyeCatch-v0", **kwargs)
+        else:
+            EyeCatchEnv(**kwargs)
+    assert named in str(excinfo.value), f"{excinfo.value!r} does not name {named!r}"
+
+
+@pytest.mark.parametrize("kwargs,choices", [
+    ({"vision": "x"}, ["foveated", "full_view", "oracle"]),
+    ({"control": "x"}, ["hand", "joint"]),
+    ({"obs_mode": "x"}, ["flat", "dict"]),
+    ({"reward": "x"}, ["sparse", "shaped"]),
+    ({"render_mode": "x"}, ["rgb_array", "human"]),
+])
+def test_bad_choice_lists_the_valid_choices(kwargs, choices):
+    with pytest.raises(ValueError) as excinfo:
+        EyeCatchEnv(**kwargs)
+    for choice in choices:
+        assert choice in str(excinfo.value)
+
+
+@pytest.mark.parametrize("kwargs", [
+    {"control_dt": 0.004}, {"control_dt": 0.01}, {"visual_delay_s": 0.04}, {"vision_noise_scale": 0.0},
+    {"reward_weights": {"catch": 2.0}}, {"vision_params": {}}, {"render_mode": None},
+])
+def test_valid_edge_values_are_accepted(kwargs):
+    env = gym.make("EyeCatch-v0", **kwargs)
+    obs, _ = env.reset(seed=0)
+    obs, *_ = env.step(_valid())
+    assert np.all(np.isfinite(obs))
+
+
+# ----------------------------------------------------------------------------------------------
+# reset
+# ----------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("options", [{"x": 1}, {"seed": 3}, {"throw": None}])
+def test_reset_with_unknown_options_raises(env, options):
+    with pytest.raises(ValueError, match=re.escape(str(sorted(options)))):
+        env.reset(options=options)
+
+
+def test_reset_with_empty_or_no_options_is_fine(env):
+    obs_a, _ = env.reset(seed=1, options=None)
+    obs_b, _ = env.reset(seed=1, options={})
+    np.testing.assert_array_equal(obs_a, obs_b)
