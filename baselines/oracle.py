@@ -2,12 +2,15 @@
 
 It reads the *true* ball state that only the Oracle variant puts in the observation, extrapolates
 the ballistic flight to the frontal plane ``x = intercept_x`` in front of the right shoulder, and
-holds the hand there, closed (or open, to check that an open hand never catches). It is a check of
+holds the hand there, closed (or open, to check that an open hand never catches); the eye follows
+the ball (saccades when it is far off the line of sight, pursuit otherwise). It is a check of
 the environment (throws are catchable, catch detection works), not a model of human catching; on
 the foveated variants its input is noisy and it has no filter, so it is not a leaderboard agent.
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 
@@ -21,9 +24,17 @@ _S = ObservationLayout().slices
 class InterceptOracle:
     """Move the catch site to where the ball will cross ``x = intercept_x`` (world, metres)."""
 
-    def __init__(self, intercept_x: float = 0.38, grasp_closed: bool = True):
+    def __init__(
+        self,
+        intercept_x: float = 0.38,
+        grasp_closed: bool = True,
+        track_with_eye: bool = True,
+        gaze_action_range_deg: float = 60.0,
+    ):
         self.intercept_x = float(intercept_x)
         self.grasp = 1.0 if grasp_closed else -1.0
+        self.track_with_eye = bool(track_with_eye)
+        self.gaze_range = math.radians(gaze_action_range_deg)
 
     def intercept_point(self, obs: np.ndarray) -> np.ndarray | None:
         """World point where the observed ball crosses the intercept plane, or None."""
@@ -52,4 +63,9 @@ class InterceptOracle:
             lo, hi = HAND_WORKSPACE[:, 0], HAND_WORKSPACE[:, 1]
             action[:3] = np.clip(2.0 * (hand - lo) / (hi - lo) - 1.0, -1.0, 1.0)
         action[3] = self.grasp
+        if self.track_with_eye and obs[_S["ball_visible"]][0] > 0.5:
+            # Request the ball's retinal direction: a saccade when far off, pursuit when close.
+            x, y, z = obs[_S["ball_pos"]].astype(float)
+            action[4] = np.clip(math.atan2(y, x) / self.gaze_range, -1.0, 1.0)
+            action[5] = np.clip(math.atan2(z, math.hypot(x, y)) / self.gaze_range, -1.0, 1.0)
         return action, state
