@@ -737,6 +737,7 @@ class EyeCatchEnv(gym.Env):
             "gaze_dir": self.plant.gaze.copy(),
             "eye_pos": self._eye_pos.copy(),
             "head_qpos": d.qpos[self._neck_qpos].copy(),
+            "head_dir": d.xmat[self._head_body, 0::3].copy(),  # the head's forward axis, world
         }
 
     # ------------------------------------------------------------------------------------------

@@ -1,0 +1,133 @@
+"""One policy interface for every agent, and the registry of agent names.
+
+Every agent is a :class:`Policy`: ``predict(observation, state, episode_start, deterministic) ->
+(action, state)``, the stable-baselines3 ``PolicyPredictor`` protocol, so SB3 models plug in
+unchanged. Agents see observations only, never ``info`` (the true state).
+
+Agent names (``make_agent``):
+
+* ``eyecatch``: the Eyecatch heuristic of Yeo et al. 2012 (``visuomotor_gym.baselines.eyecatch``);
+  keyword overrides as ``eyecatch:param=value,param=value``;
+* ``oracle``: the scripted interception oracle (true state; meaningful on ``EyeCatchOracle-v0`` only);
+* ``random``: uniform random actions (seeded);
+* ``zero``: all-zero actions (gaze held, hand at the workspace centre).
+
+Further names register with :func:`register_agent`.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Callable, Protocol, runtime_checkable
+
+import numpy as np
+
+
+@runtime_checkable
+class Policy(Protocol):
+    """What the evaluator needs from an agent (the SB3 ``PolicyPredictor`` protocol)."""
+
+    def predict(
+        self,
+        observation: np.ndarray,
+        state: Any = None,
+        episode_start: np.ndarray | None = None,
+        deterministic: bool = True,
+    ) -> tuple[np.ndarray, Any]: ...
+
+
+AgentFactory = Callable[..., Policy]
+_REGISTRY: dict[str, tuple[AgentFactory, str, bool]] = {}
+
+
+def register_agent(name: str, factory: AgentFactory, description: str = "", deterministic: bool = True) -> None:
+    """Register ``factory(env_id=..., action_dim=..., seed=..., **overrides) -> Policy`` under ``name``."""
+    if ":" in name:
+        raise ValueError(f"agent names cannot contain ':' (it separates overrides): {name!r}")
+    _REGISTRY[name] = (factory, description, deterministic)
+
+
+def agent_names() -> list[str]:
+    return sorted(_REGISTRY)
+
+
+def agent_description(name: str) -> str:
+    return _REGISTRY[name][1]
+
+
+def is_deterministic(spec: str) -> bool:
+    """Whether the named agent gives the same actions for the same observations (re-scorable)."""
+    name, _ = parse_agent_spec(spec)
+    return _REGISTRY[name][2]
+
+
+def parse_agent_spec(spec: str) -> tuple[str, dict[str, Any]]:
+    """``"eyecatch:alpha=1,beta=x"`` -> ``("eyecatch", {"alpha": 1, "beta": "x"})``."""
+    name, _, rest = spec.partition(":")
+    if name not in _REGISTRY:
+        raise ValueError(f"unknown agent {name!r}; known agents: {agent_names()}")
+    overrides: dict[str, Any] = {}
+    if rest:
+        for item in rest.split(","):
+            key, eq, value = item.partition("=")
+            if not eq or not key:
+                raise ValueError(f"agent override {item!r} in {spec!r} is not key=value")
+            overrides[key.strip()] = _parse_value(value.strip())
+    return name, overrides
+
+
+def _parse_value(text: str) -> Any:
+    for cast in (int, float):
+        try:
+            return cast(text)
+        except ValueError:
+            pass
+    if text.lower() in ("true", "false"):
+        return text.lower() == "true"
+    return text
+
+
+def make_agent(spec: str, env_id: str, action_dim: int, seed: int = 0) -> Policy:
+    """Build the agent named by ``spec`` for ``env_id``."""
+    name, overrides = parse_agent_spec(spec)
+    factory = _REGISTRY[name][0]
+    return factory(env_id=env_id, action_dim=action_dim, seed=seed, **overrides)
+
+
+class RandomAgent:
+    """Uniform random actions in [-1, 1], from its own seeded generator."""
+
+    def __init__(self, action_dim: int, seed: int = 0):
+        self.action_dim = action_dim
+        self.rng = np.random.default_rng(seed)
+
+    def predict(self, observation, state=None, episode_start=None, deterministic=True):
+        return self.rng.uniform(-1.0, 1.0, self.action_dim).astype(np.float32), state
+
+
+class ZeroAgent:
+    """All-zero actions."""
+
+    def __init__(self, action_dim: int):
+        self.action_dim = action_dim
+
+    def predict(self, observation, state=None, episode_start=None, deterministic=True):
+        return np.zeros(self.action_dim, dtype=np.float32), state
+
+
+def _oracle(env_id, action_dim, seed, **kw):
+    from visuomotor_gym.baselines.oracle import InterceptOracle
+
+    return InterceptOracle(**kw)
+
+
+def _eyecatch(env_id, action_dim, seed, **kw):
+    from visuomotor_gym.baselines.eyecatch import EyecatchAgent
+
+    return EyecatchAgent.for_env(env_id, **kw)
+
+
+register_agent("random", lambda env_id, action_dim, seed, **kw: RandomAgent(action_dim, seed, **kw),
+               "uniform random actions", deterministic=False)
+register_agent("zero", lambda env_id, action_dim, seed, **kw: ZeroAgent(action_dim, **kw), "all-zero actions")
+register_agent("oracle", _oracle, "scripted interception on the true ball state (Oracle env only)")
+register_agent("eyecatch", _eyecatch, "Eyecatch heuristic (Yeo et al. 2012): Kalman filter, saccades, submovements")
