@@ -58,7 +58,8 @@ class EyecatchParams:
     foveated: bool = True
     visual_delay_s: float = 0.0
     # Perception (Eyecatch 3.2).
-    reset_mahalanobis: float = 40.0  # adaptive reset threshold on y^T S^-1 y (chi^2, 6 dof)
+    reset_mahalanobis: float = 100.0  # adaptive reset threshold on y^T S^-1 y (chi^2, 6 dof: p ~ 1e-19;
+    # lower values reset spuriously in EyeCatchPoorVision-v0, whose noise makes rare large innovations)
     # Gaze (Eyecatch 4.1).
     first_saccade_retinal_std_deg: float = 0.5  # suppress the first saccade until S_yz std is below
     saccade_lead_s: float = 0.06  # saccades aim where the ball will be when they land
@@ -245,27 +246,31 @@ class EyecatchAgent:
     def _fuse(self, obs: np.ndarray) -> None:
         rot, eye = self.pose_history[0] if self.delay_steps else self.pose_history[-1]
         z = np.concatenate([obs[_S["ball_pos"]], obs[_S["ball_vel"]]])
+        # A visible ball is in front of the eye: a prior behind it (poor vision can put it there) is
+        # impossible, so the filter starts over.
+        if self.filter.initialised and float(rot[:, 0] @ (self.filter.x[:3] - eye)) <= 0.0:
+            self.filter.reset()
+            self.events.append((self.t, "reset"))
         # The noise covariance depends on where the ball is (distance, eccentricity) and on its
-        # retinal speed; the brain only has estimates of those. The direction comes from the sample
-        # (its lateral error is tiny), the distance from the prior once the prior's depth is better
-        # than one sample's (a single peripheral sample can be off by half the depth).
+        # retinal speed; the brain only has estimates of those. It takes the direction and velocity
+        # from its prior once it has one (a sample's direction is unreliable when its depth error is
+        # comparable to the distance, as with poor vision), and the larger of the prior's and the
+        # sample's distance: overestimating the noise only slows learning, underestimating it locks
+        # in a wrong estimate.
         pos, vel = z[:3], z[3:]
-        dist = math.sqrt(float(pos @ pos))
         if self.filter.initialised:
+            sample_dist = math.sqrt(float(pos @ pos))
             prior = rot.T @ (self.filter.x[:3] - eye)
             prior_dist = math.sqrt(float(prior @ prior))
-            u = prior / max(prior_dist, 1e-9)
-            prior_depth_var = float(u @ (rot.T @ self.filter.P[:3, :3] @ rot) @ u)
-            sample_depth_sd = foveation.standard_deviations(dist, foveation.eccentricity(pos), 0.0, self.vision)[0]
-            if prior_depth_var < sample_depth_sd**2:
-                pos = pos * (prior_dist / max(dist, 1e-9))
-        d2 = max(float(pos @ pos), 1e-9)
-        gaze_now = rot[:, 0]
-        slip = np.cross(pos, vel) / d2  # line-of-sight angular velocity, eye axes
+            pos = prior * (max(prior_dist, sample_dist) / max(prior_dist, 1e-9))
+            vel = rot.T @ self.filter.x[3:]
+        eye_turn = np.zeros(3)
         if self.prev_gaze is not None:
-            slip = slip - rot.T @ (np.cross(self.prev_gaze, gaze_now) / self.dt)  # minus the eye's own
-        slip -= pos * (float(slip @ pos) / d2)
-        R_meas = foveation.covariance(pos, float(np.linalg.norm(slip)), self.vision)
+            eye_turn = rot.T @ (np.cross(self.prev_gaze, rot[:, 0]) / self.dt)  # the eye's own rotation
+        # Retinal speed (Weber velocity noise): the larger of the prior's and the sample's, for the
+        # same reason as the distance.
+        speed = max(self._retinal_speed(pos, vel, eye_turn), self._retinal_speed(pos, z[3:], eye_turn))
+        R_meas = foveation.covariance(pos, speed, self.vision)
         before = self.filter.resets
         self.filter.update(z, R_meas, rot, eye)
         if self.filter.resets != before:
@@ -273,14 +278,31 @@ class EyecatchAgent:
             if self.proactive:  # the prediction is void: back to the reactive phase
                 self.proactive = False
 
+    @staticmethod
+    def _retinal_speed(pos: np.ndarray, vel: np.ndarray, eye_turn: np.ndarray) -> float:
+        """Speed (rad/s) of the image on the retina: line-of-sight rotation minus the eye's own."""
+        d2 = max(float(pos @ pos), 1e-9)
+        slip = np.cross(pos, vel) / d2 - eye_turn
+        slip -= pos * (float(slip @ pos) / d2)
+        return float(np.linalg.norm(slip))
+
     def _retinal_std(self) -> float:
-        """Angular std of the ball position across the line of sight, from S (Eq. 11)."""
+        """Angular std (rad) of the ball's retinal position, from the innovation covariance S (Eq. 11).
+
+        The position block of S is projected on the plane across the estimated line of sight: the
+        retinal coordinates are angles, and with poor peripheral vision the depth noise, rotated
+        off the visual axis, would otherwise swamp the eye frame's y-z block.
+        """
         S = self.filter.last_S
         if S is None:
             return math.inf
-        pos = self.filter.x[:3]
-        d = max(float(np.linalg.norm(pos - self.pose_history[-1][1])), 0.1)
-        return math.sqrt(max(S[1, 1], S[2, 2])) / d
+        rot, eye = self.pose_history[-1]
+        los = rot.T @ (self.filter.x[:3] - eye)
+        d = max(float(np.linalg.norm(los)), 0.1)
+        u = los / d
+        across = np.eye(3) - np.outer(u, u)
+        lateral = across @ S[:3, :3] @ across
+        return math.sqrt(max(float(np.trace(lateral)) / 2.0, 0.0)) / d
 
     def _retinal_angles(self, rot, eye, point) -> tuple[float, float]:
         v = rot.T @ (point - eye)

@@ -1,0 +1,277 @@
+"""``visuomotor_gym.viz``: the numeric helpers behind the Eyecatch-style figures (against closed forms),
+the figures of a real oracle episode, the MP4 recorder and the ``plot`` / ``record`` subcommands."""
+
+from __future__ import annotations
+
+import argparse
+import math
+
+import numpy as np
+import pytest
+
+pytest.importorskip("matplotlib")
+iio = pytest.importorskip("imageio.v3")
+
+from visuomotor_gym.bench.trace import EpisodeTrace, run_episode, save_traces  # noqa: E402
+from visuomotor_gym.viz import commands, plots  # noqa: E402
+
+ENV_ID = "EyeCatchOracle-v0"
+DT = 0.02
+
+
+def synthetic_trace(n=51, gaze=None, hand=None, ball=None, ball_vel=None, eye=None, head=None,
+                    onset=None, in_saccade=None, caught=True) -> EpisodeTrace:
+    """An EpisodeTrace from given arrays (defaults: everything still, looking straight ahead)."""
+    t = np.arange(n) * DT
+    ahead = np.tile([1.0, 0.0, 0.0], (n, 1))
+    return EpisodeTrace(
+        env_id="Synthetic-v0", agent="none", seed=0, dt=DT, t=t,
+        ball_pos=np.tile([3.0, 0.0, 1.2], (n, 1)) if ball is None else np.asarray(ball, float),
+        ball_vel=np.zeros((n, 3)) if ball_vel is None else np.asarray(ball_vel, float),
+        gaze_dir=ahead if gaze is None else np.asarray(gaze, float),
+        eye_pos=np.tile([0.1, 0.0, 1.2], (n, 1)) if eye is None else np.asarray(eye, float),
+        head_dir=ahead if head is None else np.asarray(head, float),
+        hand_pos=np.tile([0.3, -0.2, 0.9], (n, 1)) if hand is None else np.asarray(hand, float),
+        in_saccade=np.zeros(n, bool) if in_saccade is None else np.asarray(in_saccade, bool),
+        saccade_onset=np.zeros(n, bool) if onset is None else np.asarray(onset, bool),
+        ball_visible=np.ones(n, bool), action=np.full((n, 9), np.nan), latency_s=np.full(n, np.nan),
+        caught=caught, missed=not caught, diverged=False, truncated=False,
+        release_pos=np.array([3.0, 0.0, 1.2]), arrival_pos=np.array([0.3, -0.2, 0.9]), flight_time=1.0,
+    )
+
+
+def circle(n, rate_deg_s, axis="yaw", start_deg=0.0):
+    """Unit directions turning at a constant rate: about z (yaw) or in the x-z plane (pitch)."""
+    a = np.radians(start_deg + rate_deg_s * DT * np.arange(n))
+    if axis == "yaw":
+        return np.stack([np.cos(a), np.sin(a), np.zeros(n)], axis=1)
+    return np.stack([np.cos(a), np.zeros(n), np.sin(a)], axis=1)
+
+
+# ----------------------------------------------------------------------------------------------
+# Numeric helpers against closed forms
+# ----------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("axis", ["yaw", "pitch"])
+def test_gaze_turning_at_50_deg_s_gives_eye_speed_50(axis):
+    speed = plots.angular_speed_deg_s(circle(40, 50.0, axis, start_deg=-30.0), DT)
+    np.testing.assert_allclose(speed, 50.0, rtol=1e-9)
+    v = plots.velocity_profiles(synthetic_trace(40, gaze=circle(40, 50.0, axis)))
+    np.testing.assert_allclose(v["eye_speed"], 50.0, rtol=1e-9)
+    np.testing.assert_allclose(v["t"], (np.arange(39) + 0.5) * DT)
+
+
+def test_eye_speed_about_a_tilted_axis_and_of_unnormalised_directions():
+    axis = np.array([1.0, 2.0, 2.0]) / 3.0
+    u = np.cross(axis, [1.0, 0.0, 0.0])
+    u /= np.linalg.norm(u)
+    w = np.cross(axis, u)
+    a = np.radians(120.0) * DT * np.arange(30)
+    d = np.cos(a)[:, None] * u + np.sin(a)[:, None] * w  # a great circle at 120 deg/s
+    np.testing.assert_allclose(plots.angular_speed_deg_s(3.0 * d, DT), 120.0, rtol=1e-9)
+
+
+def test_hand_tangential_speed_closed_forms():
+    n = 30
+    line = np.outer(np.arange(n) * DT, [0.6, -0.8, 0.0]) * 1.5  # 1.5 m/s along a unit vector
+    np.testing.assert_allclose(plots.tangential_speed(line, DT), 1.5, rtol=1e-9)
+    r, omega = 0.25, 4.0  # circle: step chord 2 r sin(omega dt / 2) per dt
+    a = omega * DT * np.arange(n)
+    ring = np.stack([r * np.cos(a), r * np.sin(a), np.full(n, 1.0)], axis=1)
+    v = plots.velocity_profiles(synthetic_trace(n, hand=ring))
+    np.testing.assert_allclose(v["hand_speed"], 2 * r * math.sin(omega * DT / 2) / DT, rtol=1e-9)
+
+
+def test_direction_angles_in_a_yawed_head_frame():
+    from visuomotor_gym.oculomotor.plant import direction_from_angles
+
+    az, el = np.radians(25.0), np.radians(-10.0)
+    d = direction_from_angles(az, el)
+    got = plots.direction_angles(d)
+    np.testing.assert_allclose(got, (25.0, -10.0), atol=1e-9)
+    head = np.tile(direction_from_angles(np.radians(30.0), np.radians(15.0)), (3, 1))  # pitched head
+    frame = plots.reference_frame(synthetic_trace(3, head=head))
+    np.testing.assert_allclose(frame @ frame.T, np.eye(3), atol=1e-12)
+    np.testing.assert_allclose(frame[2], [0, 0, 1])  # elevation stays relative to the horizon
+    np.testing.assert_allclose(plots.direction_angles(d, frame), (-5.0, -10.0), atol=1e-9)
+
+
+def test_gaze_on_the_ball_gives_identical_angles_and_zero_error():
+    n = 20
+    ball = np.stack([4.0 - 3.0 * DT * np.arange(n), np.full(n, 0.5), 1.2 + 0.05 * np.arange(n)], axis=1)
+    eye = np.tile([0.1, 0.0, 1.2], (n, 1)) + np.outer(np.arange(n), [0.0, 0.001, 0.0])  # moving eye
+    tr = synthetic_trace(n, ball=ball, eye=eye, gaze=ball - eye)
+    a = plots.gaze_ball_angles(tr)
+    np.testing.assert_allclose(a["gaze_az"], a["ball_az"], atol=1e-9)
+    np.testing.assert_allclose(a["gaze_el"], a["ball_el"], atol=1e-9)
+    np.testing.assert_allclose(a["error_deg"], 0.0, atol=1e-6)
+    first = plots.direction_angles(ball[0] - eye[0])
+    np.testing.assert_allclose((a["ball_az"][0], a["ball_el"][0]), first, atol=1e-9)
+    b = plots.gaze_ball_angles(tr, origin="initial")  # from the eye at reset: parallax only
+    assert 0 < np.max(np.abs(b["ball_az"] - a["ball_az"])) < 1.0
+    with pytest.raises(ValueError, match="origin"):
+        plots.gaze_ball_angles(tr, origin="head")
+
+
+def test_saccade_intervals_onsets_and_apex():
+    n = 40
+    onset = np.zeros(n, bool)
+    flying = np.zeros(n, bool)
+    onset[[5, 20]] = True  # saccades start at t[4] and t[19]
+    flying[[5, 6]] = True  # the first lasts into step 7, the second ends within step 20
+    g, v0 = 9.81, 3.0  # ballistic: apex at v0 / g
+    t = np.arange(n) * DT
+    vel = np.stack([np.full(n, -4.0), np.zeros(n), v0 - g * t], axis=1)
+    pos = np.stack([5.0 - 4.0 * t, np.zeros(n), 1.0 + v0 * t - 0.5 * g * t * t], axis=1)
+    tr = synthetic_trace(n, onset=onset, in_saccade=flying, ball=pos, ball_vel=vel)
+    np.testing.assert_allclose(plots.saccade_onset_times(tr), [4 * DT, 19 * DT])
+    np.testing.assert_allclose(plots.saccade_intervals(tr), [(4 * DT, 7 * DT), (19 * DT, 20 * DT)])
+    assert plots.apex_time(tr) == pytest.approx(v0 / g, abs=1e-9)
+    # Thrown downward: no apex in flight, the highest row (the first) stands in for it.
+    vel_down = vel * [1, 1, 0] + np.outer(-1.0 - g * t, [0, 0, 1])
+    pos_down = pos * [1, 1, 0] + np.outer(2.0 - t - 0.5 * g * t * t, [0, 0, 1])
+    assert plots.apex_time(synthetic_trace(n, ball=pos_down, ball_vel=vel_down)) == 0.0
+
+
+# ----------------------------------------------------------------------------------------------
+# A real episode
+# ----------------------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def oracle_trace():
+    import gymnasium as gym
+
+    import visuomotor_gym  # noqa: F401
+    from visuomotor_gym.agents import make_agent
+
+    env = gym.make(ENV_ID)
+    try:
+        policy = make_agent("oracle", ENV_ID, env.action_space.shape[0], seed=0)
+        return run_episode(env, policy, 0, ENV_ID, "oracle")
+    finally:
+        env.close()
+
+
+def test_oracle_gaze_converges_on_the_ball(oracle_trace):
+    a = plots.gaze_ball_angles(oracle_trace)
+    assert a["error_deg"].shape == oracle_trace.t.shape
+    err = a["error_deg"]
+    # The initial saccade and the pursuit that follows bring the line of sight onto the ball while
+    # it rises: after 0.1 s the gaze is within a couple of degrees, closer than at the start.
+    rising = (a["t"] >= 0.1) & (a["t"] <= 0.9 * plots.apex_time(oracle_trace))
+    assert rising.sum() >= 5
+    assert np.median(err[rising]) < 3.0
+    assert np.min(err[rising]) < err[0]
+    # The angles agree with the angular error: a small error means near-identical angles.
+    close = rising & (err < 2.0)
+    assert np.all(np.abs(a["gaze_el"][close] - a["ball_el"][close]) < 2.5)
+
+
+def test_plot_episode_writes_a_real_png(oracle_trace, tmp_path):
+    path = plots.plot_episode(oracle_trace, tmp_path / "sub" / "episode.png")
+    assert path.exists() and path.stat().st_size > 50_000
+    img = iio.imread(path)
+    assert img.ndim == 3 and img.shape[0] > 800 and img.shape[1] > 1200
+    rgb = img[..., :3].astype(float)
+    assert rgb.std() > 20
+    assert np.mean(rgb.min(axis=2) < 200) > 0.03  # a fair share of drawn (non-white) pixels
+    assert np.mean(np.ptp(rgb, axis=2) > 60) > 0.005  # and coloured ones (red, green, orange)
+
+
+def test_each_panel_draws_its_data(oracle_trace):
+    az, el = plots.plot_gaze_vs_ball(oracle_trace)
+    assert len(az.lines) >= 3 and len(el.lines) >= 3 and az.figure is el.figure
+    one = plots.plot_gaze_vs_ball(oracle_trace, ax=plots._new_figure((4, 3)).subplots())
+    assert len(one.lines) >= 4
+    left, right = plots.plot_tangential_velocities(oracle_trace)
+    assert right.lines[0].get_ydata().max() > 0 and left.lines[0].get_ydata().max() > 0
+    assert len(plots.plot_gaze_path(oracle_trace).lines) >= 4
+    assert plots.plot_paths_3d(oracle_trace).name == "3d"
+
+
+def test_a_missed_episode_is_plotted_too(tmp_path):
+    n = 30
+    tr = synthetic_trace(n, gaze=circle(n, 40.0), caught=False, onset=np.eye(n, dtype=bool)[3])
+    path = plots.plot_episode(tr, tmp_path / "missed.png")
+    assert path.stat().st_size > 20_000
+    assert "missed" in plots.outcome(tr)
+
+
+# ----------------------------------------------------------------------------------------------
+# Video and commands
+# ----------------------------------------------------------------------------------------------
+def _parser():
+    parser = argparse.ArgumentParser(prog="vmgym")
+    commands.register(parser.add_subparsers(dest="command", required=True))
+    return parser
+
+
+def _run(argv):
+    args = _parser().parse_args(argv)
+    return args.func(args)
+
+
+@pytest.mark.render
+def test_record_writes_a_readable_mp4(tmp_path, capsys):
+    from visuomotor_gym.viz.video import record_episode
+
+    out = tmp_path / "ep.mp4"
+    trace = record_episode("oracle", ENV_ID, 0, out, width=96, height=72, fps=25)
+    frames = iio.imread(out)
+    assert frames.shape == (trace.steps + 1, 72, 2 * 96, 3)
+    assert trace.extras["video"]["frames"] == trace.steps + 1 and trace.caught
+    assert frames.std() > 10
+    assert not list(tmp_path.glob(".*partial*"))  # the temporary file was renamed
+    with pytest.raises(FileExistsError, match="overwrite"):
+        record_episode("oracle", ENV_ID, 0, out, width=96, height=72)
+    before = out.stat().st_mtime_ns
+    # The command line refuses too, before playing anything, and says how to force it.
+    assert _run(["record", "--agent", "oracle", "--env", ENV_ID, "--out", str(out)]) == 1
+    err = capsys.readouterr().err
+    assert "already exists" in err and "--force" in err
+    assert out.stat().st_mtime_ns == before
+    # --force replaces it (odd sizes padded to even for H.264).
+    assert _run(["record", "--agent", "oracle", "--env", ENV_ID, "--out", str(out), "--width", "33",
+                 "--height", "25", "--camera", "eye", "--force"]) == 0
+    assert str(out) in capsys.readouterr().out
+    assert iio.imread(out).shape[1:] == (26, 34, 3)
+
+
+def test_record_rejects_bad_arguments_without_playing(tmp_path):
+    from visuomotor_gym.viz.video import record_episode
+
+    with pytest.raises(ValueError, match="must end in"):
+        record_episode("oracle", ENV_ID, 0, tmp_path / "x.gif")
+    with pytest.raises(ValueError, match="pixels"):
+        record_episode("oracle", ENV_ID, 0, tmp_path / "x.mp4", width=4)
+    assert _run(["record", "--agent", "oracle", "--env", ENV_ID, "--out", str(tmp_path / "x.gif")]) == 2
+    assert not list(tmp_path.iterdir())
+
+
+def test_plot_command_from_a_run_and_from_saved_traces(oracle_trace, tmp_path, capsys):
+    assert _run(["plot", "--agent", "oracle", "--env", ENV_ID, "--seed", "0", "--out", str(tmp_path)]) == 0
+    expected = tmp_path / f"{ENV_ID}_oracle_seed0.png"
+    assert capsys.readouterr().out.strip() == str(expected) and expected.stat().st_size > 50_000
+
+    other = synthetic_trace(20, gaze=circle(20, 30.0))
+    npz = tmp_path / "traces.npz"
+    save_traces(npz, [oracle_trace, other])
+    out = tmp_path / "from_npz"
+    assert _run(["plot", "--traces", str(npz), "--episode", "1", "--out", str(out)]) == 0
+    assert (out / "Synthetic-v0_none_seed0.png").exists()
+    assert _run(["plot", "--traces", str(npz), "--episode", "2", "--out", str(out)]) == 2
+    assert "out of range" in capsys.readouterr().err
+    assert _run(["plot", "--out", str(out)]) == 2
+    assert _run(["plot", "--agent", "no-such-agent", "--env", ENV_ID, "--out", str(out)]) == 2
+    assert "unknown agent" in capsys.readouterr().err
+    name = commands.plot_filename("EyeCatch-v0", "eyecatch:alpha=1,b=x", 3)
+    assert name == "EyeCatch-v0_eyecatch_alpha_1_b_x_seed3.png"
+
+
+def test_commands_are_wired_into_vmgym(tmp_path, capsys):
+    from visuomotor_gym import cli
+
+    parser = cli.build_parser()
+    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    if "plot" not in sub.choices:
+        pytest.skip("visuomotor_gym.viz.commands.register is not called from visuomotor_gym/cli.py yet")
+    assert cli.main(["plot", "--agent", "oracle", "--env", ENV_ID, "--out", str(tmp_path)]) == 0
+    assert (tmp_path / f"{ENV_ID}_oracle_seed0.png").exists()

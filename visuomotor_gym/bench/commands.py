@@ -1,0 +1,159 @@
+"""``vmgym bench``: evaluate an agent on pinned seeds, print the summary, write validated results.
+
+    vmgym bench --agent oracle --env EyeCatchOracle-v0 --episodes 200 --seed 0 --out results.json \\
+        [--workers K] [--traces traces.npz] [--force] [--no-progress]
+
+Wired into ``vmgym`` by ``visuomotor_gym.cli`` through :func:`register`.
+"""
+
+from __future__ import annotations
+
+import argparse
+import shlex
+import sys
+from pathlib import Path
+
+
+def register(subparsers) -> argparse.ArgumentParser:
+    """Add the ``bench`` subcommand to an ``argparse`` subparsers object; returns its parser."""
+    p = subparsers.add_parser(
+        "bench",
+        help="evaluate an agent on pinned seeds and write validated results JSON",
+        description="Evaluate an agent on pinned seeds (episode i uses seed + i), print the summary "
+                    "and write results JSON validated against the results schema.",
+    )
+    p.add_argument("--agent", required=True,
+                   help="agent spec: eyecatch, oracle, random, zero, or name:param=value,...")
+    p.add_argument("--env", required=True, help="environment id (vmgym envs lists them)")
+    p.add_argument("--episodes", type=int, required=True, help="number of episodes (>= 1)")
+    p.add_argument("--seed", type=int, required=True, help="first seed (>= 0); episode i uses seed + i")
+    p.add_argument("--out", required=True, help="results JSON file to write")
+    p.add_argument("--workers", type=int, default=1, help="worker processes (default 1: in-process)")
+    p.add_argument("--traces", default=None, help="also write the per-episode traces to this .npz file")
+    p.add_argument("--force", action="store_true", help="overwrite --out / --traces if they exist")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.set_defaults(func=main_bench)
+    return p
+
+
+def canonical_command(args: argparse.Namespace) -> str:
+    """The command that reproduces the numbers (output paths reduced to file names: no personal paths)."""
+    parts = ["vmgym", "bench", "--agent", args.agent, "--env", args.env, "--episodes", str(args.episodes),
+             "--seed", str(args.seed), "--workers", str(args.workers), "--out", Path(args.out).name]
+    if args.traces:
+        parts += ["--traces", Path(args.traces).name]
+    return shlex.join(parts)
+
+
+def _fmt(value, digits: int = 3) -> str:
+    if value is None:
+        return "n/a"
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    if isinstance(value, float):
+        return f"{value:.{digits}g}" if abs(value) < 1e-3 and value != 0 else f"{value:.{digits}f}"
+    if isinstance(value, dict):
+        return ", ".join(f"{k} {_fmt(v, digits)}" for k, v in value.items())
+    if isinstance(value, list):
+        return "[" + ", ".join(_fmt(v, digits) for v in value[:6]) + (", ...]" if len(value) > 6 else "]")
+    return str(value)
+
+
+def _mean_median(stats: dict) -> str:
+    return f"mean {_fmt(stats.get('mean'))}  median {_fmt(stats.get('median'))}"
+
+
+def summary_rows(results: dict) -> list[tuple[str, str]]:
+    """(metric, value) rows of the summary table."""
+    lo, hi = results["catch_rate_ci95"]
+    gaze = results["gaze_realism"]
+    lat = results["latency_ms"]
+    rows = [
+        ("catch rate", f"{results['catch_rate']:.3f}  95% CI [{lo:.3f}, {hi:.3f}]  "
+                       f"({results['caught']}/{results['episodes']})"),
+        ("gaze realism", _fmt(gaze["score"])),
+    ]
+    for name, comp in gaze["components"].items():
+        rows.append((f"  {name}", f"score {_fmt(comp.get('score'))}  (value {_fmt(comp.get('value'))})"))
+    rows += [
+        ("latency (ms)", f"p50 {_fmt(lat['p50'])}  p95 {_fmt(lat['p95'])}  max {_fmt(lat['max'])}"),
+        ("real time", f"{_fmt(results['real_time'])}  "
+                      f"(p95 < {results['control_period_ms']:g} ms control period)"),
+    ]
+    for kind, stats in results["reaction_times_s"].items():
+        rows.append((f"reaction time, {kind.replace('_', ' ')} (s)", _mean_median(stats)))
+    rows += [
+        ("time to catch (s)", _mean_median(results["time_to_catch_s"])),
+        ("miss distance (m)", _mean_median(results["miss_distance_m"])),
+        ("diverged", f"{results['diverged']} episode(s)"),
+    ]
+    run = results.get("run")
+    if run:
+        rows.append(("wall time", f"{run['wall_time_s']:.1f} s, {run['workers']} worker(s), "
+                                  f"{_fmt(run.get('env_steps_per_s'), 0)} env steps/s"))
+    return rows
+
+
+def print_summary(results: dict, file=None) -> None:
+    """Print the summary table (rich when available, plain text otherwise)."""
+    title = f"{results['agent']} on {results['env_id']}: {results['episodes']} episodes, seeds " \
+            f"{results['seeds']['first']}..{results['seeds']['last']}"
+    rows = summary_rows(results)
+    try:
+        from rich.console import Console
+        from rich.table import Table
+    except ImportError:
+        print(title, file=file)
+        for name, value in rows:
+            print(f"  {name:<22} {value}", file=file)
+        return
+    table = Table(title=title)
+    table.add_column("metric")
+    table.add_column("value")
+    for name, value in rows:
+        table.add_row(name, value)
+    Console(file=file).print(table)
+
+
+def _refuse_existing(paths: list[Path | None], force: bool) -> str | None:
+    for path in paths:
+        if path is not None and path.exists() and not force:
+            return f"{path} already exists; refusing to overwrite it (pass --force to replace it)"
+    return None
+
+
+def main_bench(args: argparse.Namespace) -> int:
+    """Run ``vmgym bench``; returns the exit status (0 ok, 1 results invalid/exist, 2 bad arguments)."""
+    from visuomotor_gym.bench.evaluate import evaluate, validate_inputs
+    from visuomotor_gym.bench.results import ResultsError, build_results, write_results
+    from visuomotor_gym.bench.trace import save_traces
+
+    out = Path(args.out)
+    traces_path = Path(args.traces) if args.traces else None
+    if traces_path is not None and traces_path.suffix != ".npz":
+        print(f"error: --traces must name a .npz file, got {traces_path}", file=sys.stderr)
+        return 2
+    refusal = _refuse_existing([out, traces_path], args.force)  # before spending time on the run
+    if refusal:
+        print(f"error: {refusal}", file=sys.stderr)
+        return 1
+    try:
+        validate_inputs(args.agent, args.env, args.episodes, args.seed, args.workers)
+    except (ValueError, TypeError) as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    result = evaluate(args.agent, args.env, args.episodes, args.seed, workers=args.workers,
+                      keep_traces=traces_path is not None, progress=not args.no_progress)
+    try:
+        results = build_results(result, canonical_command(args))
+        print_summary(results)
+        write_results(out, results, force=args.force)
+    except (ResultsError, FileExistsError) as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 1
+    print(f"wrote {out}")
+    if traces_path is not None:
+        traces_path.parent.mkdir(parents=True, exist_ok=True)
+        save_traces(traces_path, result.traces)
+        print(f"wrote {traces_path}")
+    return 0

@@ -1,0 +1,84 @@
+"""One JSON-ready summary of a set of episodes: what the evaluator writes for an (agent, env) pair."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+
+from visuomotor_gym.metrics.outcome import miss_distance, reaction_times, time_to_catch
+from visuomotor_gym.metrics.realism import gaze_realism
+from visuomotor_gym.metrics.stats import mean_median, wilson_interval
+
+
+def latency_summary(traces: Sequence) -> dict[str, float]:
+    """Policy compute time per step over all steps of all episodes, in milliseconds: ``{"p50", "p95",
+    "max"}`` (NaN when no step was timed). Real time at 50 Hz needs p95 below the 20 ms control period."""
+    parts = [np.asarray(tr.latency_s, dtype=float).ravel() for tr in traces]
+    lat = np.concatenate(parts) if parts else np.zeros(0)
+    lat = lat[np.isfinite(lat)] * 1e3
+    if lat.size == 0:
+        return {"p50": float("nan"), "p95": float("nan"), "max": float("nan")}
+    p50, p95 = np.percentile(lat, [50.0, 95.0])
+    return {"p50": float(p50), "p95": float(p95), "max": float(lat.max())}
+
+
+def to_json_safe(obj):
+    """Plain Python for ``json.dumps(..., allow_nan=False)``: NaN/inf -> None, numpy -> float/int/list."""
+    if isinstance(obj, Mapping):
+        return {str(k): to_json_safe(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple, np.ndarray)):
+        return [to_json_safe(v) for v in obj]
+    if isinstance(obj, (bool, np.bool_)):
+        return bool(obj)
+    if isinstance(obj, (int, np.integer)):
+        return int(obj)
+    if isinstance(obj, (float, np.floating)):
+        return float(obj) if math.isfinite(obj) else None
+    return obj
+
+
+def summarize(traces: Sequence) -> dict:
+    """Every benchmark number for a set of episodes, as plain JSON-serialisable Python (None = undefined).
+
+    Keys:
+
+    * ``episodes``, ``caught`` (count), ``catch_rate``, ``catch_rate_ci95`` ([low, high], Wilson 95 %),
+      ``diverged`` (count; physics divergences count as not caught);
+    * ``gaze_realism``: ``{"score", "components": {name: {"value", "score", "episodes"}}}``
+      (:func:`~visuomotor_gym.metrics.realism.gaze_realism`);
+    * ``latency_ms``: ``{"p50", "p95", "max"}`` policy compute time per step;
+    * ``reaction_times_s``: ``{"first_saccade": {"mean", "median"}, "hand_onset": {"mean", "median"}}``;
+    * ``miss_distance_m``: ``{"mean", "median"}`` closest ball-to-catch-site distance over the episodes
+      that were not caught (diverged ones excluded);
+    * ``time_to_catch_s``: ``{"mean", "median"}`` over caught episodes.
+
+    Diverged episodes end on a physics reset, so their last state is not the agent's doing: they are
+    left out of the behavioural measures (realism, reaction times, miss distance) but count in the
+    catch rate and latency.
+    """
+    traces = list(traces)
+    n = len(traces)
+    caught = sum(bool(tr.caught) for tr in traces)
+    diverged = sum(bool(tr.diverged) for tr in traces)
+    valid = [tr for tr in traces if not tr.diverged]
+    failed = [tr for tr in valid if not tr.caught]
+    rts = [reaction_times(tr) for tr in valid]
+    low, high = wilson_interval(caught, n)
+    out = {
+        "episodes": n,
+        "caught": caught,
+        "catch_rate": caught / n if n else float("nan"),
+        "catch_rate_ci95": [low, high],
+        "diverged": diverged,
+        "gaze_realism": gaze_realism(valid),
+        "latency_ms": latency_summary(traces),
+        "reaction_times_s": {
+            "first_saccade": mean_median([r["first_saccade_s"] for r in rts]),
+            "hand_onset": mean_median([r["hand_onset_s"] for r in rts]),
+        },
+        "miss_distance_m": mean_median([miss_distance(tr) for tr in failed]),
+        "time_to_catch_s": mean_median([time_to_catch(tr) for tr in valid if tr.caught]),
+    }
+    return to_json_safe(out)
