@@ -10,7 +10,8 @@ Agent names (``make_agent``):
   keyword overrides as ``eyecatch:param=value,param=value``;
 * ``oracle``: the scripted interception oracle (true state; meaningful on ``EyeCatchOracle-v0`` only);
 * ``random``: uniform random actions (seeded);
-* ``zero``: all-zero actions (gaze held, hand at the workspace centre).
+* ``zero``: all-zero actions (gaze held, hand at the workspace centre);
+* ``ppo:<path>``: a policy trained by ``vmgym train ppo`` (``visuomotor_gym.baselines.ppo``).
 
 Further names register with :func:`register_agent`.
 """
@@ -66,6 +67,8 @@ def parse_agent_spec(spec: str) -> tuple[str, dict[str, Any]]:
     if name not in _REGISTRY:
         raise ValueError(f"unknown agent {name!r}; known agents: {agent_names()}")
     overrides: dict[str, Any] = {}
+    if rest and "=" not in rest:  # "ppo:<path>": one positional argument
+        return name, {"path": rest}
     if rest:
         for item in rest.split(","):
             key, eq, value = item.partition("=")
@@ -126,8 +129,17 @@ def _eyecatch(env_id, action_dim, seed, **kw):
     return EyecatchAgent.for_env(env_id, **kw)
 
 
+def _ppo(env_id, action_dim, seed, path=None, **kw):
+    if path is None:
+        raise ValueError("the ppo agent needs a policy file: ppo:<path to model.zip or run folder>")
+    from visuomotor_gym.baselines.ppo.agent import PPOAgent
+
+    return PPOAgent(path, env_id=env_id, **kw)
+
+
 register_agent("random", lambda env_id, action_dim, seed, **kw: RandomAgent(action_dim, seed, **kw),
                "uniform random actions", deterministic=False)
 register_agent("zero", lambda env_id, action_dim, seed, **kw: ZeroAgent(action_dim, **kw), "all-zero actions")
 register_agent("oracle", _oracle, "scripted interception on the true ball state (Oracle env only)")
+register_agent("ppo", _ppo, "a trained stable-baselines3 PPO/RecurrentPPO policy: ppo:<model.zip or run folder>")
 register_agent("eyecatch", _eyecatch, "Eyecatch heuristic (Yeo et al. 2012): Kalman filter, saccades, submovements")

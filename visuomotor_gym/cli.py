@@ -6,6 +6,7 @@
     vmgym bench --agent A --env ID --episodes N --seed S --out FILE.json [--workers K]
     vmgym plot  (--agent A --env ID [--seed S] | --traces F.npz [--episode K]) --out DIR
     vmgym record --agent A --env ID [--seed S] --out FILE.mp4 [--force]
+    vmgym train ppo --env ID [--timesteps N] [--minutes M] [--recurrent] [...]   (see --help)
 """
 
 from __future__ import annotations
@@ -62,6 +63,14 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_train(args: argparse.Namespace) -> int:
+    """Forward to the PPO training script (its own flags; ``vmgym train ppo --help``)."""
+    from visuomotor_gym.baselines.ppo.train import main as train_ppo
+
+    train_ppo(args.train_args)
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     from visuomotor_gym.bench.commands import register as register_bench
     from visuomotor_gym.viz.commands import register as register_viz
@@ -81,8 +90,15 @@ def build_parser() -> argparse.ArgumentParser:
                    "(the demo's own files there are replaced)")
     p.add_argument("--no-video", action="store_true", help="skip the video (rendering is the slow part)")
     p.set_defaults(func=_cmd_demo)
+    p = sub.add_parser("train", help="train a learned baseline (ppo: stable-baselines3 PPO / RecurrentPPO)",
+                       add_help=False)
+    p.add_argument("algo", choices=["ppo"])
+    p.add_argument("train_args", nargs=argparse.REMAINDER, help="flags of the training script")
+    p.set_defaults(func=_cmd_train)
     register_bench(sub)
     register_viz(sub)
+    from visuomotor_gym.leaderboard.commands import register as register_leaderboard
+    register_leaderboard(sub)
     return parser
 
 

@@ -1,0 +1,249 @@
+"""Train PPO (or RecurrentPPO) on an EyeCatch env with stable-baselines3, top to bottom.
+
+    python -m visuomotor_gym.baselines.ppo.train --env EyeCatchOracle-v0 --timesteps 2000000
+    vmgym train ppo --env EyeCatch-v0 --timesteps 3000000 --minutes 55
+
+Steps: read the hyperparameters for the env id (``hyperparams.yml``, a ``default`` plus per-id
+overrides, then command-line overrides), make the vectorised training env (shaped reward, optional
+Kalman belief features, observation/reward normalisation), train with TensorBoard logging (SB3
+logs ``rollout/success_rate``, the catch rate, from ``info["is_success"]``), an ``EvalCallback`` on
+the registered env and periodic checkpoints, then save the model with its normalisation statistics
+as JSON (``ppo_meta.json``: no pickles) so ``ppo:<path>`` loads it in the common evaluator.
+
+Every run writes into its own folder: ``config.yml`` (the resolved hyperparameters), ``args.json``,
+``command.txt`` (the exact command), ``model.zip``, ``ppo_meta.json``, ``progress.csv``,
+TensorBoard events, ``checkpoints/`` and ``eval/``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import copy
+import json
+import shlex
+import sys
+import time
+from dataclasses import asdict, dataclass, field, fields
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+
+@dataclass
+class Args:
+    """Command-line arguments (each field is a flag: ``--env``, ``--timesteps`` ...)."""
+
+    env: str = "EyeCatchOracle-v0"
+    """registered env id to train on (evaluation uses it unchanged)"""
+    timesteps: int = 1_000_000
+    """total environment transitions"""
+    minutes: float = 0.0
+    """stop after this many minutes of training (0: no limit)"""
+    seed: int = 0
+    """seed of the training envs, the policy and the evaluation"""
+    out: str = "runs/ppo"
+    """parent folder; the run writes to <out>/<env>/<run_name>"""
+    run_name: str = ""
+    """folder name of the run (default: algo_seed_timestamp)"""
+    recurrent: bool = False
+    """RecurrentPPO (LSTM policy, sb3-contrib) instead of PPO"""
+    belief: str = ""
+    """'yes'/'no' overrides the config's belief features"""
+    hyperparams: str = ""
+    """YAML file of hyperparameters (default: the packaged hyperparams.yml)"""
+    set: list = field(default_factory=list)
+    """overrides as key=value (YAML values), e.g. --set learning_rate=1e-4 n_envs=4"""
+    progress_bar: bool = True
+    """show SB3's progress bar"""
+    device: str = "cpu"
+    """torch device"""
+
+
+def _field_docs() -> dict[str, str]:
+    """The docstring under each ``Args`` field (CleanRL style), for ``--help``."""
+    import ast
+    import inspect
+
+    tree = ast.parse(inspect.getsource(Args))
+    docs, last = {}, None
+    for node in tree.body[0].body:
+        if isinstance(node, ast.AnnAssign):
+            last = node.target.id
+        elif isinstance(node, ast.Expr) and isinstance(node.value, ast.Constant) and last:
+            docs[last] = str(node.value.value)
+            last = None
+    return docs
+
+
+def parse_args(argv=None) -> Args:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    docs = _field_docs()
+    for f in fields(Args):
+        flag = "--" + f.name.replace("_", "-")
+        doc = docs.get(f.name, "")
+        if f.type in ("bool", bool):
+            parser.add_argument(flag, action=argparse.BooleanOptionalAction, default=f.default, help=doc)
+        elif f.name == "set":
+            parser.add_argument(flag, nargs="*", default=[], help="key=value hyperparameter overrides")
+        else:
+            cast = {"int": int, "float": float}.get(f.type if isinstance(f.type, str) else f.type.__name__, str)
+            parser.add_argument(flag, type=cast, default=f.default, help=doc)
+    return Args(**vars(parser.parse_args(argv)))
+
+
+def load_config(args: Args) -> dict:
+    """Hyperparameters: ``default``, then the env id's entry, then ``--set`` overrides."""
+    if args.hyperparams:
+        table = yaml.safe_load(Path(args.hyperparams).read_text())
+    else:
+        table = yaml.safe_load(resources.files("visuomotor_gym.baselines.ppo").joinpath("hyperparams.yml").read_text())
+    config = copy.deepcopy(table["default"])
+    for key, value in (table.get(args.env) or {}).items():
+        if isinstance(value, dict) and isinstance(config.get(key), dict):
+            config[key] = {**config[key], **value}
+        else:
+            config[key] = value
+    for item in args.set:
+        key, eq, value = item.partition("=")
+        if not eq or key not in config:
+            raise SystemExit(f"--set {item!r}: expected key=value with key in {sorted(config)}")
+        parsed = yaml.safe_load(value)
+        if isinstance(parsed, str):  # YAML 1.1 reads "1e-4" as a string
+            try:
+                parsed = float(parsed)
+            except ValueError:
+                pass
+        config[key] = parsed
+    if args.recurrent:
+        config["algo"] = "RecurrentPPO"
+    if args.belief:
+        config["belief"] = args.belief.lower() in ("yes", "true", "1")
+    return config
+
+
+def make_env_fn(env_id: str, env_kwargs: dict, belief: bool, seed: int):
+    """A thunk for SB3's vec envs: the env, optionally with belief features, with a Monitor."""
+
+    def thunk():
+        import gymnasium as gym
+        from stable_baselines3.common.monitor import Monitor
+
+        import visuomotor_gym  # noqa: F401
+
+        env = gym.make(env_id, **env_kwargs)
+        if belief:
+            from visuomotor_gym.baselines.ppo.belief import BeliefObservation
+
+            env = BeliefObservation(env, env_id)
+        env = Monitor(env, info_keywords=("is_success",))
+        env.reset(seed=seed)
+        return env
+
+    return thunk
+
+
+def main(argv=None) -> Path:
+    args = parse_args(argv)
+    config = load_config(args)
+
+    import torch
+    from stable_baselines3 import PPO
+    from stable_baselines3.common.callbacks import CallbackList, CheckpointCallback, EvalCallback
+    from stable_baselines3.common.logger import configure
+    from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
+
+    torch.set_num_threads(1)
+    run_name = args.run_name or f"{config['algo'].lower()}_s{args.seed}_{time.strftime('%Y%m%d-%H%M%S')}"
+    run_dir = Path(args.out) / args.env / run_name
+    if run_dir.exists():
+        raise SystemExit(f"{run_dir} already exists: pick another --run-name (runs are never overwritten)")
+    run_dir.mkdir(parents=True)
+    (run_dir / "config.yml").write_text(yaml.safe_dump(config, sort_keys=True))
+    (run_dir / "args.json").write_text(json.dumps(asdict(args), indent=2))
+    (run_dir / "command.txt").write_text(shlex.join([sys.executable, "-m", "visuomotor_gym.baselines.ppo.train",
+                                                     *(argv if argv is not None else sys.argv[1:])]) + "\n")
+
+    # 1. Environments: shaped reward for training, the registered env for evaluation.
+    n_envs = int(config["n_envs"])
+    train_env = DummyVecEnv([make_env_fn(args.env, config["env_kwargs"], config["belief"], args.seed + i)
+                             for i in range(n_envs)])
+    eval_env = DummyVecEnv([make_env_fn(args.env, {}, config["belief"], 10_000 + args.seed)])
+    if config["normalize_obs"] or config["normalize_reward"]:
+        train_env = VecNormalize(train_env, norm_obs=config["normalize_obs"], norm_reward=config["normalize_reward"],
+                                 gamma=config["gamma"])
+        eval_env = VecNormalize(eval_env, norm_obs=config["normalize_obs"], norm_reward=False, training=False)
+
+    # 2. The algorithm.
+    common = dict(
+        n_steps=int(config["n_steps"]), batch_size=int(config["batch_size"]), n_epochs=int(config["n_epochs"]),
+        learning_rate=float(config["learning_rate"]), gamma=float(config["gamma"]),
+        gae_lambda=float(config["gae_lambda"]), clip_range=float(config["clip_range"]),
+        ent_coef=float(config["ent_coef"]), vf_coef=float(config["vf_coef"]),
+        max_grad_norm=float(config["max_grad_norm"]), seed=args.seed, device=args.device, verbose=0,
+        policy_kwargs=dict(net_arch=list(config["net_arch"]), log_std_init=float(config["log_std_init"])),
+    )
+    if config["algo"] == "RecurrentPPO":
+        from sb3_contrib import RecurrentPPO
+
+        model = RecurrentPPO("MlpLstmPolicy", train_env, **common)
+    elif config["algo"] == "PPO":
+        model = PPO("MlpPolicy", train_env, **common)
+    else:
+        raise SystemExit(f"algo must be PPO or RecurrentPPO, got {config['algo']!r}")
+    model.set_logger(configure(str(run_dir), ["csv", "tensorboard"]))
+
+    # 3. Callbacks: evaluation on the registered env (with the training normalisation), checkpoints,
+    #    and the wall-clock budget.
+    class SyncNormalization(EvalCallback):
+        def _on_step(self) -> bool:
+            if isinstance(train_env, VecNormalize) and self.eval_freq > 0 and self.n_calls % self.eval_freq == 0:
+                eval_env.obs_rms = copy.deepcopy(train_env.obs_rms)
+            return super()._on_step()
+
+    callbacks = [
+        SyncNormalization(eval_env, n_eval_episodes=int(config["eval_episodes"]),
+                          eval_freq=max(1, int(config["eval_freq"]) // n_envs), log_path=str(run_dir / "eval"),
+                          best_model_save_path=str(run_dir / "eval"), deterministic=True),
+        CheckpointCallback(save_freq=max(1, int(config["checkpoint_freq"]) // n_envs),
+                           save_path=str(run_dir / "checkpoints"), name_prefix="model"),
+    ]
+    if args.minutes > 0:
+        from stable_baselines3.common.callbacks import BaseCallback
+
+        class WallClock(BaseCallback):
+            def _on_training_start(self) -> None:
+                self.deadline = time.time() + 60.0 * args.minutes
+
+            def _on_step(self) -> bool:
+                return time.time() < self.deadline
+
+        callbacks.append(WallClock())
+
+    start = time.time()
+    model.learn(total_timesteps=args.timesteps, callback=CallbackList(callbacks), progress_bar=args.progress_bar)
+    wall = time.time() - start
+
+    # 4. Save the policy and what evaluation needs to reproduce its inputs, as JSON.
+    model.save(run_dir / "model.zip")
+    meta = {
+        "algo": config["algo"],
+        "env_id": args.env,
+        "belief": bool(config["belief"]),
+        "timesteps": int(model.num_timesteps),
+        "train_wall_s": round(wall, 1),
+        "seed": args.seed,
+    }
+    if isinstance(train_env, VecNormalize) and config["normalize_obs"]:
+        meta["obs_mean"] = train_env.obs_rms.mean.tolist()
+        meta["obs_var"] = train_env.obs_rms.var.tolist()
+        meta["clip_obs"] = float(train_env.clip_obs)
+        meta["epsilon"] = float(train_env.epsilon)
+    (run_dir / "ppo_meta.json").write_text(json.dumps(meta, indent=2))
+    print(f"trained {model.num_timesteps} steps in {wall / 60:.1f} min; saved {run_dir / 'model.zip'}")
+    return run_dir
+
+
+if __name__ == "__main__":
+    main()
