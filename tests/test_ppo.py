@@ -39,7 +39,7 @@ def test_run_folders_are_never_overwritten(tmp_path):
 def test_hyperparameters_resolve_default_then_env_then_overrides():
     args = train.parse_args(["--env", "EyeCatch-v0", "--set", "learning_rate=1e-4"])
     config = train.load_config(args)
-    assert config["belief"] is True  # EyeCatch-v0 entry
+    assert config["belief"] is True and config["intercept_shaping"] == 0.5
     assert config["learning_rate"] == 1e-4  # override
     assert config["n_envs"] == 8  # default
     with pytest.raises(SystemExit, match="key=value"):

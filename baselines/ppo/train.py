@@ -123,8 +123,27 @@ def load_config(args: Args) -> dict:
     return config
 
 
-def make_env_fn(env_id: str, env_kwargs: dict, belief: bool, seed: int):
-    """A thunk for SB3's vec envs: the env, optionally with belief features, with a Monitor."""
+class InterceptShaping:
+    """Training-only reward shaping: minus ``weight`` x the distance (m) from the hand to the throw's
+    arrival point, every step. It uses the true throw (privileged), but only in the reward: the policy
+    still sees observations only, and evaluation uses the registered env's own reward."""
+
+    def __new__(cls, env, weight: float):
+        import gymnasium as gym
+
+        class _Wrapper(gym.Wrapper):
+            def step(self, action):
+                obs, reward, terminated, truncated, info = self.env.step(action)
+                arrival = self.env.unwrapped.throw.arrival_pos
+                term = -weight * float(np.linalg.norm(info["hand_pos"] - arrival))
+                info = {**info, "reward_terms": {**info["reward_terms"], "intercept": term}}
+                return obs, reward + term, terminated, truncated, info
+
+        return _Wrapper(env)
+
+
+def make_env_fn(env_id: str, env_kwargs: dict, belief: bool, seed: int, intercept_shaping: float = 0.0):
+    """A thunk for SB3's vec envs: the env, optional shaping and belief features, a Monitor."""
 
     def thunk():
         import gymnasium as gym
@@ -133,6 +152,8 @@ def make_env_fn(env_id: str, env_kwargs: dict, belief: bool, seed: int):
         import visuomotor_gym  # noqa: F401
 
         env = gym.make(env_id, **env_kwargs)
+        if intercept_shaping:
+            env = InterceptShaping(env, intercept_shaping)
         if belief:
             from visuomotor_gym.baselines.ppo.belief import BeliefObservation
 
@@ -167,8 +188,8 @@ def main(argv=None) -> Path:
 
     # 1. Environments: shaped reward for training, the registered env for evaluation.
     n_envs = int(config["n_envs"])
-    train_env = DummyVecEnv([make_env_fn(args.env, config["env_kwargs"], config["belief"], args.seed + i)
-                             for i in range(n_envs)])
+    train_env = DummyVecEnv([make_env_fn(args.env, config["env_kwargs"], config["belief"], args.seed + i,
+                                         float(config.get("intercept_shaping", 0.0))) for i in range(n_envs)])
     eval_env = DummyVecEnv([make_env_fn(args.env, {}, config["belief"], 10_000 + args.seed)])
     if config["normalize_obs"] or config["normalize_reward"]:
         train_env = VecNormalize(train_env, norm_obs=config["normalize_obs"], norm_reward=config["normalize_reward"],
