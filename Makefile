@@ -2,6 +2,7 @@
 #   make demo   set up, then run the main demo (writes outputs/demo/)
 #   make test   set up, then run the whole test suite
 #   make bench  set up, then run the benchmarks in benchmarks/
+#   make leaderboard-check   set up, then run the leaderboard check CI runs (leaderboard/)
 
 PYTHON ?= python3
 VENV ?= .venv
@@ -12,7 +13,7 @@ PIP := $(PY) -m pip
 STAMP := $(VENV)/.installed
 export MUJOCO_GL ?= egl
 
-.PHONY: setup demo test test-fast bench clean
+.PHONY: setup demo test test-fast bench leaderboard-check clean
 
 $(STAMP): pyproject.toml Makefile
 	$(PYTHON) -m venv $(VENV)
@@ -34,6 +35,9 @@ test-fast: setup
 
 bench: setup
 	$(PY) benchmarks/env_throughput.py
+
+leaderboard-check: setup
+	$(VENV)/bin/vmgym leaderboard check
 
 clean:
 	rm -rf $(VENV) build dist *.egg-info outputs .pytest_cache

@@ -1,0 +1,295 @@
+"""Leaderboard entries on disk: results file + entry record + policy file, and per-episode outcomes.
+
+An entry named ``<name>`` on ``<env_id>`` (key ``<name>__<env_id>``) is three files under the
+leaderboard folder:
+
+* ``results/<key>.json``: the results file of ``vmgym bench`` (validated by
+  :func:`visuomotor_gym.bench.results.load_results`; its content is never altered);
+* ``results/<key>.entry.json``: the entry record (``entry_schema.json``): the sha256 of the results
+  file, the policy file with its format and sha256, and one outcome record per pinned seed
+  (seed, caught, diverged, steps, catch time, miss distance, first-saccade time);
+* ``agents/<key><suffix>``: the policy file (absent for agents with nothing to configure).
+
+``leaderboard/superseded.json`` (optional) lists entries that no longer reproduce because the code
+they ran moved on: they stay on the leaderboard, immutable and hash-checked, but are not re-scored and
+are shown apart. Entries are never deleted or rewritten.
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+import math
+import re
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+
+from visuomotor_gym.leaderboard.problems import Problem
+
+RESULTS_DIR = "results"
+AGENTS_DIR = "agents"
+RECORD_SUFFIX = ".entry.json"
+SUPERSEDED_FILE = "superseded.json"
+ENTRY_VERSION = 1
+NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]*$")
+EPISODE_FIELDS = ("seed", "caught", "diverged", "steps", "catch_time_s", "miss_distance_m", "first_saccade_s")
+
+
+def entry_key(name: str, env_id: str) -> str:
+    return f"{name}__{env_id}"
+
+
+def check_name(name: str) -> str:
+    """Return ``name`` if it is a valid entry name, else raise ValueError saying why."""
+    if not isinstance(name, str) or not NAME_RE.match(name) or "__" in name:
+        raise ValueError(
+            f"entry name {name!r} must start with a letter or digit and hold only letters, "
+            f"digits, '.', '-' and single '_' (no '__': it separates name and env id)"
+        )
+    return name
+
+
+@functools.lru_cache(maxsize=1)
+def load_entry_schema() -> dict:
+    text = resources.files("visuomotor_gym.leaderboard").joinpath("entry_schema.json").read_text("utf-8")
+    return json.loads(text)
+
+
+def _finite_or_none(x) -> float | None:
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+def episode_record(trace) -> dict:
+    """The outcome record of one :class:`~visuomotor_gym.bench.trace.EpisodeTrace`."""
+    from visuomotor_gym.metrics.gaze import first_saccade_latency
+    from visuomotor_gym.metrics.outcome import miss_distance, time_to_catch
+
+    return {
+        "seed": int(trace.seed),
+        "caught": bool(trace.caught),
+        "diverged": bool(trace.diverged),
+        "steps": int(trace.steps),
+        "catch_time_s": _finite_or_none(time_to_catch(trace)),
+        "miss_distance_m": _finite_or_none(miss_distance(trace)),
+        "first_saccade_s": _finite_or_none(first_saccade_latency(trace)),
+    }
+
+
+def summary_from_records(records: list[dict]) -> dict:
+    """The results fields that per-episode records determine, computed as ``metrics.summarize`` does.
+
+    ``caught``, ``diverged``, ``episodes``, ``time_to_catch_s`` (caught, not diverged),
+    ``miss_distance_m`` (not caught, not diverged), ``reaction_times_s.first_saccade`` (not diverged)
+    and ``env_steps``.
+    """
+    from visuomotor_gym.metrics.stats import mean_median
+    from visuomotor_gym.metrics.summary import to_json_safe
+
+    def nan(x):
+        return float("nan") if x is None else x
+
+    valid = [r for r in records if not r["diverged"]]
+    return to_json_safe(
+        {
+            "episodes": len(records),
+            "caught": sum(bool(r["caught"]) for r in records),
+            "diverged": sum(bool(r["diverged"]) for r in records),
+            "time_to_catch_s": mean_median([nan(r["catch_time_s"]) for r in valid if r["caught"]]),
+            "miss_distance_m": mean_median([nan(r["miss_distance_m"]) for r in valid if not r["caught"]]),
+            "first_saccade_s": mean_median([nan(r["first_saccade_s"]) for r in valid]),
+            "env_steps": sum(int(r["steps"]) for r in records),
+        }
+    )
+
+
+def dumps_record(record: dict) -> str:
+    """Canonical text of an entry record: 2-space JSON, one line per episode, episodes last."""
+    head = {k: v for k, v in record.items() if k != "episodes"}
+    text = json.dumps(head, indent=2, allow_nan=False)
+    lines = ",\n".join("    " + json.dumps(ep, allow_nan=False) for ep in record["episodes"])
+    return text[:-2] + ',\n  "episodes": [\n' + lines + "\n  ]\n}\n"
+
+
+def record_problems(obj) -> list[str]:
+    """Schema problems of an entry record, each with its JSON path."""
+    from jsonschema import Draft202012Validator
+
+    if not isinstance(obj, dict):
+        return [f"$: expected a JSON object, got {type(obj).__name__}"]
+    out = []
+    for err in Draft202012Validator(load_entry_schema()).iter_errors(obj):
+        path = "$" + "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in err.absolute_path)
+        if err.validator == "required" and isinstance(err.instance, dict):
+            out += [
+                f"{path}.{n}: missing required field" for n in err.validator_value if n not in err.instance
+            ]
+        else:
+            out.append(f"{path}: {err.message}")
+    return sorted(set(out))
+
+
+@dataclass
+class Entry:
+    """One entry as found on disk; ``results`` / ``record`` are None where they failed to load."""
+
+    key: str
+    name: str
+    env_id: str
+    results_path: Path
+    record_path: Path
+    results: dict | None = None
+    record: dict | None = None
+    results_bytes: bytes | None = None
+    superseded: dict | None = None  # {"reason": ...} when listed in superseded.json
+
+    @property
+    def loaded(self) -> bool:
+        return self.results is not None and self.record is not None
+
+    @property
+    def policy(self) -> dict | None:
+        return (self.record or {}).get("policy")
+
+
+@dataclass
+class Leaderboard:
+    root: Path
+    protocol: object | None  # Protocol, or None when protocol.json is broken
+    entries: list[Entry] = field(default_factory=list)
+    problems: list[Problem] = field(default_factory=list)
+
+    def rel(self, path: Path) -> str:
+        """``path`` relative to the leaderboard folder's parent (``leaderboard/results/x.json``)."""
+        try:
+            return str(Path(path).resolve().relative_to(self.root.resolve().parent))
+        except ValueError:
+            return str(path)
+
+    @property
+    def valid_entries(self) -> list[Entry]:
+        return [e for e in self.entries if e.loaded]
+
+
+def _read_json(path: Path):
+    return json.loads(path.read_text(encoding="utf-8"), parse_constant=_reject_constant)
+
+
+def _reject_constant(name: str):
+    raise ValueError(f"{name} is not valid JSON")
+
+
+def load_leaderboard(root) -> Leaderboard:
+    """Find and parse every entry under ``root``; layout, schema and parse problems are collected."""
+    from visuomotor_gym.bench.results import ResultsError, load_results
+    from visuomotor_gym.leaderboard.protocol import ProtocolError, load_protocol
+
+    root = Path(root)
+    lb = Leaderboard(root=root, protocol=None)
+    if not root.is_dir():
+        lb.problems.append(Problem(str(root), "layout", "is not a folder (pass --dir LEADERBOARD)"))
+        return lb
+    try:
+        lb.protocol = load_protocol(root)
+    except ProtocolError as exc:
+        lb.problems.append(Problem(lb.rel(root / "protocol.json"), "protocol", str(exc)))
+
+    results_dir = root / RESULTS_DIR
+    files = sorted(p for p in results_dir.iterdir()) if results_dir.is_dir() else []
+    keys: dict[str, dict[str, Path]] = {}
+    for p in files:
+        if not p.is_file() or not p.name.endswith(".json"):
+            lb.problems.append(
+                Problem(
+                    lb.rel(p),
+                    "layout",
+                    "unexpected file in results/ (only <name>__<env_id>.json "
+                    "results files and their .entry.json records belong here)",
+                )
+            )
+            continue
+        kind = "record" if p.name.endswith(RECORD_SUFFIX) else "results"
+        key = p.name[: -len(RECORD_SUFFIX)] if kind == "record" else p.name[: -len(".json")]
+        keys.setdefault(key, {})[kind] = p
+
+    superseded = _load_superseded(lb)
+    for key, paths in sorted(keys.items()):
+        parts = key.split("__")
+        results_path = paths.get("results", results_dir / f"{key}.json")
+        record_path = paths.get("record", results_dir / f"{key}{RECORD_SUFFIX}")
+        if len(parts) != 2 or not all(parts):
+            lb.problems.append(
+                Problem(
+                    lb.rel(results_path),
+                    "layout",
+                    f"file name {key!r} is not <name>__<env_id> (exactly one '__')",
+                )
+            )
+            continue
+        entry = Entry(key, parts[0], parts[1], results_path, record_path, superseded=superseded.get(key))
+        lb.entries.append(entry)
+        if "results" not in paths:
+            lb.problems.append(
+                Problem(
+                    lb.rel(results_path),
+                    "layout",
+                    f"missing: the entry record {record_path.name} has no results file",
+                )
+            )
+        else:
+            entry.results_bytes = results_path.read_bytes()
+            try:
+                entry.results = load_results(results_path)
+            except ResultsError as exc:
+                detail = "; ".join(exc.problems) if exc.problems else str(exc)
+                lb.problems.append(Problem(lb.rel(results_path), "results", f"invalid results: {detail}"))
+        if "record" not in paths:
+            lb.problems.append(
+                Problem(
+                    lb.rel(record_path),
+                    "layout",
+                    f"missing: the results file {results_path.name} has no entry record "
+                    f"(write entries with `vmgym leaderboard submit`)",
+                )
+            )
+        else:
+            try:
+                record = _read_json(record_path)
+            except ValueError as exc:
+                lb.problems.append(Problem(lb.rel(record_path), "record", f"malformed JSON: {exc}"))
+            else:
+                problems = record_problems(record)
+                if problems:
+                    lb.problems.append(
+                        Problem(lb.rel(record_path), "record", "invalid entry record: " + "; ".join(problems))
+                    )
+                else:
+                    entry.record = record
+    for key in sorted(set(superseded) - {e.key for e in lb.entries}):
+        lb.problems.append(
+            Problem(lb.rel(root / SUPERSEDED_FILE), "layout", f"lists {key!r}, which is no entry")
+        )
+    return lb
+
+
+def _load_superseded(lb: Leaderboard) -> dict[str, dict]:
+    path = lb.root / SUPERSEDED_FILE
+    if not path.exists():
+        return {}
+    try:
+        obj = _read_json(path)
+    except ValueError as exc:
+        lb.problems.append(Problem(lb.rel(path), "layout", f"malformed JSON: {exc}"))
+        return {}
+    items = obj.get("superseded") if isinstance(obj, dict) else None
+    if not isinstance(items, dict) or not all(
+        isinstance(v, dict) and isinstance(v.get("reason"), str) for v in items.values()
+    ):
+        lb.problems.append(
+            Problem(
+                lb.rel(path), "layout", 'expected {"superseded": {"<name>__<env_id>": {"reason": "..."}}}'
+            )
+        )
+        return {}
+    return items
