@@ -286,7 +286,7 @@ def test_observations_finite_over_random_rollouts(env_id):
         for action in actions:
             obs, reward, terminated, truncated, info = env.step(action)
             steps += 1
-            assert obs.dtype == np.float32 and obs.shape == (flat_size(),)
+            assert obs.dtype == np.float32 and obs.shape == (env.unwrapped.layout.size,)
             assert np.all(np.isfinite(obs)), f"non-finite observation at step {steps} of episode {ep}"
             assert env.observation_space.contains(obs)
             assert isinstance(reward, float) and math.isfinite(reward)
@@ -480,11 +480,15 @@ def test_observation_structure_sums_to_observation_size(env_id):
     env = gym.make(env_id)
     u = env.unwrapped
     structure = u.observation_structure
-    assert sum(structure.values()) == env.observation_space.shape[0] == flat_size()
-    assert structure == ObservationLayout().structure
+    layout = u.layout  # the single-ball layout; with n_balls=2 followed by the second ball's blocks
+    single = ObservationLayout()
+    assert sum(structure.values()) == env.observation_space.shape[0] == layout.size
+    assert layout.size == flat_size() if u.n_balls == 1 else layout.size > flat_size()
+    assert structure == layout.structure
+    assert list(structure.items())[: len(single.blocks)] == list(single.structure.items())
     start = 0
     for name, size in structure.items():
-        assert ObservationLayout().slices[name] == slice(start, start + size)
+        assert layout.slices[name] == slice(start, start + size)
         start += size
     assert sum(u.action_structure.values()) == env.action_space.shape[0] == 9
 

@@ -7,7 +7,9 @@ unchanged. Agents see observations only, never ``info`` (the true state).
 Agent names (``make_agent``):
 
 * ``eyecatch``: the Eyecatch heuristic of Yeo et al. 2012 (``visuomotor_gym.baselines.eyecatch``);
-  keyword overrides as ``eyecatch:param=value,param=value``;
+  keyword overrides as ``eyecatch:param=value,param=value``; on two-ball envs it tracks the balls
+  one after the other;
+* ``belief_mpc``: the belief-space MPC of Eom et al. 2019 (``visuomotor_gym.baselines.belief_mpc``);
 * ``oracle``: the scripted interception oracle (true state; meaningful on ``EyeCatchOracle-v0`` only);
 * ``random``: uniform random actions (seeded);
 * ``zero``: all-zero actions (gaze held, hand at the workspace centre);
@@ -124,9 +126,22 @@ def _oracle(env_id, action_dim, seed, **kw):
 
 
 def _eyecatch(env_id, action_dim, seed, **kw):
+    import gymnasium as gym
+
     from visuomotor_gym.baselines.eyecatch import EyecatchAgent
 
+    if (gym.spec(env_id).kwargs or {}).get("n_balls", 1) > 1:
+        # One ball at a time, as Eyecatch tracks a single object: the second after the first catch.
+        from visuomotor_gym.baselines.belief_mpc.sequential import SequentialEyecatch
+
+        return SequentialEyecatch.for_env(env_id, **kw)
     return EyecatchAgent.for_env(env_id, **kw)
+
+
+def _belief_mpc(env_id, action_dim, seed, **kw):
+    from visuomotor_gym.baselines.belief_mpc import BeliefMPCAgent
+
+    return BeliefMPCAgent.for_env(env_id, **kw)
 
 
 def _ppo(env_id, action_dim, seed, path=None, **kw):
@@ -143,3 +158,4 @@ register_agent("zero", lambda env_id, action_dim, seed, **kw: ZeroAgent(action_d
 register_agent("oracle", _oracle, "scripted interception on the true ball state (Oracle env only)")
 register_agent("ppo", _ppo, "a trained stable-baselines3 PPO/RecurrentPPO policy: ppo:<model.zip or run folder>")
 register_agent("eyecatch", _eyecatch, "Eyecatch heuristic (Yeo et al. 2012): Kalman filter, saccades, submovements")
+register_agent("belief_mpc", _belief_mpc, "belief-space MPC (Eom et al. 2019): Kalman beliefs, iLQR over gaze, head, hand")

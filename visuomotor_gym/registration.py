@@ -12,6 +12,7 @@ import gymnasium as gym
 
 CATCH_ENTRY_POINT = "visuomotor_gym.envs.catch:EyeCatchEnv"
 CATCH_MAX_EPISODE_STEPS = 125  # 2.5 s at 50 Hz: the longest flight is 1.4 s
+TWO_BALLS_MAX_EPISODE_STEPS = 150  # 3 s: the second ball arrives at most 2.2 s after the first release
 
 
 @dataclass(frozen=True)
@@ -35,6 +36,8 @@ ENV_SPECS: tuple[EnvSpec, ...] = (
             description="foveated, all vision noise x10 (Eyecatch 5)"),
     EnvSpec("EyeCatchBounce-v0", CATCH_ENTRY_POINT, {"bounce_wall": True},
             description="foveated; the ball bounces off an invisible wall mid-flight (Eyecatch 5)"),
+    EnvSpec("EyeCatchTwoBalls-v0", CATCH_ENTRY_POINT, {"n_balls": 2}, max_episode_steps=TWO_BALLS_MAX_EPISODE_STEPS,
+            description="foveated; two staggered balls from both sides, catch both (Eom 7)"),
 )
 CATCH_ENV_IDS = tuple(spec.id for spec in ENV_SPECS if spec.entry_point == CATCH_ENTRY_POINT)
 

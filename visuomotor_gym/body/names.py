@@ -65,6 +65,15 @@ CAMERAS = (SCENE_CAMERA, EYE_CAMERA, OVER_SHOULDER_CAMERA)
 # Equality constraints
 CATCH_WELD = "catch_weld"
 
+# The second ball of EyeCatchTwoBalls-v0 (``envs_assets/catch_two_balls.xml``, which includes catch.xml).
+TWO_BALLS_SCENE = "catch_two_balls.xml"
+BALL2 = "ball2"
+BALL2_JOINT = "ball2_free"
+BALL2_GEOM = "ball2"
+THROWER2 = "thrower2"
+CATCH_WELD2 = "catch_weld2"
+TWO_BALL_NAMES = {"body": (BALL2, THROWER2), "joint": (BALL2_JOINT,), "geom": (BALL2_GEOM,), "equality": (CATCH_WELD2,)}
+
 ALL_NAMES = {
     "body": (TORSO, HEAD, EYE, FIXATION, UPPER_ARM, FOREARM, HAND, FINGERS, BALL, THROWER, BOUNCE_WALL),
     "joint": BODY_JOINTS + NECK_JOINTS + (EYE_AZIMUTH, EYE_ELEVATION, EYE_FIXATION, GRASP, BALL_JOINT),

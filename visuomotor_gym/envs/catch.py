@@ -17,7 +17,7 @@ from gymnasium import spaces
 from visuomotor_gym.assets import asset_path
 from visuomotor_gym.body import names
 from visuomotor_gym.control.hand import HandControlParams, HandController
-from visuomotor_gym.envs.observation import ObservationLayout
+from visuomotor_gym.envs.observation import SECOND_BALL_OBSERVATION, ObservationLayout, catch_observation
 from visuomotor_gym.geometry import norm
 from visuomotor_gym.envs.rewards import REWARD_TERMS, SHAPED_WEIGHTS, SPARSE_WEIGHTS, catch_reward
 from visuomotor_gym.oculomotor.plant import (
@@ -27,7 +27,7 @@ from visuomotor_gym.oculomotor.plant import (
     angles_from_direction,
     direction_from_angles,
 )
-from visuomotor_gym.scenarios.throws import BALL_RADIUS, ThrowDistribution, sample_throw
+from visuomotor_gym.scenarios.throws import BALL_RADIUS, ThrowDistribution, sample_second_throw, sample_throw
 from visuomotor_gym.vision import foveation
 from visuomotor_gym.vision.foveation import VisionParams
 
@@ -53,6 +53,7 @@ READY_POSTURE_DEG = {
 MISS_BEHIND_X = -0.3  # seat frame: the ball is behind the catcher
 MISS_FLOOR_Z = BALL_RADIUS + 0.02  # world frame: the ball is on the floor
 GAZE_AGE_CAP_S = 1.0
+PARKED_BALL_POS = (0.0, 0.0, -2.0)  # EyeCatchTwoBalls-v0: where a released ball goes (under the floor)
 
 
 def _coerce(cls, value, arg_name):
@@ -126,6 +127,30 @@ class EyeCatchEnv(gym.Env):
 
     OBSERVATION_TABLE
 
+    With ``n_balls=2`` (``EyeCatchTwoBalls-v0``) the same blocks come first, for the first ball, and
+    these follow (``Box(-inf, inf, (67,), float32)``):
+
+    TWO_BALL_OBSERVATION_TABLE
+
+    ## Two balls (``n_balls=2``, EyeCatchTwoBalls-v0; Eom et al. 2019, section 7)
+
+    The first ball is the ladder's throw for the seed. A second ball waits, weightless and hidden (not
+    seen until it is thrown), at a second thrower on the other side (1-2 m to the side, 3-6 m ahead)
+    and is released 0.2-0.5 s later (a whole number of control steps), arriving 0.5-0.8 s after the
+    first in the same catchable region (``sample_second_throw`` in
+    ``visuomotor_gym.scenarios.throws``; drawn after the first throw). The
+    catch rule is the same for both balls; the hand holds one ball at a time, and a caught ball is
+    released ``release_after_catch_s`` after its catch (it leaves the scene: parked under the floor,
+    no longer seen), so the hand can take the second. ``info["is_success"]`` needs both catches;
+    ``info["balls_caught"]`` counts them. The episode ends when both are caught or at the first miss
+    (success is then impossible). The catch reward is paid per ball; shaping terms follow the first
+    ball in flight. ``info`` adds ``ball2_pos``, ``ball2_vel``, ``ball2_visible``, ``balls_caught`` and
+    ``holding`` (the held ball's index, -1 for none), and at reset ``release2_pos``, ``release2_vel``,
+    ``arrival2_pos``, ``release2_time`` and ``flight2_time``. Registered with ``max_episode_steps``
+    150 (3 s). The scene is ``envs_assets/catch_two_balls.xml`` (``catch.xml`` plus the second
+    ball, its thrower and its catch weld), so the single-ball scene is unchanged. Not combinable with
+    ``bounce_wall``.
+
     ## Rewards
 
     A sum of named terms, each in ``info["reward_terms"]``. ``reward="sparse"`` (default): ``catch``
@@ -159,6 +184,8 @@ class EyeCatchEnv(gym.Env):
     | ``vision_params`` | None | ``VisionParams`` or a dict of its fields (acuity, Weber fraction, depth noise, field of view) |
     | ``visual_delay_s`` | 0.0 | visual latency, a multiple of the control period |
     | ``bounce_wall`` | False | an invisible wall deflects the ball mid-flight |
+    | ``n_balls`` | 1 | 1, or 2 for two staggered balls (see Two balls) |
+    | ``release_after_catch_s`` | 0.2 | with two balls, a caught ball leaves the hand this long after its catch |
     | ``control`` | ``"hand"`` | ``"hand"`` (Cartesian) or ``"joint"`` |
     | ``obs_mode`` | ``"flat"`` | ``"flat"`` or ``"dict"`` |
     | ``reward`` | ``"sparse"`` | ``"sparse"`` or ``"shaped"`` |
@@ -190,6 +217,8 @@ class EyeCatchEnv(gym.Env):
         vision_params: VisionParams | dict | None = None,
         visual_delay_s: float = 0.0,
         bounce_wall: bool = False,
+        n_balls: int = 1,
+        release_after_catch_s: float = 0.2,
         control: str = "hand",
         obs_mode: str = "flat",
         reward: str = "sparse",
@@ -228,6 +257,14 @@ class EyeCatchEnv(gym.Env):
         self.hand_params = _coerce(HandControlParams, hand_params, "hand_params")
         self.throw_distribution = _coerce(ThrowDistribution, throw_distribution, "throw_distribution")
         self.bounce_wall = bool(bounce_wall)
+        if isinstance(n_balls, bool) or n_balls not in (1, 2):
+            raise ValueError(f"n_balls must be 1 or 2, got {n_balls!r}")
+        if n_balls == 2 and self.bounce_wall:
+            raise ValueError("n_balls=2 cannot be combined with bounce_wall")
+        if not (math.isfinite(release_after_catch_s) and release_after_catch_s >= 0):
+            raise ValueError(f"release_after_catch_s must be finite and >= 0, got {release_after_catch_s!r}")
+        self.n_balls = int(n_balls)
+        self.release_after_catch_s = float(release_after_catch_s)
         self.catch_radius = float(catch_radius)
         self.grasp_closed_fraction = float(grasp_closed_fraction)
         self.gaze_action_range = float(gaze_action_range_deg) * DEG
@@ -243,7 +280,8 @@ class EyeCatchEnv(gym.Env):
         self.width, self.height = int(width), int(height)
 
         # --- MuJoCo model and name lookups --------------------------------------------------
-        self.model = mujoco.MjModel.from_xml_path(str(asset_path("catch.xml")))
+        scene = "catch.xml" if self.n_balls == 1 else names.TWO_BALLS_SCENE
+        self.model = mujoco.MjModel.from_xml_path(str(asset_path(scene)))
         self.data = mujoco.MjData(self.model)
         m = self.model
         physics_dt = float(m.opt.timestep)
@@ -300,6 +338,17 @@ class EyeCatchEnv(gym.Env):
         self._catch_site = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, names.CATCH_SITE)
         self._wall_geom = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, names.BOUNCE_WALL_GEOM)
         self._weld = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_EQUALITY, names.CATCH_WELD)
+        # Per ball: (qpos address, dof address, body, catch weld, geom); ball 0 is the ladder's ball.
+        self._balls = [(self._ball_qpos, self._ball_dof, self._ball_body, self._weld,
+                        mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, names.BALL_GEOM))]
+        if self.n_balls == 2:
+            ball2_j = jid(names.BALL2_JOINT)
+            self._balls.append((int(m.jnt_qposadr[ball2_j]), int(m.jnt_dofadr[ball2_j]),
+                                mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, names.BALL2),
+                                mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_EQUALITY, names.CATCH_WELD2),
+                                mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, names.BALL2_GEOM)))
+            self._thrower2_body = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, names.THROWER2)
+            self._ball_conaffinity = [int(m.geom_conaffinity[b[4]]) for b in self._balls]
         self._ready = np.array(
             [0.0, 0.0, 0.0] + [READY_POSTURE_DEG[n] * DEG for n in names.ARM_JOINTS]
         )
@@ -330,13 +379,15 @@ class EyeCatchEnv(gym.Env):
         n_act = sum(self.action_structure.values())
         self._n_body_act = n_act - 6
         self.action_space = spaces.Box(-1.0, 1.0, shape=(n_act,), dtype=np.float32)
-        self.layout = ObservationLayout()
+        self.layout = ObservationLayout(catch_observation(self.n_balls))
         self.observation_structure = self.layout.structure
         self.observation_space = self.layout.flat_space() if obs_mode == "flat" else self.layout.dict_space()
         self._s = self.layout.slices
         expected = ("ball_pos", "ball_vel", "ball_visible", "ball_age", "eye_pos", "eye_rot", "eye_in_head",
                     "fixation", "saccade", "head_qpos", "head_qvel", "body_qpos", "body_qvel", "hand_pos",
                     "hand_vel", "grasp", "time")
+        if self.n_balls == 2:
+            expected += ("ball2_pos", "ball2_vel", "ball2_visible", "balls_caught", "holding")
         assert tuple(b.name for b in self.layout.blocks) == expected, "update _observe with the layout"
 
         self._renderers: dict[str, mujoco.Renderer] = {}
@@ -377,6 +428,8 @@ class EyeCatchEnv(gym.Env):
         m.body_pos[self._thrower_body] = (throw.release_pos[0] + 0.35, throw.release_pos[1], 0.0)
         self._place_wall(throw)
         d.eq_active[self._weld] = 0
+        if self.n_balls == 2:
+            self._reset_second_ball()
         mujoco.mj_forward(m, d)
         self._warning_counts = [d.warning[i].number for i in self._bad_warnings]
 
@@ -401,6 +454,10 @@ class EyeCatchEnv(gym.Env):
             flight_time=throw.flight_time,
             wall_y=throw.wall_y,
         )
+        if self.n_balls == 2:
+            info.update(release2_pos=self.throw2.release_pos.copy(), release2_vel=self.throw2.release_vel.copy(),
+                        arrival2_pos=self.throw2.arrival_pos.copy(), release2_time=self.throw2.release_time,
+                        flight2_time=self.throw2.flight_time)
         return self._format(obs), info
 
     def step(self, action):
@@ -441,6 +498,9 @@ class EyeCatchEnv(gym.Env):
         d.ctrl[self._body_act] = (new_setpoint - setpoint) / dt  # MuJoCo clamps to ctrlrange: a rate limit
         d.ctrl[self._grasp_act] = (float(a[nb]) + 1.0) * 0.5 * self._grasp_max
 
+        if self.n_balls == 2:
+            self._launch_and_release()
+
         # --- physics ---------------------------------------------------------------------------
         caught, diverged = self._simulate()
         if diverged:
@@ -448,7 +508,7 @@ class EyeCatchEnv(gym.Env):
             return self._format(self._last_obs.copy()), 0.0, True, False, info
         mujoco.mj_kinematics(m, d)
         mujoco.mj_comPos(m, d)
-        caught = caught or self._catch_now(d.xpos[self._ball_body])
+        caught = caught or self._catch_any()
         self._apply_gaze()
         obs = self._observe(saccading=plant_step.saccading)
         self._last_obs = obs.copy()  # the fallback after divergence; the caller may edit ``obs``
@@ -456,19 +516,25 @@ class EyeCatchEnv(gym.Env):
         self._prev_gaze = self._eye_rot[:, 0].tolist()
 
         # --- outcome and reward --------------------------------------------------------------
-        ball = d.qpos[self._ball_qpos : self._ball_qpos + 3]
-        missed = (not caught) and self._is_missed(ball)
-        visible = self._visible
+        k = self._shaping_ball()
+        qa = self._balls[k][0]
+        ball = d.qpos[qa : qa + 3]
+        if self.n_balls == 1:
+            missed = (not caught) and self._is_missed(ball)
+        else:  # the first miss ends the episode: success (both caught) is then impossible
+            missed = any(self._is_missed(d.qpos[self._balls[j][0] : self._balls[j][0] + 3])
+                         for j in range(self.n_balls) if self._status[j] == "flying")
+        visible = self._visible if k == 0 else self._visible2
         weights = self.reward_weights
         hand_ball = norm(d.site_xpos[self._catch_site] - ball) if weights.get("approach") else 0.0
-        ecc = foveation.eccentricity(self._true_ball_eye()[0]) if visible and weights.get("foveation") else None
+        ecc = foveation.eccentricity(self._true_ball_eye(k)[0]) if visible and weights.get("foveation") else None
         effort = float(a @ a) / a.size if weights.get("effort") else 0.0
         reward, terms = catch_reward(weights, caught, missed, hand_ball, ecc, effort)
-        info = self._info(caught=caught, missed=missed, diverged=False, terms=terms, visible=visible)
+        info = self._info(caught=caught, missed=missed, diverged=False, terms=terms, visible=self._visible)
         info["saccade_onset"] = plant_step.saccade_started
         if self.render_mode == "human":
             self.render()
-        return self._format(obs), reward, caught or missed, False, info
+        return self._format(obs), reward, (caught if self.n_balls == 1 else self._caught) or missed, False, info
 
     def render(self):
         if self.render_mode is None:
@@ -504,7 +570,11 @@ class EyeCatchEnv(gym.Env):
     # Pieces of a step
     # ------------------------------------------------------------------------------------------
     def _reset_episode_state(self) -> None:
-        self._caught = False
+        self._caught = False  # every ball caught (success)
+        self._status = ["flying"] + ["waiting"] * (self.n_balls - 1)  # waiting/flying/held/released
+        self._holding: int | None = None  # the ball in the hand
+        self._held_since = 0.0
+        self._visible2 = False
         self._delay_buffer: deque = deque(maxlen=self.delay_steps + 1)
         self._fixation = 1.0
         self._eye_rot = np.eye(3)
@@ -550,10 +620,10 @@ class EyeCatchEnv(gym.Env):
         t_expected = d.time + self.dt
         if self._caught or not self._catch_possible():
             mujoco.mj_step(m, d, nstep=self.n_substeps)
-        else:  # the ball may cross the catch volume within this step: check every substep
+        else:  # a ball may cross the catch volume within this step: check every substep
             for _ in range(self.n_substeps):
                 mujoco.mj_step(m, d)
-                if not caught and self._catch_now(d.xpos[self._ball_body]):
+                if not caught and self._catch_any():
                     caught = True
         # MuJoCo checks qpos/qvel/qacc every substep (NaN, inf or > 1e10), counts a warning and resets
         # the data (time back to 0) when one is bad: either sign is our divergence signal.
@@ -564,45 +634,98 @@ class EyeCatchEnv(gym.Env):
     def _catch_possible(self) -> bool:
         """Whether a catch could happen during the coming control step (else skip substep checks)."""
         d = self.data
+        if self._holding is not None:  # the hand holds one ball at a time
+            return False
         closing = self.grasp_closed_fraction * self._grasp_max
         if d.qpos[self._grasp_qpos] < closing and d.ctrl[self._grasp_act] < closing:
             return False
-        return self._ball_near_hand()
+        return any(self._ball_near_hand(k) for k in range(self.n_balls) if self._status[k] == "flying")
 
-    def _ball_near_hand(self) -> bool:
+    def _ball_near_hand(self, k: int = 0) -> bool:
         d = self.data
-        ball = d.qpos[self._ball_qpos : self._ball_qpos + 3]
-        speed = norm(d.qvel[self._ball_dof : self._ball_dof + 3])
+        qa, da = self._balls[k][0], self._balls[k][1]
+        ball = d.qpos[qa : qa + 3]
+        speed = norm(d.qvel[da : da + 3])
         gap = norm(ball - d.site_xpos[self._catch_site]) - self.catch_radius
         return gap < (speed + 2.0 * self.hand_params.max_speed_m_s) * self.dt + 0.05
 
-    def _catch_now(self, ball_pos: np.ndarray) -> bool:
-        """Catch test on consistent kinematics: ball centre in the catch volume, fingers closed."""
-        if self._caught:
+    def _catch_any(self) -> bool:
+        """Catch test of every ball in flight (current kinematics); True if one was caught."""
+        return any(self._catch_now(k) for k in range(self.n_balls) if self._status[k] == "flying")
+
+    def _catch_now(self, k: int = 0) -> bool:
+        """Catch test on consistent kinematics: ball centre in the catch volume, fingers closed, hand empty."""
+        if self._caught or self._holding is not None:
             return False
         d = self.data
         closed = d.qpos[self._grasp_qpos] >= self.grasp_closed_fraction * self._grasp_max
         if not closed:
             return False
-        if norm(ball_pos - d.site_xpos[self._catch_site]) > self.catch_radius:
+        if norm(d.xpos[self._balls[k][2]] - d.site_xpos[self._catch_site]) > self.catch_radius:
             return False
-        self._caught = True
-        self._activate_weld()
+        self._status[k] = "held"
+        self._holding = k
+        self._held_since = float(d.time)
+        self._caught = all(status == "held" or status == "released" for status in self._status)
+        self._activate_weld(k)
         return True
 
-    def _activate_weld(self) -> None:
+    def _activate_weld(self, k: int = 0) -> None:
         """Hold the caught ball in the hand: weld it at its current pose relative to the hand."""
         m, d = self.model, self.data
+        _, _, body, weld, _ = self._balls[k]
         hand_pos, hand_quat = d.xpos[self._hand_body], d.xquat[self._hand_body]
-        ball_pos, ball_quat = d.xpos[self._ball_body], d.xquat[self._ball_body]
+        ball_pos, ball_quat = d.xpos[body], d.xquat[body]
         rel_pos = d.xmat[self._hand_body].reshape(3, 3).T @ (ball_pos - hand_pos)
         inv = np.zeros(4)
         mujoco.mju_negQuat(inv, hand_quat)
         rel_quat = np.zeros(4)
         mujoco.mju_mulQuat(rel_quat, inv, ball_quat)
-        m.eq_data[self._weld, 3:6] = rel_pos
-        m.eq_data[self._weld, 6:10] = rel_quat
-        d.eq_active[self._weld] = 1
+        m.eq_data[weld, 3:6] = rel_pos
+        m.eq_data[weld, 6:10] = rel_quat
+        d.eq_active[weld] = 1
+
+    # --- two balls ----------------------------------------------------------------------------
+    def _reset_second_ball(self) -> None:
+        """Draw the second throw and hold its ball, weightless, at the second thrower's hand."""
+        m, d = self.model, self.data
+        self.throw2 = sample_second_throw(self.np_random, self.throw_distribution, float(m.opt.timestep),
+                                          self.dt, self.throw)
+        qa, da, _, _, _ = self._balls[1]
+        d.qpos[qa : qa + 3] = self.throw2.release_pos
+        d.qpos[qa + 3 : qa + 7] = (1.0, 0.0, 0.0, 0.0)
+        d.qvel[da : da + 6] = 0.0
+        m.body_pos[self._thrower2_body] = (self.throw2.release_pos[0] + 0.35, self.throw2.release_pos[1], 0.0)
+        for k, ball in enumerate(self._balls):
+            m.body_gravcomp[ball[2]] = 1.0 if k == 1 else 0.0
+            m.geom_conaffinity[ball[4]] = self._ball_conaffinity[k]
+            d.eq_active[ball[3]] = 0
+
+    def _launch_and_release(self) -> None:
+        """Before the physics of a step: throw the waiting ball when its time has come, and let a held
+        ball go ``release_after_catch_s`` after its catch (parked under the floor, out of play)."""
+        m, d = self.model, self.data
+        if self._status[1] == "waiting" and d.time >= self.throw2.release_time - 1e-9:
+            qa, da, body, _, _ = self._balls[1]
+            d.qvel[da : da + 3] = self.throw2.release_vel
+            m.body_gravcomp[body] = 0.0
+            self._status[1] = "flying"
+        k = self._holding
+        if k is not None and not self._caught and d.time >= self._held_since + self.release_after_catch_s - 1e-9:
+            qa, da, body, weld, geom = self._balls[k]
+            d.eq_active[weld] = 0
+            d.qpos[qa : qa + 3] = PARKED_BALL_POS
+            d.qvel[da : da + 6] = 0.0
+            m.body_gravcomp[body] = 1.0
+            m.geom_conaffinity[geom] = 0
+            self._status[k] = "released"
+            self._holding = None
+
+    def _shaping_ball(self) -> int:
+        """The ball the shaping terms follow: the first still in flight (else the first)."""
+        if self.n_balls == 1:
+            return 0
+        return next((k for k in range(self.n_balls) if self._status[k] == "flying"), 0)
 
     def _is_missed(self, ball: np.ndarray) -> bool:
         x = ball[0] - SEAT_ORIGIN[0]
@@ -635,24 +758,27 @@ class EyeCatchEnv(gym.Env):
         qpos[self._fix_qpos] = self._fixation
         d.qvel[self._eye_dof] = 0.0
 
-    def _true_ball_eye(self) -> tuple[np.ndarray, np.ndarray]:
+    def _true_ball_eye(self, k: int = 0) -> tuple[np.ndarray, np.ndarray]:
         """True ball position and velocity in the current eye frame (Eyecatch Eq. 6-7, no noise)."""
         d = self.data
-        ball = d.qpos[self._ball_qpos : self._ball_qpos + 3]
-        vel = d.qvel[self._ball_dof : self._ball_dof + 3]
+        qa, da = self._balls[k][0], self._balls[k][1]
+        ball = d.qpos[qa : qa + 3]
+        vel = d.qvel[da : da + 3]
         rot = self._eye_rot
         return (ball - self._eye_pos) @ rot, vel @ rot  # R^T v
 
-    def _see_ball(self, saccading: bool) -> tuple[list, list, bool]:
-        """One visual sample of the ball: (position, velocity, visible), eye frame, float lists."""
+    def _see_ball(self, saccading: bool, k: int = 0) -> tuple[list, list, bool]:
+        """One visual sample of ball ``k``: (position, velocity, visible), eye frame, float lists."""
+        if self._status[k] in ("waiting", "released"):  # hidden by its thrower / out of play
+            return [0.0, 0.0, 0.0], [0.0, 0.0, 0.0], False
         if self.vision == "oracle":
-            pos_eye, vel_eye = self._true_ball_eye()
+            pos_eye, vel_eye = self._true_ball_eye(k)
             return pos_eye.tolist(), vel_eye.tolist(), True
         vp = self.vision_params
         if vp.foveated and saccading:  # saccadic suppression
             return [0.0, 0.0, 0.0], [0.0, 0.0, 0.0], False
         d = self.data
-        bq, bd = self._ball_qpos, self._ball_dof
+        bq, bd = self._balls[k][0], self._balls[k][1]
         ball = d.qpos[bq : bq + 3]
         ball_vel = d.qvel[bd : bd + 3]
         rot = self._eye_rot
@@ -679,12 +805,18 @@ class EyeCatchEnv(gym.Env):
     def _observe(self, saccading: bool) -> np.ndarray:
         d = self.data
         sample = self._see_ball(saccading)
+        if self.n_balls == 2:
+            sample = (sample, self._see_ball(saccading, 1))
         if self.delay_steps:
             self._delay_buffer.append(sample)
             if len(self._delay_buffer) <= self.delay_steps:
-                sample = ([0.0, 0.0, 0.0], [0.0, 0.0, 0.0], False)  # nothing has reached the brain yet
+                nothing = ([0.0, 0.0, 0.0], [0.0, 0.0, 0.0], False)  # nothing has reached the brain yet
+                sample = nothing if self.n_balls == 1 else (nothing, nothing)
             else:
                 sample = self._delay_buffer[0]
+        if self.n_balls == 2:
+            sample, (pos2, vel2, visible2) = sample
+            self._visible2 = visible2
         pos, vel, visible = sample
         self._visible = visible
         hand = d.site_xpos[self._catch_site]
@@ -710,6 +842,10 @@ class EyeCatchEnv(gym.Env):
             qpos[self._grasp_qpos] / self._grasp_max,
             d.time,
         ]
+        if self.n_balls == 2:
+            values += [*pos2, *vel2, 1.0 if visible2 else 0.0,
+                       *(0.0 if status == "waiting" or status == "flying" else 1.0 for status in self._status),
+                       0.0 if self._holding is None else 1.0]
         self._hand_prev = hand.copy()
         return np.array(values, dtype=np.float32)
 
@@ -721,7 +857,7 @@ class EyeCatchEnv(gym.Env):
     def _info(self, *, caught: bool, missed: bool, diverged: bool, terms: dict, visible: bool) -> dict:
         """Step information. The true state in here is for scoring only: never feed it to a policy."""
         d = self.data
-        return {
+        info = {
             "is_success": bool(self._caught),
             "caught": caught,
             "missed": missed,
@@ -739,6 +875,16 @@ class EyeCatchEnv(gym.Env):
             "head_qpos": d.qpos[self._neck_qpos].copy(),
             "head_dir": d.xmat[self._head_body, 0::3].copy(),  # the head's forward axis, world
         }
+        if self.n_balls == 2:
+            qa, da = self._balls[1][0], self._balls[1][1]
+            info.update(
+                ball2_pos=d.qpos[qa : qa + 3].copy(),
+                ball2_vel=d.qvel[da : da + 3].copy(),
+                ball2_visible=bool(self._visible2),
+                balls_caught=sum(status in ("held", "released") for status in self._status),
+                holding=-1 if self._holding is None else int(self._holding),
+            )
+        return info
 
     # ------------------------------------------------------------------------------------------
     # Rendering
@@ -785,4 +931,8 @@ class EyeCatchEnv(gym.Env):
 
 
 if EyeCatchEnv.__doc__:
+    EyeCatchEnv.__doc__ = EyeCatchEnv.__doc__.replace("TWO_BALL_OBSERVATION_TABLE", "\n    ".join(
+        row for row in ObservationLayout(catch_observation(2)).markdown_table().splitlines()
+        if row.startswith("| index") or row.startswith("|---")
+        or any(f"| {b.name} |" in row for b in SECOND_BALL_OBSERVATION)))
     EyeCatchEnv.__doc__ = EyeCatchEnv.__doc__.replace("OBSERVATION_TABLE", ObservationLayout().markdown_table())

@@ -42,6 +42,25 @@ CATCH_OBSERVATION = (
     Block("time", 1, "s", "time since the throw"),
 )
 
+# Appended after CATCH_OBSERVATION in EyeCatchTwoBalls-v0 (``n_balls=2``) only: the single-ball layout
+# is unchanged and stays a prefix, so its slices hold in both.
+SECOND_BALL_OBSERVATION = (
+    Block("ball2_pos", 3, "m", "perceived position of the second ball, eye frame (zeros when not visible)"),
+    Block("ball2_vel", 3, "m/s", "perceived velocity of the second ball, eye-frame axes (zeros when not visible)"),
+    Block("ball2_visible", 1, "0/1", "1 if this step produced a visual sample of the second ball"),
+    Block("balls_caught", 2, "0/1", "touch: 1 once the first / second ball has been caught (stays 1 after release)"),
+    Block("holding", 1, "0/1", "touch: 1 while a caught ball is held in the hand"),
+)
+
+
+def catch_observation(n_balls: int = 1) -> tuple[Block, ...]:
+    """The blocks of the catch family's observation for ``n_balls`` balls (1 or 2)."""
+    if n_balls == 1:
+        return CATCH_OBSERVATION
+    if n_balls == 2:
+        return CATCH_OBSERVATION + SECOND_BALL_OBSERVATION
+    raise ValueError(f"n_balls must be 1 or 2, got {n_balls!r}")
+
 
 class ObservationLayout:
     """Slices of each named block in the flat observation vector."""

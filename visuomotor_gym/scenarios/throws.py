@@ -18,10 +18,14 @@ image, so that after an elastic, frictionless bounce it still reaches the arriva
 (Eyecatch section 5). MuJoCo's soft contact delays the bounce by a few milliseconds, so in that
 variant the ball passes 4-9 cm from ``arrival_pos`` (measured over 30 seeds: median 4.5 cm); it is
 still catchable, and scoring always uses the simulated ball, never ``arrival_pos``.
+
+``EyeCatchTwoBalls-v0`` draws a second throw after the first (:func:`sample_second_throw`), so its first
+ball is the ladder's throw for the seed.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -43,6 +47,11 @@ class ThrowDistribution:
     arrival_z_m: tuple[float, float] = (0.85, 1.20)
     gaze_jitter_deg: float = 2.0  # initial gaze: at the thrower's hand, +- this (std)
     wall_clearance_m: tuple[float, float] = (0.8, 1.4)  # Bounce: wall distance beyond the path
+    # EyeCatchTwoBalls-v0 only (sample_second_throw): the second ball comes from the other side.
+    second_release_lateral_m: tuple[float, float] = (1.0, 2.0)  # |y|, opposite to the first release
+    second_stagger_s: tuple[float, float] = (0.2, 0.5)  # released this long after the first ball
+    second_arrival_gap_s: tuple[float, float] = (0.5, 0.8)  # arrives this long after the first
+    second_max_flight_s: float = 1.6  # longer flights are released later instead
 
     def __post_init__(self) -> None:
         for name, value in self.__dict__.items():
@@ -65,6 +74,7 @@ class Throw:
     gaze_offset: np.ndarray  # initial gaze offset from the release point (azimuth, elevation), rad
     wall_y: float | None = None  # Bounce: y of the wall surface the ball centre reflects from
     wall_side: float = 0.0  # +1: wall on the left of the flight, -1: on the right
+    release_time: float = 0.0  # s after the episode start (the second ball of EyeCatchTwoBalls-v0)
 
 
 def launch_velocity(release: np.ndarray, arrival: np.ndarray, n_steps: int, dt: float) -> np.ndarray:
@@ -102,3 +112,31 @@ def sample_throw(
         aim[1] = 2.0 * wall_y - arrival[1]
     velocity = launch_velocity(release, aim, n_steps, dt)
     return Throw(release, velocity, arrival, n_steps * dt, gaze_offset, wall_y, side)
+
+
+def sample_second_throw(
+    rng: np.random.Generator, dist: ThrowDistribution, dt: float, control_dt: float, first: Throw
+) -> Throw:
+    """The second ball of EyeCatchTwoBalls-v0, drawn after ``first`` (so the first throw is the ladder's).
+
+    Released from the other side of the first release (``second_release_lateral_m``, same distance and
+    height ranges), ``second_stagger_s`` after the first ball (rounded up to a whole control step, so it
+    is released between control steps), arriving in the same catchable region ``second_arrival_gap_s``
+    after the first ball's arrival; a flight longer than ``second_max_flight_s`` is released later.
+    ``release_time`` is the release time; ``flight_time`` counts from it.
+    """
+    u = rng.random(8)
+
+    def lerp(rng_range, x):
+        return rng_range[0] + (rng_range[1] - rng_range[0]) * x
+
+    side = -1.0 if first.release_pos[1] >= 0.0 else 1.0
+    release = np.array([lerp(dist.release_x_m, u[0]), side * lerp(dist.second_release_lateral_m, u[1]),
+                        lerp(dist.release_z_m, u[2])])
+    arrival = np.array([lerp(dist.arrival_x_m, u[3]), lerp(dist.arrival_y_m, u[4]), lerp(dist.arrival_z_m, u[5])])
+    arrives = first.release_time + first.flight_time + lerp(dist.second_arrival_gap_s, u[6])
+    stagger = max(lerp(dist.second_stagger_s, u[7]), arrives - dist.second_max_flight_s)
+    stagger = math.ceil(stagger / control_dt - 1e-9) * control_dt  # the next control step
+    n_steps = max(1, int(round((arrives - stagger) / dt)))
+    velocity = launch_velocity(release, arrival, n_steps, dt)
+    return Throw(release, velocity, arrival, n_steps * dt, np.zeros(2), release_time=stagger)
