@@ -135,7 +135,8 @@ def test_first_entries_cover_every_env_id_of_the_protocol():
         assert f"eyecatch__{env.env_id}" in keys
         assert (env.episodes, env.seed) == (200, 0)
     for entry in board.entries:
-        assert entry.policy is not None and (COMMITTED / entry.policy["file"]).is_file()
+        if entry.name == "eyecatch":  # its policy file is its resolved parameters
+            assert entry.policy is not None and (COMMITTED / entry.policy["file"]).is_file()
         assert len(entry.record["episodes"]) == 200
 
 
@@ -319,7 +320,7 @@ def test_superseded_entries_are_kept_but_not_rescored(lb):
     )
     report = check(lb, rescore=True, seeds=[0], pages=False)
     assert any(KEY in n and "superseded" in n for n in report.notes)
-    assert report.rescored_entries == 5
+    assert report.rescored_entries == len(load_leaderboard(lb).entries) - 1
     assert_refused(report, "layout", "lists 'nobody__EyeCatch-v0', which is no entry")
     html = render_pages(load_leaderboard(lb))["index.html"]
     assert 'id="superseded-table"' in html and "test: the agent changed" in html
