@@ -43,3 +43,14 @@ def test_joint_control_drives_joints_to_setpoints():
         obs, *_ = env.step(action)
     q = obs[env.layout.slices["body_qpos"]]
     assert np.max(np.abs(q - goal)) < np.radians(4)
+
+
+def test_action_encoder_neck_ranges_match_the_model():
+    """``envs.actions.NECK_RANGE_DEG`` (used by the agents) agrees with the MJCF neck joints."""
+    from visuomotor_gym.envs.actions import NECK_RANGE_DEG, hand_action
+
+    env = gym.make("EyeCatch-v0").unwrapped
+    np.testing.assert_allclose(np.radians(NECK_RANGE_DEG), env._neck_range, atol=1e-9)
+    a = hand_action([0.4, -0.2, 1.0], True, head=(np.radians(40.0), np.radians(-25.0)))
+    assert a[3] == 1.0 and a[7] == pytest.approx(0.5) and a[8] == pytest.approx(-0.5)  # -25 of -50 deg
+    np.testing.assert_allclose(a[:3], to_action([0.4, -0.2, 1.0]), atol=1e-6)

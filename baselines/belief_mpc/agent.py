@@ -47,10 +47,10 @@ import gymnasium as gym
 import numpy as np
 
 from visuomotor_gym.baselines.eyecatch import KalmanParams
-from visuomotor_gym.baselines.eyecatch.agent import NECK_RANGE_DEG, SHOULDER_WORLD
-from visuomotor_gym.envs.catch import HAND_WORKSPACE, SEAT_ORIGIN
+from visuomotor_gym.baselines.eyecatch.agent import SHOULDER_WORLD
+from visuomotor_gym.envs.actions import hand_action
+from visuomotor_gym.envs.catch import SEAT_ORIGIN
 from visuomotor_gym.envs.observation import ObservationLayout, catch_observation
-from visuomotor_gym.oculomotor.plant import OculomotorParams
 from visuomotor_gym.vision.foveation import VisionParams
 
 from . import ilqr
@@ -172,8 +172,6 @@ class BeliefMPCAgent:
         self.q_control = p.alpha * self.dt / CONTROL_DT_REFERENCE
         self.q_plan = p.alpha * self.h / CONTROL_DT_REFERENCE
         self.gaze_range = p.gaze_action_range_deg * DEG
-        fix = OculomotorParams().fixation_range_m
-        self.fix_log = (math.log(fix[0]), math.log(fix[1]))
         self._problems: dict[int, tuple[GazeBeliefProblem, HandProblem]] = {}
         self.timing: dict[str, float] = {}  # seconds per part of the policy, accumulated over episodes
         self.reset()
@@ -473,20 +471,7 @@ class BeliefMPCAgent:
                          "sigma": [None if b.sigma is None else b.sigma.copy() for b in self.balls]})
 
     def _action(self, hand_target, gaze_ret, head, fixation) -> np.ndarray:
-        a = np.zeros(9, dtype=np.float32)
-        lo, hi = HAND_WORKSPACE[:, 0], HAND_WORKSPACE[:, 1]
-        a[:3] = np.clip(2.0 * (hand_target - SEAT_ORIGIN - lo) / (hi - lo) - 1.0, -1.0, 1.0)
-        a[3] = 1.0 if self.grasp else -1.0
-        a[4] = np.clip(gaze_ret[0] / self.gaze_range, -1.0, 1.0)
-        a[5] = np.clip(gaze_ret[1] / self.gaze_range, -1.0, 1.0)
-        if fixation is not None:
-            lo_f, hi_f = self.fix_log
-            a[6] = np.clip(2.0 * (math.log(max(fixation, 1e-3)) - lo_f) / (hi_f - lo_f) - 1.0, -1.0, 1.0)
-        for k in range(2):
-            lo_h, hi_h = NECK_RANGE_DEG[k]
-            v = float(head[k])
-            a[7 + k] = np.clip(v / (hi_h * DEG) if v >= 0 else -v / (lo_h * DEG), -1.0, 1.0)
-        return a
+        return hand_action(hand_target, self.grasp, gaze_ret, head, fixation, self.gaze_range)
 
 
 def _angle(a: np.ndarray, b: np.ndarray) -> float:

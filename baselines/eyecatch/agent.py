@@ -35,9 +35,10 @@ from dataclasses import dataclass, fields, replace
 import gymnasium as gym
 import numpy as np
 
-from visuomotor_gym.envs.catch import HAND_WORKSPACE, SEAT_ORIGIN
+from visuomotor_gym.envs.actions import NECK_RANGE_DEG, hand_action
+from visuomotor_gym.envs.catch import SEAT_ORIGIN
 from visuomotor_gym.envs.observation import ObservationLayout
-from visuomotor_gym.oculomotor.plant import OculomotorParams, minimum_jerk
+from visuomotor_gym.oculomotor.plant import minimum_jerk
 from visuomotor_gym.vision import foveation
 from visuomotor_gym.vision.foveation import VisionParams
 
@@ -45,7 +46,6 @@ from .kalman import BallKalmanFilter, KalmanParams
 
 _S = ObservationLayout().slices
 DEG = math.pi / 180.0
-NECK_RANGE_DEG = ((-80.0, 80.0), (-50.0, 40.0))  # envs_assets/common/upper_body.xml
 SHOULDER_WORLD = np.array([0.0, -0.2, 0.9])  # right shoulder at the reset posture
 
 
@@ -143,7 +143,6 @@ class EyecatchAgent:
         self.delay_steps = int(round(p.visual_delay_s / self.dt))
         self.filter = BallKalmanFilter(self.dt, self.kalman_params)
         self.gaze_range = p.gaze_action_range_deg * DEG
-        self.fix_log = (math.log(OculomotorParams().fixation_range_m[0]), math.log(OculomotorParams().fixation_range_m[1]))
         self.reset()
 
     @classmethod
@@ -381,17 +380,4 @@ class EyecatchAgent:
         return point
 
     def _action(self, hand_target, obs, gaze, head, fixation: float | None = None) -> np.ndarray:
-        a = np.zeros(9, dtype=np.float32)
-        lo, hi = HAND_WORKSPACE[:, 0], HAND_WORKSPACE[:, 1]
-        a[:3] = np.clip(2.0 * (hand_target - SEAT_ORIGIN - lo) / (hi - lo) - 1.0, -1.0, 1.0)
-        a[3] = 1.0 if self.grasp else -1.0
-        a[4] = np.clip(gaze[0] / self.gaze_range, -1.0, 1.0)
-        a[5] = np.clip(gaze[1] / self.gaze_range, -1.0, 1.0)
-        if fixation is not None:
-            lo_f, hi_f = self.fix_log
-            a[6] = np.clip(2.0 * (math.log(max(fixation, 1e-3)) - lo_f) / (hi_f - lo_f) - 1.0, -1.0, 1.0)
-        for k in range(2):
-            lo_h, hi_h = NECK_RANGE_DEG[k]
-            h = float(head[k])
-            a[7 + k] = np.clip(h / (hi_h * DEG) if h >= 0 else -h / (lo_h * DEG), -1.0, 1.0)
-        return a
+        return hand_action(hand_target, self.grasp, gaze, head, fixation, self.gaze_range)

@@ -1,0 +1,41 @@
+"""Encoding agent intentions as the catch env's ``control="hand"`` action (the inverse of the env's
+action mapping), shared by the scripted and model-based agents."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from visuomotor_gym.envs.catch import HAND_WORKSPACE, SEAT_ORIGIN
+from visuomotor_gym.oculomotor.plant import OculomotorParams
+
+NECK_RANGE_DEG = ((-80.0, 80.0), (-50.0, 40.0))  # yaw, pitch: envs_assets/common/upper_body.xml
+_FIX = OculomotorParams().fixation_range_m
+_LOG_FIX = (math.log(_FIX[0]), math.log(_FIX[1]))
+
+
+def hand_action(
+    hand_target_world,
+    grasp_closed: bool,
+    gaze=(0.0, 0.0),
+    head=(0.0, 0.0),
+    fixation_m: float | None = None,
+    gaze_range_rad: float = math.radians(60.0),
+) -> np.ndarray:
+    """The 9-dim action: hand target (world point), grasp, gaze change (retinal azimuth, elevation,
+    rad), fixation distance (m; None keeps the action's neutral value) and neck (yaw, pitch, rad)."""
+    a = np.zeros(9, dtype=np.float32)
+    lo, hi = HAND_WORKSPACE[:, 0], HAND_WORKSPACE[:, 1]
+    a[:3] = np.clip(2.0 * (np.asarray(hand_target_world) - SEAT_ORIGIN - lo) / (hi - lo) - 1.0, -1.0, 1.0)
+    a[3] = 1.0 if grasp_closed else -1.0
+    a[4] = np.clip(gaze[0] / gaze_range_rad, -1.0, 1.0)
+    a[5] = np.clip(gaze[1] / gaze_range_rad, -1.0, 1.0)
+    if fixation_m is not None:
+        lo_f, hi_f = _LOG_FIX
+        a[6] = np.clip(2.0 * (math.log(max(fixation_m, 1e-3)) - lo_f) / (hi_f - lo_f) - 1.0, -1.0, 1.0)
+    for k in range(2):
+        lo_h, hi_h = NECK_RANGE_DEG[k]
+        h = math.degrees(float(head[k]))
+        a[7 + k] = np.clip(h / hi_h if h >= 0 else -h / lo_h, -1.0, 1.0)
+    return a
