@@ -14,7 +14,8 @@ import math
 
 import numpy as np
 
-from visuomotor_gym.envs.catch import HAND_WORKSPACE, SEAT_ORIGIN
+from visuomotor_gym.envs.actions import hand_action
+from visuomotor_gym.envs.catch import SEAT_ORIGIN
 from visuomotor_gym.envs.observation import ObservationLayout
 from visuomotor_gym.scenarios.throws import GRAVITY
 
@@ -53,19 +54,12 @@ class InterceptOracle:
 
     def predict(self, observation, state=None, episode_start=None, deterministic=True):
         obs = np.asarray(observation, dtype=float)
-        action = np.zeros(9, dtype=np.float32)
         point = self.intercept_point(obs)
-        if point is not None:
-            lo, hi = HAND_WORKSPACE[:, 0], HAND_WORKSPACE[:, 1]
-            action[:3] = np.clip(2.0 * (point - SEAT_ORIGIN - lo) / (hi - lo) - 1.0, -1.0, 1.0)
-        else:  # hold the hand where it is
-            hand = obs[_S["hand_pos"]].astype(float)
-            lo, hi = HAND_WORKSPACE[:, 0], HAND_WORKSPACE[:, 1]
-            action[:3] = np.clip(2.0 * (hand - lo) / (hi - lo) - 1.0, -1.0, 1.0)
-        action[3] = self.grasp
+        if point is None:  # hold the hand where it is
+            point = obs[_S["hand_pos"]] + SEAT_ORIGIN
+        gaze = (0.0, 0.0)
         if self.track_with_eye and obs[_S["ball_visible"]][0] > 0.5:
             # Request the ball's retinal direction: a saccade when far off, pursuit when close.
-            x, y, z = obs[_S["ball_pos"]].astype(float)
-            action[4] = np.clip(math.atan2(y, x) / self.gaze_range, -1.0, 1.0)
-            action[5] = np.clip(math.atan2(z, math.hypot(x, y)) / self.gaze_range, -1.0, 1.0)
-        return action, state
+            x, y, z = obs[_S["ball_pos"]]
+            gaze = (math.atan2(y, x), math.atan2(z, math.hypot(x, y)))
+        return hand_action(point, self.grasp > 0, gaze, gaze_range_rad=self.gaze_range), state

@@ -20,13 +20,16 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import platform
+import shlex
 import sys
 
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")  # before numpy is imported: one core means one BLAS thread
 
 import numpy as np  # noqa: E402
+
+from visuomotor_gym.bench.provenance import provenance  # noqa: E402
+
 
 def main(argv=None) -> dict:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
@@ -45,7 +48,6 @@ def main(argv=None) -> dict:
         pinned = args.core if args.core is not None else allowed[0]
         os.sched_setaffinity(0, {pinned})
 
-    import mujoco
 
     from visuomotor_gym.agents import make_agent
     from visuomotor_gym.bench.evaluate import make_env
@@ -93,11 +95,7 @@ def main(argv=None) -> dict:
         "real_time": bool(np.percentile(lat, 95) <= period_ms),
         "time_share_percent": shares,
         "mean_ms_per_step_by_part": per_step_ms,
-        "python": sys.version.split()[0],
-        "numpy": np.__version__,
-        "mujoco": mujoco.__version__,
-        "platform": platform.platform(),
-        "processor": platform.processor() or platform.machine(),
+        "provenance": provenance(shlex.join(["python", *sys.argv])),
     }
     print(json.dumps(result, indent=2))
     if args.json:

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import argparse
 import json
-import platform
+import shlex
 import sys
 import time
 
@@ -25,6 +25,7 @@ import mujoco
 import numpy as np
 
 import visuomotor_gym  # noqa: F401  (registers the ids)
+from visuomotor_gym.bench.provenance import provenance  # noqa: E402
 
 
 def env_run(env_id: str, actions: np.ndarray, seed: int, record: bool):
@@ -90,9 +91,7 @@ def main(argv=None) -> dict:
         "ratio_env_over_raw": round(env_rate / raw_rate, 3),
         "target_ratio": 0.5,
         "meets_target": env_rate / raw_rate >= 0.5,
-        "python": sys.version.split()[0],
-        "mujoco": mujoco.__version__,
-        "platform": platform.platform(),
+        "provenance": provenance(shlex.join(["python", *sys.argv])),
     }
     print(json.dumps(result, indent=2))
     if args.json:

@@ -14,12 +14,11 @@ from __future__ import annotations
 
 import argparse
 import json
-import platform
+import shlex
 import sys
 
-import mujoco
-
 from visuomotor_gym.bench.evaluate import evaluate
+from visuomotor_gym.bench.provenance import provenance
 
 
 def main(argv=None) -> dict:
@@ -51,9 +50,7 @@ def main(argv=None) -> dict:
         "eval_wall_over_2_min_budget": round(agent.wall_time_s / 120.0, 4),
         "meets_wall_target": agent.wall_time_s < 120.0,
         "env_steps": agent.env_steps,
-        "python": sys.version.split()[0],
-        "mujoco": mujoco.__version__,
-        "platform": platform.platform(),
+        "provenance": provenance(shlex.join(["python", *sys.argv])),
     }
     print(json.dumps(result, indent=2))
     if args.json:

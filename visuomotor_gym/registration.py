@@ -42,6 +42,18 @@ ENV_SPECS: tuple[EnvSpec, ...] = (
 CATCH_ENV_IDS = tuple(spec.id for spec in ENV_SPECS if spec.entry_point == CATCH_ENTRY_POINT)
 
 
+def env_vision(env_id: str) -> dict:
+    """What the eye of a registered catch env gives its agent, for agents that model their own vision:
+    ``vision_noise_scale`` (0 for the oracle), ``foveated``, ``visual_delay_s``, ``gaze_action_range_deg``."""
+    kw = gym.spec(env_id).kwargs or {}
+    return {
+        "vision_noise_scale": 0.0 if kw.get("vision") == "oracle" else float(kw.get("vision_noise_scale", 1.0)),
+        "foveated": kw.get("vision", "foveated") == "foveated",
+        "visual_delay_s": float(kw.get("visual_delay_s", 0.0)),
+        "gaze_action_range_deg": float(kw.get("gaze_action_range_deg", 60.0)),
+    }
+
+
 def register_envs() -> None:
     """Register every id in :data:`ENV_SPECS` (idempotent)."""
     for spec in ENV_SPECS:

@@ -43,14 +43,14 @@ import math
 import time
 from dataclasses import dataclass, fields, replace
 
-import gymnasium as gym
 import numpy as np
-
 from visuomotor_gym.baselines.eyecatch import KalmanParams
 from visuomotor_gym.baselines.eyecatch.agent import SHOULDER_WORLD
+
 from visuomotor_gym.envs.actions import hand_action
 from visuomotor_gym.envs.catch import SEAT_ORIGIN
 from visuomotor_gym.envs.observation import ObservationLayout, catch_observation
+from visuomotor_gym.registration import env_vision
 from visuomotor_gym.vision.foveation import VisionParams
 
 from . import ilqr
@@ -179,14 +179,7 @@ class BeliefMPCAgent:
     @classmethod
     def for_env(cls, env_id: str, **overrides) -> BeliefMPCAgent:
         """An agent whose assumed vision matches the registered env (noise, foveation, latency)."""
-        spec = gym.spec(env_id)
-        kw = spec.kwargs or {}
-        base = BeliefMPCParams(
-            vision_noise_scale=0.0 if kw.get("vision") == "oracle" else float(kw.get("vision_noise_scale", 1.0)),
-            foveated=kw.get("vision", "foveated") == "foveated",
-            visual_delay_s=float(kw.get("visual_delay_s", 0.0)),
-            gaze_action_range_deg=float(kw.get("gaze_action_range_deg", 60.0)),
-        )
+        base = BeliefMPCParams(**env_vision(env_id))
         known = {f.name for f in fields(BeliefMPCParams)}
         unknown = sorted(set(overrides) - known)
         if unknown:

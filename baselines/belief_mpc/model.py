@@ -55,7 +55,13 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import solveh_banded
 
-from .belief import ObservationNoise, covariance_step, gaze_vector, gaze_vector_derivatives, observation_variance
+from .belief import (
+    ObservationNoise,
+    covariance_step,
+    gaze_vector,
+    gaze_vector_derivatives,
+    observation_variance,
+)
 
 DEG = np.pi / 180.0
 N_BODY = 7  # gaze (2) + head (2) + hand (3): the body part of the joint state (see the table above)

@@ -14,8 +14,8 @@ tests build it directly and play it with the evaluator's episode runner.
 from __future__ import annotations
 
 import numpy as np
-
 from visuomotor_gym.baselines.eyecatch import EyecatchAgent
+
 from visuomotor_gym.envs.observation import ObservationLayout, catch_observation
 
 _ONE = ObservationLayout()

@@ -21,8 +21,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-
 from visuomotor_gym.baselines.eyecatch import BallKalmanFilter, EyecatchAgent, KalmanParams
+
 from visuomotor_gym.vision import foveation
 from visuomotor_gym.vision.foveation import VisionParams
 

@@ -32,13 +32,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, fields, replace
 
-import gymnasium as gym
 import numpy as np
 
 from visuomotor_gym.envs.actions import NECK_RANGE_DEG, hand_action
 from visuomotor_gym.envs.catch import SEAT_ORIGIN
 from visuomotor_gym.envs.observation import ObservationLayout
 from visuomotor_gym.oculomotor.plant import minimum_jerk
+from visuomotor_gym.registration import env_vision
 from visuomotor_gym.vision import foveation
 from visuomotor_gym.vision.foveation import VisionParams
 
@@ -148,14 +148,7 @@ class EyecatchAgent:
     @classmethod
     def for_env(cls, env_id: str, **overrides) -> EyecatchAgent:
         """An agent whose assumed vision matches the registered env (noise, foveation, latency)."""
-        spec = gym.spec(env_id)
-        kw = spec.kwargs or {}
-        base = EyecatchParams(
-            vision_noise_scale=0.0 if kw.get("vision") == "oracle" else float(kw.get("vision_noise_scale", 1.0)),
-            foveated=kw.get("vision", "foveated") == "foveated",
-            visual_delay_s=float(kw.get("visual_delay_s", 0.0)),
-            gaze_action_range_deg=float(kw.get("gaze_action_range_deg", 60.0)),
-        )
+        base = EyecatchParams(**env_vision(env_id))
         unknown = sorted(set(overrides) - {f.name for f in fields(EyecatchParams)})
         if unknown:
             raise TypeError(f"unknown Eyecatch parameter(s) {unknown}; known: {[f.name for f in fields(EyecatchParams)]}")

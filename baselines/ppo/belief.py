@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import gymnasium as gym
 import numpy as np
-
 from visuomotor_gym.baselines.eyecatch.agent import EyecatchAgent
+
 from visuomotor_gym.envs.catch import SEAT_ORIGIN
 
 N_BELIEF = 10

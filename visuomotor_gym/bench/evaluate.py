@@ -154,8 +154,14 @@ def _progress_bar(enabled: bool, description: str, total: int):
     if not enabled:
         return None
     try:
-        from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn,
-                                   TimeRemainingColumn)
+        from rich.progress import (
+            BarColumn,
+            MofNCompleteColumn,
+            Progress,
+            TextColumn,
+            TimeElapsedColumn,
+            TimeRemainingColumn,
+        )
     except ImportError:
         return None
     progress = Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),

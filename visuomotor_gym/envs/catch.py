@@ -16,10 +16,10 @@ from gymnasium import spaces
 
 from visuomotor_gym.assets import asset_path
 from visuomotor_gym.body import names
-from visuomotor_gym.control.hand import HandControlParams, HandController
+from visuomotor_gym.control.hand import HandController, HandControlParams
 from visuomotor_gym.envs.observation import SECOND_BALL_OBSERVATION, ObservationLayout, catch_observation
-from visuomotor_gym.geometry import norm
 from visuomotor_gym.envs.rewards import REWARD_TERMS, SHAPED_WEIGHTS, SPARSE_WEIGHTS, catch_reward
+from visuomotor_gym.geometry import norm
 from visuomotor_gym.oculomotor.plant import (
     DEG,
     OculomotorParams,
