@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from visuomotor_gym.geometry import norm, solve3
+from visuomotor_gym.geometry import solve3
 
 
 @dataclass(frozen=True)
@@ -76,14 +76,17 @@ class HandController:
         """Start the hand reference where the hand is."""
         self.reference = np.array(hand_pos, dtype=float)
 
-    def advance_reference(self, target: np.ndarray, dt: float) -> np.ndarray:
-        """Move the reference toward ``target`` by at most ``max_speed * dt``; return it."""
-        delta = target - self.reference
-        dist = norm(delta)
+    def advance_reference(self, target, dt: float) -> np.ndarray:
+        """Move the reference toward ``target`` (a 3-vector) by at most ``max_speed * dt``; return it."""
+        tx, ty, tz = target.tolist() if isinstance(target, np.ndarray) else target
+        rx, ry, rz = self.reference.tolist()
+        dx, dy, dz = tx - rx, ty - ry, tz - rz
+        dist = math.sqrt(dx * dx + dy * dy + dz * dz)
         limit = self.params.max_speed_m_s * dt
         if dist > limit:
-            delta *= limit / dist
-        self.reference = self.reference + delta
+            k = limit / dist
+            dx, dy, dz = dx * k, dy * k, dz * k
+        self.reference = np.array([rx + dx, ry + dy, rz + dz])
         return self.reference
 
     def setpoints(self, data: mujoco.MjData, setpoint: np.ndarray) -> np.ndarray:
@@ -94,15 +97,17 @@ class HandController:
         """
         p = self.params
         mujoco.mj_jacSite(self.model, data, self._jacp, None, self.site_id)
-        jac = self._jacp[:, self.dof_ids]
-        offset = setpoint - data.qpos[self.qpos_ids]
+        # A contiguous copy, and ndarray.dot rather than @: on these 3x10 shapes numpy's per-call
+        # overhead is most of the cost (this runs every control step).
+        jac = np.ascontiguousarray(self._jacp[:, self.dof_ids])
         posture = p.posture_gain * (self.nominal - setpoint)
         # Error of the hand the setpoints would give, minus what the posture step already moves.
-        error = self.reference - data.site_xpos[self.site_id] - jac @ (offset + posture)
+        error = self.reference - data.site_xpos[self.site_id] - jac.dot(setpoint - data.qpos[self.qpos_ids] + posture)
         jw = jac * self.weights  # J W
         # W (JW)^T (JW (JW)^T + l^2 I)^-1 e
-        dq = self.weights * (jw.T @ solve3(jw @ jw.T + self._damping_eye, error)) + posture
-        step = float(np.abs(dq).max())
+        dq = self.weights * solve3(jw.dot(jw.T) + self._damping_eye, error).dot(jw) + posture
+        values = dq.tolist()
+        step = max(max(values), -min(values))
         if step > p.max_joint_step_rad:
             dq *= p.max_joint_step_rad / step
         return np.minimum(np.maximum(setpoint + dq, self.lower), self.upper)

@@ -38,6 +38,7 @@ REWARD_MODES = ("sparse", "shaped")
 RENDER_CAMERAS = ("both", "scene", "eye", "over_shoulder")
 
 SEAT_ORIGIN = np.array([0.0, 0.0, 0.5])  # the pelvis joint, world frame
+_SEAT_X, _SEAT_Y, _SEAT_Z = SEAT_ORIGIN.tolist()
 # Hand workspace of control="hand": an axis-aligned box in the seat frame (min, max), metres.
 HAND_WORKSPACE = np.array([[-0.1, 0.7], [-0.8, 0.3], [0.0, 1.0]])
 # Ready posture at reset (degrees): hand in front of the belly, palm facing the body's midline.
@@ -335,6 +336,7 @@ class EyeCatchEnv(gym.Env):
         self._ball_body = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, names.BALL)
         self._thrower_body = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, names.THROWER)
         self._eye_offset = m.body_pos[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, names.EYE)].copy()
+        self._eye_offset_list = self._eye_offset.tolist()
         self._catch_site = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, names.CATCH_SITE)
         self._wall_geom = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, names.BOUNCE_WALL_GEOM)
         self._weld = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_EQUALITY, names.CATCH_WELD)
@@ -356,6 +358,7 @@ class EyeCatchEnv(gym.Env):
             raise ValueError("the body servos must have a ctrlrange (it is their speed limit)")
         self._ws_lo = HAND_WORKSPACE[:, 0] + SEAT_ORIGIN  # world frame
         self._ws_half = 0.5 * (HAND_WORKSPACE[:, 1] - HAND_WORKSPACE[:, 0])
+        self._ws_lo_half = (tuple(self._ws_lo.tolist()), tuple(self._ws_half.tolist()))
         self.hand = HandController(
             m, self._catch_site, self._body_dof, self._body_qpos, self._body_range, self._ready,
             n_torso=len(names.TORSO_JOINTS), params=self.hand_params,
@@ -434,6 +437,7 @@ class EyeCatchEnv(gym.Env):
         # Live views of MuJoCo's bad-state warning counters (reading one costs ~0.1 us).
         self._warning_stats = [d.warning[i] for i in self._bad_warnings]
         self._warning_total = sum(w.number for w in self._warning_stats)
+        self._half_timestep = 0.5 * float(m.opt.timestep)
 
         # Gaze on the release point (the thrower's hand), with a small jitter.
         eye_pos = d.xpos[self._head_body] + d.xmat[self._head_body].reshape(3, 3) @ self._eye_offset
@@ -442,10 +446,10 @@ class EyeCatchEnv(gym.Env):
         self.plant.reset(gaze, time=0.0)
         self._fixation = float(np.linalg.norm(throw.release_pos - eye_pos))
         self._apply_gaze()
-        self._prev_eye_pos = self._eye_pos.copy()
-        self._prev_gaze = self._eye_rot[:, 0].tolist()
+        self._prev_eye_pos = self._eye_pos_list
+        self._prev_gaze = self._eye_rot_flat[0::3]
         self.hand.reset(d.site_xpos[self._catch_site])
-        self._hand_prev = d.site_xpos[self._catch_site].copy()
+        self._hand_prev = tuple(d.site_xpos[self._catch_site].tolist())
         obs = self._observe(saccading=False)
         self._last_obs = obs.copy()
         info = self._info(caught=False, missed=False, diverged=False, terms={}, visible=self._visible)
@@ -463,14 +467,18 @@ class EyeCatchEnv(gym.Env):
         return self._format(obs), info
 
     def step(self, action):
-        a = self._check_action(action)
+        a, al = self._check_action(action)  # al: the same values in a list (cheaper to read than slices)
         m, d = self.model, self.data
         dt = self.dt
         nb = self._n_body_act
 
         # --- eye: requested gaze change, in retinal coordinates of the current eye frame --------
-        g_az, g_el, g_fix = a[nb + 1 : nb + 4].tolist()
-        target = self._eye_rot @ direction_from_angles(g_az * self.gaze_action_range, g_el * self.gaze_action_range)
+        g_az, g_el, g_fix = al[nb + 1 : nb + 4]
+        az, el = g_az * self.gaze_action_range, g_el * self.gaze_action_range
+        ce = math.cos(el)
+        ux, uy, uz = ce * math.cos(az), ce * math.sin(az), math.sin(el)  # direction_from_angles, eye frame
+        r0, r1, r2, r3, r4, r5, r6, r7, r8 = self._eye_rot_flat
+        target = np.array([r0 * ux + r1 * uy + r2 * uz, r3 * ux + r4 * uy + r5 * uz, r6 * ux + r7 * uy + r8 * uz])
         plant_step = self.plant.step(target, dt, self.n_substeps, self.np_random)
         lo, hi = self._log_fix
         fix_target = math.exp(lo + (g_fix + 1.0) * 0.5 * (hi - lo))
@@ -481,7 +489,7 @@ class EyeCatchEnv(gym.Env):
         # --- head: velocity-limited position servo -------------------------------------------
         vmax = self._head_vmax
         act, ctrl = d.act, d.ctrl
-        head_a = a[nb + 4 : nb + 6].tolist()
+        head_a = al[nb + 4 : nb + 6]
         for k in range(2):
             h = head_a[k]
             lo_h, hi_h = self._neck_range_list[k]
@@ -491,14 +499,14 @@ class EyeCatchEnv(gym.Env):
         # --- torso and arm ----------------------------------------------------------------------
         setpoint = d.act[self._body_actadr]
         if self.control == "hand":
-            target = self._ws_lo + (a[:3] + 1.0) * self._ws_half
-            self.hand.advance_reference(target, dt)
+            (lx, ly, lz), (hx, hy, hz) = self._ws_lo_half
+            self.hand.advance_reference((lx + (al[0] + 1.0) * hx, ly + (al[1] + 1.0) * hy, lz + (al[2] + 1.0) * hz), dt)
             new_setpoint = self.hand.setpoints(d, setpoint)
         else:
             r = self._body_range
             new_setpoint = r[:, 0] + (a[:10].astype(float) + 1.0) * 0.5 * (r[:, 1] - r[:, 0])
         d.ctrl[self._body_act] = (new_setpoint - setpoint) / dt  # MuJoCo clamps to ctrlrange: a rate limit
-        d.ctrl[self._grasp_act] = (float(a[nb]) + 1.0) * 0.5 * self._grasp_max
+        d.ctrl[self._grasp_act] = (al[nb] + 1.0) * 0.5 * self._grasp_max
 
         if self.n_balls == 2:
             self._launch_and_release()
@@ -514,8 +522,8 @@ class EyeCatchEnv(gym.Env):
         self._apply_gaze()
         obs = self._observe(saccading=plant_step.saccading)
         self._last_obs = obs.copy()  # the fallback after divergence; the caller may edit ``obs``
-        self._prev_eye_pos = self._eye_pos.copy()
-        self._prev_gaze = self._eye_rot[:, 0].tolist()
+        self._prev_eye_pos = self._eye_pos_list
+        self._prev_gaze = self._eye_rot_flat[0::3]
 
         # --- outcome and reward --------------------------------------------------------------
         k = self._shaping_ball()
@@ -586,28 +594,37 @@ class EyeCatchEnv(gym.Env):
         self._delay_buffer: deque = deque(maxlen=self.delay_steps + 1)
         self._fixation = 1.0
         self._eye_rot = np.eye(3)
+        self._eye_rot_flat = self._eye_rot.ravel().tolist()
         self._eye_pos = np.zeros(3)
+        self._eye_pos_list = [0.0, 0.0, 0.0]
         self._eye_in_head = (0.0, 0.0)
 
-    def _check_action(self, action) -> np.ndarray:
-        try:
-            a = np.asarray(action)
-        except (TypeError, ValueError) as exc:
-            raise ValueError(f"action must be a numeric array of shape {self.action_space.shape}; got {action!r}") from exc
-        if a.dtype.kind not in "biuf":
-            raise ValueError(
-                f"action must be a real numeric array of shape {self.action_space.shape}; got dtype {a.dtype}"
-            )
-        a = a.astype(np.float64)
-        if a.shape != self.action_space.shape:
-            raise ValueError(
-                f"action must have shape {self.action_space.shape} (blocks {self.action_structure}), got shape {a.shape}"
-            )
-        peak = float(np.abs(a).max())
-        if not math.isfinite(peak):
+    def _check_action(self, action) -> tuple[np.ndarray, list]:
+        """The action as float64, clipped to [-1, 1], and the same values as a list; errors say why not."""
+        if type(action) is np.ndarray and action.shape == self.action_space.shape and action.dtype.kind == "f":
+            a = action.astype(np.float64)  # the common case: a float array of the right shape
+        else:
+            try:
+                a = np.asarray(action)
+            except (TypeError, ValueError) as exc:
+                raise ValueError(f"action must be a numeric array of shape {self.action_space.shape}; got {action!r}") from exc
+            if a.dtype.kind not in "biuf":
+                raise ValueError(
+                    f"action must be a real numeric array of shape {self.action_space.shape}; got dtype {a.dtype}"
+                )
+            a = a.astype(np.float64)
+            if a.shape != self.action_space.shape:
+                raise ValueError(
+                    f"action must have shape {self.action_space.shape} (blocks {self.action_structure}), got shape {a.shape}"
+                )
+        values = a.tolist()
+        if not math.isfinite(sum(values)) and not all(map(math.isfinite, values)):  # NaN or inf somewhere
             bad = np.flatnonzero(~np.isfinite(a)).tolist()
-            raise ValueError(f"action contains NaN or inf at index {bad}: {a.tolist()}; actions must be finite in [-1, 1]")
-        return np.clip(a, -1.0, 1.0) if peak > 1.0 else a
+            raise ValueError(f"action contains NaN or inf at index {bad}: {values}; actions must be finite in [-1, 1]")
+        if min(values) < -1.0 or max(values) > 1.0:
+            a = np.clip(a, -1.0, 1.0)
+            values = a.tolist()
+        return a, values
 
     def _place_wall(self, throw) -> None:
         m = self.model
@@ -636,7 +653,7 @@ class EyeCatchEnv(gym.Env):
         # MuJoCo checks qpos/qvel/qacc every substep (NaN, inf or > 1e10), counts a warning and resets
         # the data (time back to 0) when one is bad: either sign is our divergence signal.
         total = self._warning_stats[0].number + self._warning_stats[1].number + self._warning_stats[2].number
-        return caught, total != self._warning_total or abs(d.time - t_expected) > 0.5 * m.opt.timestep
+        return caught, total != self._warning_total or abs(d.time - t_expected) > self._half_timestep
 
     def _catch_possible(self) -> bool:
         """Whether a catch could happen during the coming control step (else skip substep checks)."""
@@ -646,6 +663,8 @@ class EyeCatchEnv(gym.Env):
         closing = self.grasp_closed_fraction * self._grasp_max
         if d.qpos[self._grasp_qpos] < closing and d.ctrl[self._grasp_act] < closing:
             return False
+        if self.n_balls == 1:
+            return self._status[0] == "flying" and self._ball_near_hand(0)
         return any(self._ball_near_hand(k) for k in range(self.n_balls) if self._status[k] == "flying")
 
     def _ball_near_hand(self, k: int = 0) -> bool:
@@ -658,6 +677,8 @@ class EyeCatchEnv(gym.Env):
 
     def _catch_any(self) -> bool:
         """Catch test of every ball in flight (current kinematics); True if one was caught."""
+        if self.n_balls == 1:
+            return self._status[0] == "flying" and self._catch_now(0)
         return any(self._catch_now(k) for k in range(self.n_balls) if self._status[k] == "flying")
 
     def _catch_now(self, k: int = 0) -> bool:
@@ -735,29 +756,44 @@ class EyeCatchEnv(gym.Env):
         return next((k for k in range(self.n_balls) if self._status[k] == "flying"), 0)
 
     def _is_missed(self, ball: np.ndarray) -> bool:
-        x = ball[0] - SEAT_ORIGIN[0]
-        return bool(x < MISS_BEHIND_X or ball[2] < MISS_FLOOR_Z or abs(ball[1]) > 5.0 or x > 10.0 or ball[2] > 15.0)
+        bx, by, bz = ball.tolist()
+        x = bx - _SEAT_X
+        return x < MISS_BEHIND_X or bz < MISS_FLOOR_Z or abs(by) > 5.0 or x > 10.0 or bz > 15.0
 
     def _apply_gaze(self) -> None:
         """Vestibulo-ocular reflex: turn the world gaze into eye-in-head angles for the current head.
 
         Clamps to the eye's range (Eom 4.1); if clamped, the plant's gaze becomes what was reached.
-        Needs current head kinematics. Sets the eye joints and the cached eye frame.
+        Needs current head kinematics. Sets the eye joints and the cached eye frame (``_eye_rot`` as
+        an array, ``_eye_rot_flat`` as the same 9 numbers, row-major, in a list; scalar maths: this
+        runs every step, and numpy's per-call cost dominates 3x3 products).
         """
         d = self.data
-        head_rot = d.xmat[self._head_body].reshape(3, 3)
-        gx, gy, gz = (self.plant.gaze @ head_rot).tolist()  # gaze in head coordinates
+        h0, h1, h2, h3, h4, h5, h6, h7, h8 = d.xmat[self._head_body].tolist()  # head rotation, row-major
+        wx, wy, wz = self.plant.gaze.tolist()
+        gx, gy, gz = h0 * wx + h3 * wy + h6 * wz, h1 * wx + h4 * wy + h7 * wz, h2 * wx + h5 * wy + h8 * wz  # in head
         az = math.atan2(gy, gx)
         el = math.atan2(gz, math.hypot(gx, gy))
         az_c = min(max(az, self._az_range[0]), self._az_range[1])
         el_c = min(max(el, self._el_range[0]), self._el_range[1])
         ca, sa, ce, se = math.cos(az_c), math.sin(az_c), math.cos(el_c), math.sin(el_c)
-        # Eye in head: Rz(azimuth) Ry(-elevation) (Donders/Fick order of the eye joints).
-        eye_in_head = np.array([[ca * ce, -sa, -ca * se], [sa * ce, ca, -sa * se], [se, 0.0, ce]])
-        self._eye_rot = head_rot @ eye_in_head
+        # Eye in head: Rz(azimuth) Ry(-elevation) (Donders/Fick order of the eye joints):
+        # [[ca ce, -sa, -ca se], [sa ce, ca, -sa se], [se, 0, ce]]; the eye frame is head_rot @ that.
+        e00, e01, e02, e10, e11, e12, e20, e22 = ca * ce, -sa, -ca * se, sa * ce, ca, -sa * se, se, ce
+        flat = [
+            h0 * e00 + h1 * e10 + h2 * e20, h0 * e01 + h1 * e11, h0 * e02 + h1 * e12 + h2 * e22,
+            h3 * e00 + h4 * e10 + h5 * e20, h3 * e01 + h4 * e11, h3 * e02 + h4 * e12 + h5 * e22,
+            h6 * e00 + h7 * e10 + h8 * e20, h6 * e01 + h7 * e11, h6 * e02 + h7 * e12 + h8 * e22,
+        ]
+        self._eye_rot_flat = flat
+        self._eye_rot = np.array(flat).reshape(3, 3)
         if az_c != az or el_c != el:
-            self.plant.constrain(self._eye_rot[:, 0].copy())
-        self._eye_pos = d.xpos[self._head_body] + head_rot @ self._eye_offset
+            self.plant.constrain(np.array(flat[0::3]))
+        ox, oy, oz = self._eye_offset_list
+        px, py, pz = d.xpos[self._head_body].tolist()
+        eye = [px + h0 * ox + h1 * oy + h2 * oz, py + h3 * ox + h4 * oy + h5 * oz, pz + h6 * ox + h7 * oy + h8 * oz]
+        self._eye_pos_list = eye
+        self._eye_pos = np.array(eye)
         self._eye_in_head = (az_c, el_c)
         qpos = d.qpos
         qpos[self._eye_qpos_az] = az_c
@@ -786,20 +822,22 @@ class EyeCatchEnv(gym.Env):
             return [0.0, 0.0, 0.0], [0.0, 0.0, 0.0], False
         d = self.data
         bq, bd = self._balls[k][0], self._balls[k][1]
-        ball = d.qpos[bq : bq + 3]
-        ball_vel = d.qvel[bd : bd + 3]
-        rot = self._eye_rot
-        rel = ball - self._eye_pos
-        pos_eye = (rel @ rot).tolist()  # R^T (p - r): Eyecatch Eq. 6-7
-        vel_eye = (ball_vel @ rot).tolist()
+        r0, r1, r2, r3, r4, r5, r6, r7, r8 = self._eye_rot_flat
+        ex, ey, ez = self._eye_pos_list
+        bx, by, bz = d.qpos[bq : bq + 3].tolist()
+        vx, vy, vz = d.qvel[bd : bd + 3].tolist()
+        rx, ry, rz = bx - ex, by - ey, bz - ez
+        # R^T (p - r) and R^T v: Eyecatch Eq. 6-7
+        pos_eye = [r0 * rx + r3 * ry + r6 * rz, r1 * rx + r4 * ry + r7 * rz, r2 * rx + r5 * ry + r8 * rz]
+        vel_eye = [r0 * vx + r3 * vy + r6 * vz, r1 * vx + r4 * vy + r7 * vz, r2 * vx + r5 * vy + r8 * vz]
         # Retinal slip: line-of-sight angular velocity minus the gaze's own angular velocity over the
         # step (pursuit, or the head carrying a clamped eye), perpendicular to the line of sight.
-        rx, ry, rz = rel.tolist()
-        ux, uy, uz = (ball_vel - (self._eye_pos - self._prev_eye_pos) / self.dt).tolist()
-        ax, ay, az = self._prev_gaze
-        bx, by, bz = rot[:, 0].tolist()
         inv_dt = 1.0 / self.dt
-        wx, wy, wz = (ay * bz - az * by) * inv_dt, (az * bx - ax * bz) * inv_dt, (ax * by - ay * bx) * inv_dt
+        px, py, pz = self._prev_eye_pos
+        dt = self.dt
+        ux, uy, uz = vx - (ex - px) / dt, vy - (ey - py) / dt, vz - (ez - pz) / dt
+        ax, ay, az = self._prev_gaze
+        wx, wy, wz = (ay * r6 - az * r3) * inv_dt, (az * r0 - ax * r6) * inv_dt, (ax * r3 - ay * r0) * inv_dt
         dist2 = rx * rx + ry * ry + rz * rz
         sx = (ry * uz - rz * uy) / dist2 - wx
         sy = (rz * ux - rx * uz) / dist2 - wy
@@ -826,7 +864,10 @@ class EyeCatchEnv(gym.Env):
             self._visible2 = visible2
         pos, vel, visible = sample
         self._visible = visible
-        hand = d.site_xpos[self._catch_site]
+        hx, hy, hz = d.site_xpos[self._catch_site].tolist()
+        px, py, pz = self._hand_prev
+        dt = self.dt
+        ex, ey, ez = self._eye_pos_list
         plant = self.plant
         qpos, qvel = d.qpos, d.qvel
         values = [
@@ -834,8 +875,8 @@ class EyeCatchEnv(gym.Env):
             *vel,
             1.0 if visible else 0.0,
             self.visual_delay_s,
-            *(self._eye_pos - SEAT_ORIGIN).tolist(),
-            *self._eye_rot.ravel().tolist(),
+            ex - _SEAT_X, ey - _SEAT_Y, ez - _SEAT_Z,
+            *self._eye_rot_flat,
             *self._eye_in_head,
             self._fixation,
             1.0 if plant.saccade is not None else 0.0,
@@ -844,8 +885,8 @@ class EyeCatchEnv(gym.Env):
             *qvel[self._neck_dof].tolist(),
             *qpos[self._body_qpos].tolist(),
             *qvel[self._body_dof].tolist(),
-            *(hand - SEAT_ORIGIN).tolist(),
-            *((hand - self._hand_prev) / self.dt).tolist(),
+            hx - _SEAT_X, hy - _SEAT_Y, hz - _SEAT_Z,
+            (hx - px) / dt, (hy - py) / dt, (hz - pz) / dt,
             qpos[self._grasp_qpos] / self._grasp_max,
             d.time,
         ]
@@ -853,7 +894,7 @@ class EyeCatchEnv(gym.Env):
             values += [*pos2, *vel2, 1.0 if visible2 else 0.0,
                        *(0.0 if status == "waiting" or status == "flying" else 1.0 for status in self._status),
                        0.0 if self._holding is None else 1.0]
-        self._hand_prev = hand.copy()
+        self._hand_prev = (hx, hy, hz)
         return np.array(values, dtype=np.float32)
 
     def _format(self, obs: np.ndarray):

@@ -137,6 +137,19 @@ class Saccade:
     end: np.ndarray  # unit gaze direction at landing
     amplitude: float  # rad
     axis: np.ndarray  # unit rotation axis (world) from start to end
+    tangent: np.ndarray | None = None  # unit vector across ``start`` toward ``end`` (the great circle)
+
+    def __post_init__(self) -> None:
+        if self.tangent is None:
+            self.tangent = _tangent(self.start, self.end, self.amplitude)
+        self._arc = (self.start.tolist(), self.tangent.tolist())
+
+    def direction(self, fraction: float) -> tuple[float, float, float]:
+        """Gaze direction at ``fraction`` (0..1) of the path (as ``_slerp``, with the tangent kept)."""
+        t = fraction * self.amplitude
+        c, s = math.cos(t), math.sin(t)
+        (ax, ay, az), (wx, wy, wz) = self._arc
+        return c * ax + s * wx, c * ay + s * wy, c * az + s * wz
 
 
 @dataclass
@@ -189,6 +202,7 @@ class OculomotorPlant:
         p = self.params
         t0 = self.time
         started = False
+        amplitude = None  # of the requested change; computed once when no saccade is in flight
         if self.saccade is None:
             amplitude = angle_between(self.gaze, target)
             if amplitude > p.saccade_threshold_deg * DEG and self.ready_for_saccade:
@@ -196,8 +210,10 @@ class OculomotorPlant:
                 if p.saccade_endpoint_noise > 0.0 and rng is not None:
                     end = _perturb(end, rng.standard_normal(2) * p.saccade_endpoint_noise * amplitude)
                     amplitude = angle_between(self.gaze, end)
-                axis = cross(self.gaze, _tangent(self.gaze, end, amplitude))
-                self.saccade = Saccade(t0, p.saccade_duration(amplitude), self.gaze.copy(), end, amplitude, axis)
+                tangent = _tangent(self.gaze, end, amplitude)
+                axis = cross(self.gaze, tangent)
+                self.saccade = Saccade(t0, p.saccade_duration(amplitude), self.gaze.copy(), end, amplitude, axis,
+                                       tangent)
                 self.saccades.append(self.saccade)
                 self.last_onset = t0
                 started = True
@@ -212,27 +228,31 @@ class OculomotorPlant:
                 u = np.clip((sub_t - sac.onset) / sac.duration, 0.0, 1.0)
                 points = _slerp(sac.start, sac.end, sac.amplitude, minimum_jerk(u))
             u_end = min(max((t_end - sac.onset) / sac.duration, 0.0), 1.0)
-            self.gaze = _slerp(sac.start, sac.end, sac.amplitude, minimum_jerk(u_end))
+            gx, gy, gz = sac.direction(minimum_jerk(u_end))
             speed = sac.amplitude * 30.0 * u_end**2 * (1.0 - u_end) ** 2 / sac.duration  # Eq. 15
             self.angular_velocity = sac.axis * speed
             if u_end >= 1.0:
                 self.saccade = None
-        else:
-            amplitude = angle_between(self.gaze, target)
+        else:  # pursuit (no saccade started, so the gaze and the amplitude are unchanged)
             travel = min(amplitude, p.pursuit_max_deg_s * DEG * dt)
             start = self.gaze
             if amplitude > 1e-12:
                 if self.record:
                     fractions = np.arange(1, n_substeps + 1) / n_substeps * (travel / amplitude)
                     points = _slerp(start, target, amplitude, fractions)
-                self.gaze = _slerp(start, target, amplitude, travel / amplitude)
-                self.angular_velocity = cross(start, _tangent(start, target, amplitude)) * (travel / dt)
+                w = _tangent(start, target, amplitude)
+                t = travel / amplitude * amplitude  # as _slerp(start, target, amplitude, travel / amplitude)
+                c, s = math.cos(t), math.sin(t)
+                (ax, ay, az), (wx, wy, wz) = start.tolist(), w.tolist()
+                gx, gy, gz = c * ax + s * wx, c * ay + s * wy, c * az + s * wz
+                self.angular_velocity = cross(start, w) * (travel / dt)
             else:
                 if self.record:
                     points = np.broadcast_to(start, (n_substeps, 3)).copy()
                 self.angular_velocity = np.zeros(3)
-        gx, gy, gz = self.gaze.tolist()
-        self.gaze = self.gaze / math.sqrt(gx * gx + gy * gy + gz * gz)
+                gx, gy, gz = start.tolist()
+        n = math.sqrt(gx * gx + gy * gy + gz * gz)
+        self.gaze = np.array([gx / n, gy / n, gz / n])
         self.time = t_end
         if self.record:
             self.trace_t.extend(sub_t.tolist())
