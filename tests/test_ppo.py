@@ -11,7 +11,10 @@ from visuomotor_gym.bench.evaluate import evaluate
 
 
 @pytest.mark.parametrize(
-    "extra", [["--belief", "no"], ["--belief", "yes"], ["--recurrent", "--belief", "no"]], ids=["ppo", "belief", "recurrent"]
+    "extra",
+    [["--belief", "no", "--hand-action", "absolute"], ["--belief", "yes", "--hand-action", "absolute"],
+     ["--belief", "yes"], ["--recurrent", "--belief", "no", "--hand-action", "absolute"]],
+    ids=["ppo", "belief", "intercept", "recurrent"],
 )
 def test_tiny_training_saves_loads_and_evaluates(tmp_path, extra):
     run = train.main(["--env", "EyeCatch-v0", "--timesteps", "512", "--out", str(tmp_path), "--run-name", "t",
@@ -20,7 +23,9 @@ def test_tiny_training_saves_loads_and_evaluates(tmp_path, extra):
     for name in ("model.zip", "ppo_meta.json", "config.yml", "args.json", "command.txt", "progress.csv"):
         assert (run / name).is_file(), name
     meta = json.loads((run / "ppo_meta.json").read_text())
-    assert meta["timesteps"] >= 512 and len(meta["obs_mean"]) == (67 if "yes" in extra else 57)
+    n_obs = 57 + (10 if "yes" in extra else 0) + (4 if "absolute" not in extra else 0)
+    assert meta["timesteps"] >= 512 and len(meta["obs_mean"]) == n_obs
+    assert meta["hand_action"] == ("absolute" if "absolute" in extra else "intercept")
     assert "--timesteps 512" in (run / "command.txt").read_text()
     result = evaluate(f"ppo:{run}", "EyeCatch-v0", 2, 0, workers=1)
     assert result.summary["episodes"] == 2

@@ -50,7 +50,8 @@ class PPOAgent:
         if self.meta.get("belief"):
             from visuomotor_gym.baselines.ppo.belief import BeliefFeatures
 
-            self.features = BeliefFeatures(self.env_id)
+            self.features = BeliefFeatures(self.env_id, self.meta.get("hand_action", "absolute"),
+                                           float(self.meta.get("intercept_residual_m", 0.15)))
         self.mean = np.asarray(self.meta["obs_mean"]) if "obs_mean" in self.meta else None
         self.std = np.sqrt(np.asarray(self.meta["obs_var"]) + self.meta.get("epsilon", 1e-8)) if self.mean is not None else None
         self.clip = float(self.meta.get("clip_obs", 10.0))
@@ -76,4 +77,7 @@ class PPOAgent:
             )
         else:
             action, _ = self.model.predict(obs, deterministic=True)
-        return np.asarray(action, dtype=np.float32), state
+        action = np.clip(np.asarray(action, dtype=np.float32), -1.0, 1.0)  # as SB3 does in training
+        if self.features is not None:
+            action = self.features.env_action(action)
+        return action, state

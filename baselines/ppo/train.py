@@ -51,6 +51,9 @@ class Args:
     """RecurrentPPO (LSTM policy, sb3-contrib) instead of PPO"""
     belief: str = ""
     """'yes'/'no' overrides the config's belief features"""
+    hand_action: str = ""
+    """'absolute' (hand target anywhere in the workspace) or 'intercept' (residual around the
+    belief's interception point); overrides the config"""
     hyperparams: str = ""
     """YAML file of hyperparameters (default: the packaged hyperparams.yml)"""
     set: list = field(default_factory=list)
@@ -120,6 +123,15 @@ def load_config(args: Args) -> dict:
         config["algo"] = "RecurrentPPO"
     if args.belief:
         config["belief"] = args.belief.lower() in ("yes", "true", "1")
+    if args.hand_action:
+        config["hand_action"] = args.hand_action
+    config.setdefault("hand_action", "absolute")
+    config.setdefault("intercept_residual_m", 0.15)
+    if config["hand_action"] not in ("absolute", "intercept"):
+        raise SystemExit(f"hand_action must be 'absolute' or 'intercept', got {config['hand_action']!r}")
+    if config["hand_action"] == "intercept" and not config["belief"]:
+        raise SystemExit("hand_action=intercept needs the belief features (belief: true): the residual is "
+                         "relative to the belief's interception point")
     return config
 
 
@@ -142,8 +154,10 @@ class InterceptShaping:
         return _Wrapper(env)
 
 
-def make_env_fn(env_id: str, env_kwargs: dict, belief: bool, seed: int, intercept_shaping: float = 0.0):
-    """A thunk for SB3's vec envs: the env, optional shaping and belief features, a Monitor."""
+def make_env_fn(env_id: str, env_kwargs: dict, belief: bool, seed: int, intercept_shaping: float = 0.0,
+                hand_action: str = "absolute", residual_m: float = 0.15):
+    """A thunk for SB3's vec envs: the env, optional shaping and belief features (and the
+    belief-relative hand action), a Monitor."""
 
     def thunk():
         import gymnasium as gym
@@ -157,7 +171,7 @@ def make_env_fn(env_id: str, env_kwargs: dict, belief: bool, seed: int, intercep
         if belief:
             from visuomotor_gym.baselines.ppo.belief import BeliefObservation
 
-            env = BeliefObservation(env, env_id)
+            env = BeliefObservation(env, env_id, hand_action, residual_m)
         env = Monitor(env, info_keywords=("is_success",))
         env.reset(seed=seed)
         return env
@@ -188,9 +202,10 @@ def main(argv=None) -> Path:
 
     # 1. Environments: shaped reward for training, the registered env for evaluation.
     n_envs = int(config["n_envs"])
+    hand = {"hand_action": config["hand_action"], "residual_m": float(config["intercept_residual_m"])}
     train_env = DummyVecEnv([make_env_fn(args.env, config["env_kwargs"], config["belief"], args.seed + i,
-                                         float(config.get("intercept_shaping", 0.0))) for i in range(n_envs)])
-    eval_env = DummyVecEnv([make_env_fn(args.env, {}, config["belief"], 10_000 + args.seed)])
+                                         float(config.get("intercept_shaping", 0.0)), **hand) for i in range(n_envs)])
+    eval_env = DummyVecEnv([make_env_fn(args.env, {}, config["belief"], 10_000 + args.seed, **hand)])
     if config["normalize_obs"] or config["normalize_reward"]:
         train_env = VecNormalize(train_env, norm_obs=config["normalize_obs"], norm_reward=config["normalize_reward"],
                                  gamma=config["gamma"])
@@ -252,6 +267,8 @@ def main(argv=None) -> Path:
         "algo": config["algo"],
         "env_id": args.env,
         "belief": bool(config["belief"]),
+        "hand_action": config["hand_action"],
+        "intercept_residual_m": float(config["intercept_residual_m"]),
         "timesteps": int(model.num_timesteps),
         "train_wall_s": round(wall, 1),
         "seed": args.seed,

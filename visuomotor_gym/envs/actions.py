@@ -15,6 +15,13 @@ _FIX = OculomotorParams().fixation_range_m
 _LOG_FIX = (math.log(_FIX[0]), math.log(_FIX[1]))
 
 
+def hand_target_action(hand_target_world) -> np.ndarray:
+    """The hand-target block (3 values in [-1, 1]) of a ``control="hand"`` action for a world point
+    (clipped to the hand workspace)."""
+    lo, hi = HAND_WORKSPACE[:, 0], HAND_WORKSPACE[:, 1]
+    return np.clip(2.0 * (np.asarray(hand_target_world) - SEAT_ORIGIN - lo) / (hi - lo) - 1.0, -1.0, 1.0)
+
+
 def hand_action(
     hand_target_world,
     grasp_closed: bool,
@@ -26,8 +33,7 @@ def hand_action(
     """The 9-dim action: hand target (world point), grasp, gaze change (retinal azimuth, elevation,
     rad), fixation distance (m; None keeps the action's neutral value) and neck (yaw, pitch, rad)."""
     a = np.zeros(9, dtype=np.float32)
-    lo, hi = HAND_WORKSPACE[:, 0], HAND_WORKSPACE[:, 1]
-    a[:3] = np.clip(2.0 * (np.asarray(hand_target_world) - SEAT_ORIGIN - lo) / (hi - lo) - 1.0, -1.0, 1.0)
+    a[:3] = hand_target_action(hand_target_world)
     a[3] = 1.0 if grasp_closed else -1.0
     a[4] = np.clip(gaze[0] / gaze_range_rad, -1.0, 1.0)
     a[5] = np.clip(gaze[1] / gaze_range_rad, -1.0, 1.0)
