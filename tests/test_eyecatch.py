@@ -150,3 +150,29 @@ def test_first_saccade_waits_for_a_reliable_estimate():
     default = make_agent("eyecatch", "EyeCatch-v0", 9)
     t = run_episode(env, default, 0, "EyeCatch-v0", "eyecatch")
     assert default.first_saccade_released and t.saccade_onset.any()
+
+
+def _angles_deg(a, b):
+    return np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", a, b), -1.0, 1.0)))
+
+
+def test_head_pursues_with_the_eye():
+    """Eyecatch 4.2: the head adds the eye's pursuit velocity. With the first saccade never released
+    (so no visuomotor update, hence no head saccade), only head pursuit moves the head: it carries the
+    eye along, which stays near the head's axis (not at its +27.7 deg elevation limit) and on the ball."""
+    env = gym.make("EyeCatch-v0")
+    spec = "eyecatch:first_saccade_retinal_std_deg=1e-6"
+    for seed in (0, 1):
+        still = run_episode(env, make_agent(spec + ",head_pursuit_gain=0", "EyeCatch-v0", 9), seed, "EyeCatch-v0", "x")
+        pursuing = run_episode(env, make_agent(spec, "EyeCatch-v0", 9), seed, "EyeCatch-v0", "x")
+        for t in (still, pursuing):
+            assert not t.saccade_onset.any()
+        n = min(len(still.t), len(pursuing.t)) * 2 // 3  # the flight before the hand region
+        head_turn = lambda t: _angles_deg(np.repeat(t.head_dir[:1], n, axis=0), t.head_dir[:n]).max()
+        eye_in_head = lambda t: _angles_deg(t.gaze_dir[:n], t.head_dir[:n]).max()
+        assert head_turn(still) < 0.5
+        assert head_turn(pursuing) > 15.0
+        assert eye_in_head(pursuing) < 0.6 * eye_in_head(still)
+        rel = pursuing.ball_pos[:n] - pursuing.eye_pos[:n]
+        rel /= np.linalg.norm(rel, axis=1, keepdims=True)
+        assert np.median(_angles_deg(pursuing.gaze_dir[:n], rel)) < 1.0

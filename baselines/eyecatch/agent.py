@@ -10,7 +10,9 @@ The agent sees observations only. Each 20 ms control step:
    a threshold; then large errors produce catch-up saccades (the plant allows one per 200 ms) and
    small ones pursuit toward the ball's predicted next position, ``v = (p_target - p) / dt``.
 3. **Head** (section 4.2): at every visuomotor update the head turns by the part of the eye-in-head
-   angle beyond a 20 deg dead zone (Eq. 17-18), as a ~400 ms minimum-jerk submovement.
+   angle beyond a 20 deg dead zone (Eq. 17-18), as a ~400 ms minimum-jerk submovement; between
+   saccades "the pursuit velocity of the head, which is identical to that of the eye, is then
+   added", so pursuit (also before the first saccade) does not drive the eye into its range limits.
 4. **Hand** (section 4.3): a superposition of ~400 ms minimum-jerk submovements (Eq. 15-16), one per
    visuomotor update (every ~200 ms, re-synchronised to each saccade onset), each aimed from the
    previous destination (not the current position) to the new one, peak speed <= 2 m/s:
@@ -37,7 +39,7 @@ import numpy as np
 from visuomotor_gym.envs.actions import NECK_RANGE_DEG, hand_action
 from visuomotor_gym.envs.catch import SEAT_ORIGIN
 from visuomotor_gym.envs.observation import ObservationLayout
-from visuomotor_gym.oculomotor.plant import minimum_jerk
+from visuomotor_gym.oculomotor.plant import angles_from_direction, direction_from_angles, minimum_jerk
 from visuomotor_gym.registration import env_vision
 from visuomotor_gym.vision import foveation
 from visuomotor_gym.vision.foveation import VisionParams
@@ -70,6 +72,11 @@ class EyecatchParams:
     # Head (Eyecatch 4.2, Eq. 17-18).
     head_dead_zone_deg: float = 20.0  # 0.349 rad in Eq. 17
     head_submovement_s: float = 0.4  # peak velocity 4-8/s x amplitude -> ~400 ms
+    head_pursuit_gain: float = 1.0  # Eyecatch 4.2: "the pursuit velocity of the head, which is
+    # identical to that of the eye, is then added" (1 = as the paper; 0 = saccadic head only). Without
+    # it the rising ball drives the eye into its +27.7 deg elevation limit before any head saccade.
+    pursuit_max_deg_s: float = 100.0  # the plant's pursuit speed cap (OculomotorParams)
+    saccade_refractory_s: float = 0.2  # the plant's minimum time between saccade onsets
     # Hand (Eyecatch 4.3, Eq. 15-16, 19).
     hand_submovement_s: float = 0.4  # submovement duration (Novak et al. 2002)
     hand_max_speed_m_s: float = 2.0  # peak hand speed observed in the data
@@ -78,7 +85,11 @@ class EyecatchParams:
     proactive_logdet: float = -55.0  # log det(P) (SI units) below which the proactive phase starts;
     # Eyecatch Fig. 9 picks the criterion so the decision falls near the apex: over 30 EyeCatch-v0
     # throws log det(P) at the apex has median -57 and 90th percentile -55.
-    proactive_deadline_s: float = 0.45  # ours: commit anyway when the ball is this close in time
+    proactive_deadline_s: float = 0.6  # ours: commit anyway when the ball is this close in time.
+    # The check runs only at visuomotor updates (200 ms apart), so commitment comes 0-200 ms after the
+    # deadline: 0.6 s = hand_submovement_s + update_period_s leaves every throw at least one full
+    # 400 ms hand submovement (with 0.45 s, poor-vision throws committed 0.25-0.45 s before arrival
+    # and the 2 m/s hand could not get there in time although the estimate was good).
     prediction_window_s: float = 0.4  # prediction limit of the internal model
     prediction_horizon_s: float = 1.5  # how far the proactive phase looks for the sphere crossing
     max_reach_m: float = 0.6  # destinations are pulled within this distance of the shoulder
@@ -224,6 +235,8 @@ class EyecatchAgent:
         # --- visuomotor update: every ~200 ms, re-synchronised to saccade onsets --------------
         in_saccade = obs[_S["saccade"]][0] > 0.5
         since_onset = obs[_S["saccade"]][1]
+        if p.head_pursuit_gain > 0.0 and not in_saccade:
+            self._head_pursuit(rot, gaze, since_onset)
         if in_saccade and since_onset < self.dt * 0.5 + 1e-9:
             self.next_update = t  # a saccade just started: update with it
         if math.isinf(self.next_update) and self.first_saccade_released:
@@ -234,6 +247,35 @@ class EyecatchAgent:
 
         return self._action(self.hand.position(t + p.hand_lead_s), obs, gaze=gaze,
                             head=self.head.position(t + self.dt), fixation=float(np.linalg.norm(ball_now - eye)))
+
+    def _head_pursuit(self, rot: np.ndarray, gaze, since_onset: float) -> None:
+        """Eyecatch 4.2: the head also pursues, with the eye's pursuit velocity.
+
+        When this step's gaze request is a pursuit (no saccade can start: below the threshold, or
+        within the refractory period), the eye turns toward it at ``A / dt`` capped at the pursuit
+        speed; the head's whole plan (its submovements' start and destination) is shifted by the same
+        change of gaze azimuth and elevation, so pursuit does not use up the eye's orbital range.
+        """
+        p = self.params
+        mag = math.hypot(*gaze)
+        if mag < 1e-9:
+            return
+        if mag > p.saccade_threshold_deg * DEG and since_onset >= p.saccade_refractory_s - 1e-9:
+            return  # a saccade starts: the head follows it through the dead-zone law at the update
+        step = min(mag, p.pursuit_max_deg_s * DEG * self.dt)
+        az, el = gaze[0] * step / mag, gaze[1] * step / mag
+        g0 = rot[:, 0]
+        g1 = rot @ direction_from_angles(az, el)
+        a0, e0 = angles_from_direction(g0)
+        a1, e1 = angles_from_direction(g1)
+        d_az = (a1 - a0 + math.pi) % (2.0 * math.pi) - math.pi
+        shift = p.head_pursuit_gain * np.array([d_az, e1 - e0])
+        for k in range(2):
+            lo, hi = NECK_RANGE_DEG[k]
+            dest = min(max(self.head.destination[k] + shift[k], lo * DEG), hi * DEG)
+            shift[k] = dest - self.head.destination[k]
+        self.head.start = self.head.start + shift
+        self.head.destination = self.head.destination + shift
 
     def _fuse(self, obs: np.ndarray) -> None:
         rot, eye = self.pose_history[0] if self.delay_steps else self.pose_history[-1]
