@@ -43,7 +43,9 @@ def git_state(package_dir: Path | None = None) -> tuple[str, bool | None]:
 
     The package counts as "in git" only when its ``__init__.py`` is tracked: a wheel installed into a
     virtual environment that happens to sit inside some repository is not that repository's code.
-    ``dirty`` is True when tracked files differ from HEAD or untracked, non-ignored files exist.
+    ``dirty`` is True when tracked files differ from HEAD or untracked, non-ignored files exist,
+    outside ``leaderboard/`` (leaderboard data is not code: a submission writes its files there while
+    it evaluates the next env id).
     """
     if package_dir is None:
         package_dir = Path(__file__).resolve().parents[1]
@@ -52,7 +54,7 @@ def git_state(package_dir: Path | None = None) -> tuple[str, bool | None]:
     sha = _git(["rev-parse", "HEAD"], package_dir)
     if not sha:
         return "unknown", None
-    status = _git(["status", "--porcelain"], package_dir)
+    status = _git(["status", "--porcelain", "--", ":(top)", ":(top,exclude)leaderboard"], package_dir)
     return sha, (None if status is None else bool(status))
 
 
