@@ -174,9 +174,12 @@ def perceive(position_eye, velocity_eye, retinal_speed: float, params: VisionPar
     """
     x, y, z = position_eye
     d = math.sqrt(x * x + y * y + z * z)
-    if params.foveated and d > 0.0 and math.acos(max(-1.0, min(1.0, x / d))) > params.field_of_view_deg * DEG:
+    if d <= 0.0:
+        return list(position_eye), list(velocity_eye), True
+    ecc = math.acos(max(-1.0, min(1.0, x / d)))
+    if params.foveated and ecc > params.field_of_view_deg * DEG:
         return [0.0, 0.0, 0.0], [0.0, 0.0, 0.0], False
-    pos, vel = _draw(position_eye, velocity_eye, retinal_speed, params, rng)
+    pos, vel = _draw_at(x, y, z, d, ecc, velocity_eye, retinal_speed, params, rng)
     return pos, vel, True
 
 
@@ -186,7 +189,11 @@ def _draw(position_eye, velocity_eye, retinal_speed, params, rng):
     d = math.sqrt(x * x + y * y + z * z)
     if d <= 0.0:
         return list(position_eye), list(velocity_eye)
-    ecc = math.acos(max(-1.0, min(1.0, x / d)))
+    return _draw_at(x, y, z, d, math.acos(max(-1.0, min(1.0, x / d))), velocity_eye, retinal_speed, params, rng)
+
+
+def _draw_at(x, y, z, d, ecc, velocity_eye, retinal_speed, params, rng):
+    """:func:`_draw` for a point at distance ``d`` > 0 and eccentricity ``ecc`` (rad)."""
     s0, s1, s2, s3, s4, s5 = _sigmas(d, ecc, retinal_speed, params)
     e0, e1, e2, e3, e4, e5 = rng.standard_normal(6).tolist()
     n0, n1, n2, n3, n4, n5 = s0 * e0, s1 * e1, s2 * e2, s3 * e3, s4 * e4, s5 * e5
