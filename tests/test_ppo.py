@@ -1,6 +1,7 @@
 """PPO baseline: a tiny-budget training run, saved, loaded as ``ppo:<path>``, evaluated."""
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -33,6 +34,57 @@ def test_tiny_training_saves_loads_and_evaluates(tmp_path, extra):
     again = evaluate(f"ppo:{run}", "EyeCatch-v0", 2, 0, workers=1)
     for a, b in zip(result.traces, again.traces):
         np.testing.assert_array_equal(a.action[1:], b.action[1:])
+
+
+@pytest.fixture(scope="module")
+def tiny_run(tmp_path_factory):
+    out = tmp_path_factory.mktemp("ppo")
+    return train.main(["--env", "EyeCatch-v0", "--timesteps", "256", "--out", str(out), "--run-name", "t",
+                       "--no-progress-bar", "--set", "n_envs=2", "n_steps=128", "batch_size=128", "eval_freq=100000",
+                       "eval_episodes=1", "checkpoint_freq=100000"])
+
+
+def test_packed_policy_is_one_smaller_file_with_the_same_actions(tiny_run, tmp_path):
+    from visuomotor_gym.baselines.ppo.agent import pack_policy
+
+    data = pack_policy(tiny_run)
+    assert data == pack_policy(tiny_run)  # byte-identical: the leaderboard hashes it
+    assert len(data) < 0.6 * (tiny_run / "model.zip").stat().st_size  # no optimizer moments
+    packed = tmp_path / "policy.zip"  # alone: no ppo_meta.json beside it
+    packed.write_bytes(data)
+    assert pack_policy(packed) == data
+    a = evaluate(f"ppo:{tiny_run}", "EyeCatch-v0", 2, 0, workers=1)
+    b = evaluate(f"ppo:{packed}", "EyeCatch-v0", 2, 0, workers=1)
+    for x, y in zip(a.traces, b.traces):
+        np.testing.assert_array_equal(x.action, y.action)
+    with pytest.raises(ValueError, match="not a packed PPO policy"):
+        from visuomotor_gym.baselines.ppo.agent import PPOAgent
+
+        PPOAgent.from_bytes((tiny_run / "model.zip").read_bytes())
+
+
+def test_ppo_entry_is_submitted_and_rescored_from_its_packed_file(tiny_run, tmp_path, capsys):
+    from visuomotor_gym.cli import main
+
+    root = tmp_path / "lb"
+    (root / "results").mkdir(parents=True)
+    proto = json.loads((Path(__file__).parents[1] / "leaderboard" / "protocol.json").read_text())
+    proto["envs"] = [dict(e, episodes=2) for e in proto["envs"] if e["env_id"] == "EyeCatch-v0"]
+    (root / "protocol.json").write_text(json.dumps(proto, indent=2))
+    assert main(["leaderboard", "submit", "--agent", f"ppo:{tiny_run}", "--name", "ppo-tiny", "--env", "EyeCatch-v0",
+                 "--dir", str(root), "--workers", "1", "--no-progress"]) == 0
+    policy = root / "agents" / "ppo-tiny__EyeCatch-v0.zip"
+    assert policy.is_file()
+    record = json.loads((root / "results" / "ppo-tiny__EyeCatch-v0.entry.json").read_text())
+    assert record["policy"]["format"] == "sb3-ppo-zip"
+    # The training run may be gone where the check runs: the packed file is the policy.
+    moved = tiny_run.parent / "moved"
+    tiny_run.rename(moved)
+    try:
+        capsys.readouterr()
+        assert main(["leaderboard", "check", "--dir", str(root), "--base", "none", "--sample", "all"]) == 0, capsys.readouterr().out
+    finally:
+        moved.rename(tiny_run)
 
 
 def test_run_folders_are_never_overwritten(tmp_path):

@@ -311,7 +311,7 @@ def policy_problems(lb: Leaderboard, entry: Entry, export: bool = True) -> list[
                 f"file changed after submission",
             )
         ]
-    if export and entry.superseded is None:
+    if export and fmt.reexport and entry.superseded is None:
         try:
             fresh = fmt.export(entry.results["agent"], entry.env_id)
         except Exception as exc:  # noqa: BLE001 - any failure to rebuild the spec is a refusal

@@ -8,7 +8,8 @@ re-scores the entry with the policy ``load`` builds from the file.
 
 Formats register with :func:`register_policy_format` (one per agent name): ``eyecatch-params``
 here (every :class:`~visuomotor_gym.baselines.eyecatch.EyecatchParams` field, resolved for the env
-id); trained agents (stable-baselines3 ``.zip`` files) add theirs the same way. Agents without a
+id) and ``sb3-ppo-zip`` (a packed stable-baselines3 PPO/RecurrentPPO ``.zip`` with its
+``ppo_meta.json`` inside, from ``ppo:<run folder or zip>``). Agents without a
 format (``oracle``, ``zero``, ``random``: nothing to configure) have no policy file and are re-scored
 from their spec with :func:`visuomotor_gym.agents.make_agent`.
 """
@@ -30,6 +31,11 @@ class PolicyFormat:
     suffix: str  # file name suffix, e.g. ".json" or ".zip"
     export: Callable[[str, str], bytes]  # (agent spec, env id) -> file bytes
     load: Callable[[bytes, str], Policy]  # (file bytes, env id) -> a fresh policy
+    # True: the file is a pure function of the spec, and ``check`` verifies that the spec still exports
+    # to it (a changed agent is caught). False for trained artifacts: the spec names a training run
+    # that need not exist where the check runs; the hashed file *is* the policy, and re-scoring it
+    # is the check.
+    reexport: bool = True
 
 
 _FORMATS: dict[str, PolicyFormat] = {}
@@ -107,3 +113,27 @@ def _eyecatch_load(data: bytes, env_id: str) -> Policy:
 
 
 register_policy_format(PolicyFormat(EYECATCH_FORMAT, "eyecatch", ".json", _eyecatch_export, _eyecatch_load))
+
+
+# ------------------------------------------------------------------ sb3-ppo-zip
+
+PPO_FORMAT = "sb3-ppo-zip"
+
+
+def _ppo_export(spec: str, env_id: str) -> bytes:
+    from visuomotor_gym.agents import parse_agent_spec
+    from visuomotor_gym.baselines.ppo.agent import pack_policy
+
+    name, overrides = parse_agent_spec(spec)
+    if name != "ppo" or set(overrides) != {"path"}:
+        raise ValueError(f"the {PPO_FORMAT} format serves ppo:<run folder or model zip>, not {spec!r}")
+    return pack_policy(overrides["path"])
+
+
+def _ppo_load(data: bytes, env_id: str) -> Policy:
+    from visuomotor_gym.baselines.ppo.agent import PPOAgent
+
+    return PPOAgent.from_bytes(data, env_id)
+
+
+register_policy_format(PolicyFormat(PPO_FORMAT, "ppo", ".zip", _ppo_export, _ppo_load, reexport=False))
