@@ -67,12 +67,15 @@ def main(argv=None) -> None:
     ax.set_xlabel("time from the bounce to the ball's arrival (s)")
     ax.set_ylabel("catch rate")
     ax.set_ylim(0, 1.1)
-    ax.set_title(f"EyeCatchBounce-v0: Eyecatch recovers when time allows ({args.episodes} throws)")
+    ax.set_title(f"EyeCatchBounce-v0, {args.episodes} throws: recovery needs time")
     fig.savefig(OUT / "eyecatch_bounce_recovery.png", dpi=110)
     for e, r in runs.items():
         print(f"{e}: catch rate {r.summary['catch_rate']:.3f}")
     for c, rate, n in zip(centres, rates, counts):
         print(f"bounce-to-arrival ~{c:.2f} s: {rate:.2f} (n={n})")
+    late = left >= 0.6
+    print(f"bounce-to-arrival >= 0.6 s: {ok[late].mean():.3f} ({ok[late].sum()}/{late.sum()})")
+    print(f"examples: PoorVision caught seed {caught.seed}, missed seed {missed.seed}; Bounce seed {recovered.seed}")
 
 
 if __name__ == "__main__":
