@@ -31,8 +31,8 @@ from visuomotor_gym.metrics.stats import wilson_interval
 
 REPO = Path(__file__).resolve().parents[1]
 COMMITTED = REPO / "leaderboard"
-KEY = "eyecatch__EyeCatch-v0"
-POOR = "eyecatch__EyeCatchPoorVision-v0"
+KEY = "eyecatch-v2__EyeCatch-v0"  # current (not superseded) entries
+POOR = "eyecatch-v2__EyeCatchPoorVision-v0"
 
 
 # ---------------------------------------------------------------- helpers
@@ -163,14 +163,16 @@ def test_tampered_catch_rate_is_refused(lb):
 def test_consistently_tampered_counts_are_refused_by_the_episode_records(lb):
     """caught, rate and interval forged together, new hash recorded: the per-episode records disagree."""
     obj = read(results_path(lb, POOR))
-    obj["caught"] = 150
-    obj["catch_rate"] = 0.75
-    obj["catch_rate_ci95"] = list(wilson_interval(150, 200))
+    true_caught = obj["caught"]
+    forged = true_caught + 16
+    obj["caught"] = forged
+    obj["catch_rate"] = forged / 200
+    obj["catch_rate_ci95"] = list(wilson_interval(forged, 200))
     write_results(results_path(lb, POOR), obj)
     rerecord_results_hash(lb, POOR)
     report = check(lb)
     assert not messages(report, "results")  # the forged file passes the schema and its semantics
-    assert_refused(report, "consistency", "caught = 150 in the results", "per-episode records give 109")
+    assert_refused(report, "consistency", f"caught = {forged} in the results", f"per-episode records give {true_caught}")
 
 
 def test_missing_field_is_refused(lb):
@@ -308,10 +310,12 @@ def test_rescore_sample_is_stratified_and_deterministic():
 
 
 def test_superseded_entries_are_kept_but_not_rescored(lb):
+    already = json.loads((lb / "superseded.json").read_text())["superseded"] if (lb / "superseded.json").exists() else {}
     (lb / "superseded.json").write_text(
         json.dumps(
             {
                 "superseded": {
+                    **already,
                     KEY: {"reason": "test: the agent changed"},
                     "nobody__EyeCatch-v0": {"reason": "x"},
                 }
@@ -320,7 +324,7 @@ def test_superseded_entries_are_kept_but_not_rescored(lb):
     )
     report = check(lb, rescore=True, seeds=[0], pages=False)
     assert any(KEY in n and "superseded" in n for n in report.notes)
-    assert report.rescored_entries == len(load_leaderboard(lb).entries) - 1
+    assert report.rescored_entries == len(load_leaderboard(lb).entries) - len(already) - 1
     assert_refused(report, "layout", "lists 'nobody__EyeCatch-v0', which is no entry")
     html = render_pages(load_leaderboard(lb))["index.html"]
     assert 'id="superseded-table"' in html and "test: the agent changed" in html
@@ -454,7 +458,7 @@ def test_submit_writes_entries_that_pass_and_refuses_to_overwrite(tmp_path, caps
     oracle = next(e for e in board.entries if e.name == "oracle")
     assert oracle.policy is None  # nothing to configure: re-scored from its spec
     assert (root / "agents" / "eyecatch__EyeCatch-v0.json").is_file()
-    assert read(results_path(root))["provenance"]["command"].startswith(
+    assert read(results_path(root, "eyecatch__EyeCatch-v0"))["provenance"]["command"].startswith(
         "vmgym leaderboard submit --agent eyecatch"
     )
     report = check_leaderboard(root, base=None, sample="all")

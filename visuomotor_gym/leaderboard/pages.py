@@ -494,6 +494,7 @@ th, td { border-bottom: 1px solid #ddd; padding: 5px 7px; text-align: left; whit
 th { background: #f3f5f8; font-weight: 600; }
 td.num { text-align: right; font-variant-numeric: tabular-nums; }
 tr.superseded td { color: #888; }
+td.why { white-space: normal; min-width: 16em; }
 code { font-size: 12px; }
 .plot { display: block; margin: 8px 0 18px; max-width: 100%; height: auto; }
 .plot text { font-family: "DejaVu Sans", Arial, sans-serif; }
@@ -565,20 +566,6 @@ def render_html(lb: Leaderboard) -> str:
         body,
         "</tbody></table>",
     ]
-    if old:
-        parts += [
-            "<h2>Superseded entries</h2>",
-            '<table id="superseded-table"><thead><tr><th>agent</th><th>env id</th>'
-            "<th>catch rate [95 % CI]</th>"
-            "<th>commit</th><th>date</th><th>why</th></tr></thead><tbody>",
-        ]
-        parts += [
-            f'<tr class="superseded" data-entry="{E(r.key)}"><td><code>{E(r.name)}</code></td><td><code>'
-            f'{E(r.env_id)}</code></td><td class="num">{E(fmt_rate(r))}</td><td><code>{E(r.commit)}</code>'
-            f"</td><td>{E(r.date)}</td><td>{E(r.entry.superseded['reason'])}</td></tr>"
-            for r in old
-        ]
-        parts.append("</tbody></table>")
     parts += [
         "<h2>Catch rate along the observability ladder</h2>",
         svg_catch_rate(rows, ladder),
@@ -592,6 +579,23 @@ def render_html(lb: Leaderboard) -> str:
         "<p>Compute time of the policy per control step; <em>real time</em> means p95 below the control "
         "period.</p>",
         svg_latency(rows),
+    ]
+    # Retired entries after the current board and its plots: kept for the record, not ranked.
+    if old:
+        parts += [
+            "<h2>Superseded entries</h2>",
+            '<table id="superseded-table"><thead><tr><th>agent</th><th>env id</th>'
+            "<th>catch rate [95 % CI]</th>"
+            "<th>commit</th><th>date</th><th>why</th></tr></thead><tbody>",
+        ]
+        parts += [
+            f'<tr class="superseded" data-entry="{E(r.key)}"><td><code>{E(r.name)}</code></td><td><code>'
+            f'{E(r.env_id)}</code></td><td class="num">{E(fmt_rate(r))}</td><td><code>{E(r.commit)}</code>'
+            f'</td><td>{E(r.date)}</td><td class="why">{E(r.entry.superseded["reason"])}</td></tr>'
+            for r in old
+        ]
+        parts.append("</tbody></table>")
+    parts += [
         "<h2>How the leaderboard is kept honest</h2>",
         '<ul class="rules">',
         "<li>Every results file is validated against the results schema and its semantic checks, with "
