@@ -593,9 +593,7 @@ class EyeCatchEnv(gym.Env):
         self._visible2 = False
         self._delay_buffer: deque = deque(maxlen=self.delay_steps + 1)
         self._fixation = 1.0
-        self._eye_rot = np.eye(3)
-        self._eye_rot_flat = self._eye_rot.ravel().tolist()
-        self._eye_pos = np.zeros(3)
+        self._eye_rot_flat = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]
         self._eye_pos_list = [0.0, 0.0, 0.0]
         self._eye_in_head = (0.0, 0.0)
 
@@ -764,9 +762,9 @@ class EyeCatchEnv(gym.Env):
         """Vestibulo-ocular reflex: turn the world gaze into eye-in-head angles for the current head.
 
         Clamps to the eye's range (Eom 4.1); if clamped, the plant's gaze becomes what was reached.
-        Needs current head kinematics. Sets the eye joints and the cached eye frame (``_eye_rot`` as
-        an array, ``_eye_rot_flat`` as the same 9 numbers, row-major, in a list; scalar maths: this
-        runs every step, and numpy's per-call cost dominates 3x3 products).
+        Needs current head kinematics. Sets the eye joints and the cached eye frame (``_eye_rot_flat``:
+        the rotation's 9 numbers, row-major; ``_eye_pos_list``; scalar maths: this runs every step,
+        and numpy's per-call cost dominates 3x3 products).
         """
         d = self.data
         h0, h1, h2, h3, h4, h5, h6, h7, h8 = d.xmat[self._head_body].tolist()  # head rotation, row-major
@@ -786,20 +784,28 @@ class EyeCatchEnv(gym.Env):
             h6 * e00 + h7 * e10 + h8 * e20, h6 * e01 + h7 * e11, h6 * e02 + h7 * e12 + h8 * e22,
         ]
         self._eye_rot_flat = flat
-        self._eye_rot = np.array(flat).reshape(3, 3)
         if az_c != az or el_c != el:
             self.plant.constrain(np.array(flat[0::3]))
         ox, oy, oz = self._eye_offset_list
         px, py, pz = d.xpos[self._head_body].tolist()
         eye = [px + h0 * ox + h1 * oy + h2 * oz, py + h3 * ox + h4 * oy + h5 * oz, pz + h6 * ox + h7 * oy + h8 * oz]
         self._eye_pos_list = eye
-        self._eye_pos = np.array(eye)
         self._eye_in_head = (az_c, el_c)
         qpos = d.qpos
         qpos[self._eye_qpos_az] = az_c
         qpos[self._eye_qpos_el] = el_c
         qpos[self._fix_qpos] = self._fixation
         d.qvel[self._eye_dof] = 0.0
+
+    @property
+    def _eye_rot(self) -> np.ndarray:
+        """The eye frame's rotation (columns: visual axis, left, up in the world), as an array."""
+        return np.array(self._eye_rot_flat).reshape(3, 3)
+
+    @property
+    def _eye_pos(self) -> np.ndarray:
+        """The eye's centre (world), as an array."""
+        return np.array(self._eye_pos_list)
 
     def _true_ball_eye(self, k: int = 0) -> tuple[np.ndarray, np.ndarray]:
         """True ball position and velocity in the current eye frame (Eyecatch Eq. 6-7, no noise)."""
@@ -919,7 +925,7 @@ class EyeCatchEnv(gym.Env):
             "ball_vel": d.qvel[self._ball_dof : self._ball_dof + 3].copy(),
             "hand_pos": d.site_xpos[self._catch_site].copy(),
             "gaze_dir": self.plant.gaze.copy(),
-            "eye_pos": self._eye_pos.copy(),
+            "eye_pos": np.array(self._eye_pos_list),
             "head_qpos": d.qpos[self._neck_qpos].copy(),
             "head_dir": d.xmat[self._head_body, 0::3].copy(),  # the head's forward axis, world
         }

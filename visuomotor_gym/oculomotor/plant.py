@@ -173,7 +173,7 @@ class OculomotorPlant:
         """Start at ``gaze`` (unit vector, world) with the saccade generator recharged."""
         self.gaze = np.asarray(gaze, dtype=float) / np.linalg.norm(gaze)
         self.time = float(time)
-        self.angular_velocity = np.zeros(3)  # world, rad/s, at self.time
+        self._omega = (None, np.zeros(3), 0.0)  # angular velocity = (cross(a, b) if a else b) * k
         self.last_onset = -math.inf
         self.saccade: Saccade | None = None
         self.saccades: list[Saccade] = []
@@ -182,6 +182,12 @@ class OculomotorPlant:
         if self.record:
             self.trace_t.append(self.time)
             self.trace_gaze.append(self.gaze.copy())
+
+    @property
+    def angular_velocity(self) -> np.ndarray:
+        """Angular velocity of the gaze (world, rad/s) over the last step (computed when asked)."""
+        a, b, k = self._omega
+        return (cross(a, b) if a is not None else b) * k
 
     @property
     def ready_for_saccade(self) -> bool:
@@ -230,7 +236,7 @@ class OculomotorPlant:
             u_end = min(max((t_end - sac.onset) / sac.duration, 0.0), 1.0)
             gx, gy, gz = sac.direction(minimum_jerk(u_end))
             speed = sac.amplitude * 30.0 * u_end**2 * (1.0 - u_end) ** 2 / sac.duration  # Eq. 15
-            self.angular_velocity = sac.axis * speed
+            self._omega = (None, sac.axis, speed)
             if u_end >= 1.0:
                 self.saccade = None
         else:  # pursuit (no saccade started, so the gaze and the amplitude are unchanged)
@@ -245,11 +251,11 @@ class OculomotorPlant:
                 c, s = math.cos(t), math.sin(t)
                 (ax, ay, az), (wx, wy, wz) = start.tolist(), w.tolist()
                 gx, gy, gz = c * ax + s * wx, c * ay + s * wy, c * az + s * wz
-                self.angular_velocity = cross(start, w) * (travel / dt)
+                self._omega = (start, w, travel / dt)
             else:
                 if self.record:
                     points = np.broadcast_to(start, (n_substeps, 3)).copy()
-                self.angular_velocity = np.zeros(3)
+                self._omega = (None, np.zeros(3), 0.0)
                 gx, gy, gz = start.tolist()
         n = math.sqrt(gx * gx + gy * gy + gz * gz)
         self.gaze = np.array([gx / n, gy / n, gz / n])
