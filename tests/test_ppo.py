@@ -108,3 +108,32 @@ def test_ppo_agent_needs_a_policy_file():
         make_agent("ppo", "EyeCatch-v0", 9)
     with pytest.raises(FileNotFoundError, match="no PPO model"):
         make_agent("ppo:/nonexistent/model.zip", "EyeCatch-v0", 9)
+
+
+def test_belief_intercept_base_catches_with_exact_vision_and_maps_residuals():
+    """The residual's base (nothing learned) catches Oracle throws; a residual moves the hand target by
+    exactly residual_m per unit, and hand_action='absolute' leaves actions alone."""
+    result = evaluate("belief_intercept", "EyeCatchOracle-v0", 4, 0, workers=1)
+    assert result.summary["caught"] >= 3
+
+    import gymnasium as gym
+
+    from visuomotor_gym.baselines.ppo.belief import BeliefFeatures
+    from visuomotor_gym.envs.catch import HAND_WORKSPACE
+
+    env = gym.make("EyeCatchOracle-v0")
+    obs, _ = env.reset(seed=3)
+    feats = BeliefFeatures("EyeCatchOracle-v0", "intercept", residual_m=0.1)
+    x = feats(obs)
+    assert x.shape == (57 + 14,) and feats.intercept_point is not None
+    zero = feats.env_action(np.zeros(9, np.float32))
+    push = feats.env_action(np.array([0.5, 0, 0, 0, 0, 0, 0, 0, 0], np.float32))
+    scale = 2.0 / (HAND_WORKSPACE[0, 1] - HAND_WORKSPACE[0, 0])  # action units per metre along x
+    assert push[0] - zero[0] == pytest.approx(0.05 * scale, abs=1e-6)
+    np.testing.assert_array_equal(push[3:], np.zeros(6))
+    plain = BeliefFeatures("EyeCatchOracle-v0", "absolute")
+    plain(obs)
+    a = np.linspace(-1, 1, 9).astype(np.float32)
+    assert plain.env_action(a) is a
+    with pytest.raises(ValueError, match="hand_action must be one of"):
+        BeliefFeatures("EyeCatch-v0", "relative")

@@ -14,6 +14,8 @@ Agent names (``make_agent``):
 * ``random``: uniform random actions (seeded);
 * ``zero``: all-zero actions (gaze held, hand at the workspace centre);
 * ``ppo:<path>``: a policy trained by ``vmgym train ppo`` (``visuomotor_gym.baselines.ppo``).
+* ``belief_intercept``: no learning, the base of PPO's belief-relative hand action (closed hand at the
+  Eyecatch filter's interception point, gaze held still).
 
 Further names register with :func:`register_agent`.
 """
@@ -156,6 +158,14 @@ register_agent("random", lambda env_id, action_dim, seed, **kw: RandomAgent(acti
                "uniform random actions", deterministic=False)
 register_agent("zero", lambda env_id, action_dim, seed, **kw: ZeroAgent(action_dim, **kw), "all-zero actions")
 register_agent("oracle", _oracle, "scripted interception on the true ball state (Oracle env only)")
+def _belief_intercept(env_id, action_dim, seed, **kw):
+    from visuomotor_gym.baselines.ppo.belief import InterceptBase
+
+    return InterceptBase(env_id, **kw)
+
+
+register_agent("belief_intercept", _belief_intercept,
+               "no learning: closed hand at the Eyecatch filter's interception point, gaze held (PPO's residual base)")
 register_agent("ppo", _ppo, "a trained stable-baselines3 PPO/RecurrentPPO policy: ppo:<model.zip or run folder>")
 register_agent("eyecatch", _eyecatch, "Eyecatch heuristic (Yeo et al. 2012): Kalman filter, saccades, submovements")
 register_agent("belief_mpc", _belief_mpc, "belief-space MPC (Eom et al. 2019): Kalman beliefs, iLQR over gaze, head, hand")

@@ -123,3 +123,26 @@ class BeliefObservation(gym.Wrapper):
     def step(self, action):
         obs, reward, terminated, truncated, info = self.env.step(self.features.env_action(action))
         return self.features(obs), reward, terminated, truncated, info
+
+
+class InterceptBase:
+    """The fixed policy PPO's residual starts from, with nothing learned: hand block 0 (the closed
+    hand at the belief's interception point), grasp closed, gaze, fixation and head held still.
+
+    It measures how much of a ``hand_action="intercept"`` policy's catch rate the structure alone
+    gives (``vmgym bench --agent belief_intercept``).
+    """
+
+    def __init__(self, env_id: str, residual_m: float = 0.15):
+        self.features = BeliefFeatures(env_id, "intercept", residual_m)
+
+    def reset(self) -> None:
+        self.features.reset()
+
+    def predict(self, observation, state=None, episode_start=None, deterministic=True):
+        if episode_start is not None and bool(np.asarray(episode_start).reshape(-1)[0]):
+            self.reset()
+        self.features(observation)
+        action = np.zeros(9, dtype=np.float32)
+        action[3] = 1.0  # grasp closed
+        return self.features.env_action(action), state
