@@ -246,12 +246,18 @@ class OculomotorPlant:
                 if self.record:
                     fractions = np.arange(1, n_substeps + 1) / n_substeps * (travel / amplitude)
                     points = _slerp(start, target, amplitude, fractions)
-                w = _tangent(start, target, amplitude)
-                t = travel / amplitude * amplitude  # as _slerp(start, target, amplitude, travel / amplitude)
+                # _slerp(start, target, amplitude, travel / amplitude) in scalars (same operations)
+                (ax, ay, az), (bx, by, bz) = start.tolist(), np.asarray(target, dtype=float).tolist()
+                sa = math.sin(amplitude)
+                if sa > 1e-9:  # _tangent's general case
+                    ca = math.cos(amplitude)
+                    wx, wy, wz = (bx - ca * ax) / sa, (by - ca * ay) / sa, (bz - ca * az) / sa
+                else:
+                    wx, wy, wz = _tangent(start, target, amplitude).tolist()
+                t = travel / amplitude * amplitude
                 c, s = math.cos(t), math.sin(t)
-                (ax, ay, az), (wx, wy, wz) = start.tolist(), w.tolist()
                 gx, gy, gz = c * ax + s * wx, c * ay + s * wy, c * az + s * wz
-                self._omega = (start, w, travel / dt)
+                self._omega = (start, (wx, wy, wz), travel / dt)
             else:
                 if self.record:
                     points = np.broadcast_to(start, (n_substeps, 3)).copy()
