@@ -30,6 +30,10 @@ def test_tiny_training_saves_loads_and_evaluates(tmp_path, extra):
     assert "--timesteps 512" in (run / "command.txt").read_text()
     result = evaluate(f"ppo:{run}", "EyeCatch-v0", 2, 0, workers=1)
     assert result.summary["episodes"] == 2
+    # EvalCallback's best model carries the normalisation it was evaluated with.
+    best = json.loads((run / "eval" / "best_model.meta.json").read_text())
+    assert best["selected"].startswith("best EvalCallback") and len(best["obs_mean"]) == n_obs
+    assert evaluate(f"ppo:{run}/eval/best_model.zip", "EyeCatch-v0", 1, 0, workers=1).summary["episodes"] == 1
     # Deterministic: the same policy gives the same actions on the same seeds.
     again = evaluate(f"ppo:{run}", "EyeCatch-v0", 2, 0, workers=1)
     for a, b in zip(result.traces, again.traces):

@@ -179,6 +179,28 @@ def make_env_fn(env_id: str, env_kwargs: dict, belief: bool, seed: int, intercep
     return thunk
 
 
+def run_meta(model, train_env, config: dict, args: Args, wall_s: float) -> dict:
+    """What ``ppo:<path>`` needs besides the zip: algorithm, inputs, hand action, normalisation."""
+    from stable_baselines3.common.vec_env import VecNormalize
+
+    meta = {
+        "algo": config["algo"],
+        "env_id": args.env,
+        "belief": bool(config["belief"]),
+        "hand_action": config["hand_action"],
+        "intercept_residual_m": float(config["intercept_residual_m"]),
+        "timesteps": int(model.num_timesteps),
+        "train_wall_s": round(wall_s, 1),
+        "seed": args.seed,
+    }
+    if isinstance(train_env, VecNormalize) and config["normalize_obs"]:
+        meta["obs_mean"] = train_env.obs_rms.mean.tolist()
+        meta["obs_var"] = train_env.obs_rms.var.tolist()
+        meta["clip_obs"] = float(train_env.clip_obs)
+        meta["epsilon"] = float(train_env.epsilon)
+    return meta
+
+
 def main(argv=None) -> Path:
     args = parse_args(argv)
     config = load_config(args)
@@ -238,15 +260,28 @@ def main(argv=None) -> Path:
                 eval_env.obs_rms = copy.deepcopy(train_env.obs_rms)
             return super()._on_step()
 
+    from stable_baselines3.common.callbacks import BaseCallback
+
+    class SaveBestMeta(BaseCallback):
+        """Beside EvalCallback's ``eval/best_model.zip``, the normalisation it was evaluated with
+        (``eval/best_model.meta.json``), so ``ppo:<run>/eval/best_model.zip`` loads it. The best is
+        chosen on the EvalCallback's own throws (seed 10 000 + seed), never the evaluator's 0-199."""
+
+        def _on_step(self) -> bool:
+            meta = run_meta(model, train_env, config, args, time.time() - start)
+            meta["selected"] = f"best EvalCallback mean reward {self.parent.best_mean_reward:.3f}"
+            (run_dir / "eval" / "best_model.meta.json").write_text(json.dumps(meta, indent=2))
+            return True
+
     callbacks = [
         SyncNormalization(eval_env, n_eval_episodes=int(config["eval_episodes"]),
                           eval_freq=max(1, int(config["eval_freq"]) // n_envs), log_path=str(run_dir / "eval"),
-                          best_model_save_path=str(run_dir / "eval"), deterministic=True),
+                          best_model_save_path=str(run_dir / "eval"), deterministic=True,
+                          callback_on_new_best=SaveBestMeta()),
         CheckpointCallback(save_freq=max(1, int(config["checkpoint_freq"]) // n_envs),
                            save_path=str(run_dir / "checkpoints"), name_prefix="model"),
     ]
     if args.minutes > 0:
-        from stable_baselines3.common.callbacks import BaseCallback
 
         class WallClock(BaseCallback):
             def _on_training_start(self) -> None:
@@ -263,21 +298,7 @@ def main(argv=None) -> Path:
 
     # 4. Save the policy and what evaluation needs to reproduce its inputs, as JSON.
     model.save(run_dir / "model.zip")
-    meta = {
-        "algo": config["algo"],
-        "env_id": args.env,
-        "belief": bool(config["belief"]),
-        "hand_action": config["hand_action"],
-        "intercept_residual_m": float(config["intercept_residual_m"]),
-        "timesteps": int(model.num_timesteps),
-        "train_wall_s": round(wall, 1),
-        "seed": args.seed,
-    }
-    if isinstance(train_env, VecNormalize) and config["normalize_obs"]:
-        meta["obs_mean"] = train_env.obs_rms.mean.tolist()
-        meta["obs_var"] = train_env.obs_rms.var.tolist()
-        meta["clip_obs"] = float(train_env.clip_obs)
-        meta["epsilon"] = float(train_env.epsilon)
+    meta = run_meta(model, train_env, config, args, wall)
     (run_dir / "ppo_meta.json").write_text(json.dumps(meta, indent=2))
     print(f"trained {model.num_timesteps} steps in {wall / 60:.1f} min; saved {run_dir / 'model.zip'}")
     return run_dir
