@@ -82,9 +82,11 @@ class EyecatchParams:
     hand_max_speed_m_s: float = 2.0  # peak hand speed observed in the data
     preferred_distance_m: float = 0.5  # interception distance from the head (Eyecatch Fig. 8)
     ready_angle_deg: float = 20.0  # ready pose: this far from the line of sight, toward the lower right
-    proactive_logdet: float = -55.0  # log det(P) (SI units) below which the proactive phase starts;
-    # Eyecatch Fig. 9 picks the criterion so the decision falls near the apex: over 30 EyeCatch-v0
-    # throws log det(P) at the apex has median -57 and 90th percentile -55.
+    proactive_logdet: float = -55.0  # log det(P) (SI units) below which the proactive phase starts.
+    # Eyecatch Fig. 9 picks the criterion so the decision falls near the apex. -55 was calibrated on an
+    # earlier filter (apex median -57); with the current one log det(P) is ~ -60 by the second update
+    # (0.22 s) and ~ -63 at the apex, so on EyeCatch-v0 the agent commits ~0.3 s before the apex (see
+    # docs/reproductions/eyecatch.md). Kept: changing it changes the eyecatch-v2 leaderboard entries.
     proactive_deadline_s: float = 0.6  # ours: commit anyway when the ball is this close in time.
     # The check runs only at visuomotor updates (200 ms apart), so commitment comes 0-200 ms after the
     # deadline: 0.6 s = hand_submovement_s + update_period_s leaves every throw at least one full
