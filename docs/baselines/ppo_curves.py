@@ -36,8 +36,10 @@ def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("runs", nargs="+", type=Path)
     parser.add_argument("--out", type=Path, required=True)
+    parser.add_argument("--base", type=float, default=None,
+                        help="catch rate of the residual's base (belief_intercept) on EyeCatch-v0, drawn as a line")
     args = parser.parse_args(argv)
-    fig = Figure(figsize=(13, 5), layout="constrained")
+    fig = Figure(figsize=(13, 6.5), layout="constrained")
     FigureCanvasAgg(fig)
     ax_steps, ax_min = fig.subplots(1, 2, sharey=True)
     for run in args.runs:
@@ -58,7 +60,11 @@ def main(argv=None) -> None:
         ax.grid(alpha=0.3)
     ax_min.axhline(0.85, color="k", lw=0.8, ls="--")
     ax_min.text(0.5, 0.86, "goal: 85 %", fontsize=8)
-    ax_steps.legend(fontsize=7, loc="lower right")
+    if args.base is not None:
+        ax_min.axhline(args.base, color="0.3", lw=1.0, ls=":")
+        ax_steps.axhline(args.base, color="0.3", lw=1.0, ls=":",
+                         label=f"belief_intercept on EyeCatch-v0, nothing learned: {args.base:.0%} (200 throws)")
+    fig.legend(*ax_steps.get_legend_handles_labels(), loc="outside lower center", ncols=2, fontsize=7)
     args.out.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(args.out, dpi=110)
     print(f"wrote {args.out}")
