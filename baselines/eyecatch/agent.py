@@ -382,11 +382,17 @@ class EyecatchAgent:
                     self.grasp = True  # grasping starts with the last submovement
                     self.events.append((t, "grasp"))
         else:
-            d, a = p.preferred_distance_m, p.ready_angle_deg * DEG
-            ready_eye = d * np.array([math.cos(a), -math.sin(a) * math.cos(math.pi / 4), -math.sin(a) * math.sin(math.pi / 4)])
-            dest = rot @ ready_eye + eye  # Eq. 19
+            dest = self.ready_point(rot, eye)
             duration = p.hand_submovement_s
         self.hand.add(t, duration, self._within_reach(dest), max_speed=p.hand_max_speed_m_s)
+
+    def ready_point(self, rot: np.ndarray, eye: np.ndarray) -> np.ndarray:
+        """The reactive phase's hand destination (Eq. 19): fixed in the eye frame at the preferred
+        distance, ``ready_angle_deg`` off the line of sight toward the lower right."""
+        p = self.params
+        d, a = p.preferred_distance_m, p.ready_angle_deg * DEG
+        ready_eye = d * np.array([math.cos(a), -math.sin(a) * math.cos(math.pi / 4), -math.sin(a) * math.sin(math.pi / 4)])
+        return rot @ ready_eye + eye
 
     def _logdet(self) -> float:
         sign, logdet = np.linalg.slogdet(self.filter.P)

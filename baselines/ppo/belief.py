@@ -85,10 +85,7 @@ class BeliefFeatures:
         agent, p = self._agent, self._agent.params
         eye = obs[_S["eye_pos"]] + SEAT_ORIGIN
         if not agent.filter.initialised:  # nothing seen yet: the ready pose (Eyecatch Eq. 19)
-            rot = obs[_S["eye_rot"]].reshape(3, 3)
-            d, a = p.preferred_distance_m, math.radians(p.ready_angle_deg)
-            ready_eye = d * np.array([math.cos(a), -math.sin(a) * math.cos(math.pi / 4), -math.sin(a) * math.sin(math.pi / 4)])
-            return agent._within_reach(rot @ ready_eye + eye), p.prediction_horizon_s
+            return agent._within_reach(agent.ready_point(obs[_S["eye_rot"]].reshape(3, 3), eye)), p.prediction_horizon_s
         point, seconds = agent._interception(eye, agent.delay_steps * agent.dt)
         return agent._within_reach(point), seconds
 
