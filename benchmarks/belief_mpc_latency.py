@@ -18,7 +18,6 @@ control step on one CPU core. This script
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import shlex
 import sys
@@ -28,7 +27,7 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
 
 import numpy as np  # noqa: E402
 
-from visuomotor_gym.bench.provenance import provenance  # noqa: E402
+from visuomotor_gym.bench.provenance import provenance, report_benchmark  # noqa: E402
 
 
 def main(argv=None) -> dict:
@@ -97,11 +96,7 @@ def main(argv=None) -> dict:
         "mean_ms_per_step_by_part": per_step_ms,
         "provenance": provenance(shlex.join(["python", *sys.argv])),
     }
-    print(json.dumps(result, indent=2))
-    if args.json:
-        with open(args.json, "w") as f:
-            json.dump(result, f, indent=2)
-    return result
+    return report_benchmark(result, args.json)
 
 
 if __name__ == "__main__":

@@ -15,7 +15,6 @@ and the best of each is compared.
 from __future__ import annotations
 
 import argparse
-import json
 import shlex
 import sys
 import time
@@ -25,7 +24,7 @@ import mujoco
 import numpy as np
 
 import visuomotor_gym  # noqa: F401  (registers the ids)
-from visuomotor_gym.bench.provenance import provenance  # noqa: E402
+from visuomotor_gym.bench.provenance import provenance, report_benchmark  # noqa: E402
 
 
 def env_run(env_id: str, actions: np.ndarray, seed: int, record: bool):
@@ -93,11 +92,7 @@ def main(argv=None) -> dict:
         "meets_target": env_rate / raw_rate >= 0.5,
         "provenance": provenance(shlex.join(["python", *sys.argv])),
     }
-    print(json.dumps(result, indent=2))
-    if args.json:
-        with open(args.json, "w") as f:
-            json.dump(result, f, indent=2)
-    return result
+    return report_benchmark(result, args.json)
 
 
 if __name__ == "__main__":

@@ -13,12 +13,11 @@ Both figures are reported as ratios to references measured in the same run (mach
 from __future__ import annotations
 
 import argparse
-import json
 import shlex
 import sys
 
 from visuomotor_gym.bench.evaluate import evaluate
-from visuomotor_gym.bench.provenance import provenance
+from visuomotor_gym.bench.provenance import provenance, report_benchmark
 
 
 def main(argv=None) -> dict:
@@ -52,11 +51,7 @@ def main(argv=None) -> dict:
         "env_steps": agent.env_steps,
         "provenance": provenance(shlex.join(["python", *sys.argv])),
     }
-    print(json.dumps(result, indent=2))
-    if args.json:
-        with open(args.json, "w") as f:
-            json.dump(result, f, indent=2)
-    return result
+    return report_benchmark(result, args.json)
 
 
 if __name__ == "__main__":

@@ -32,6 +32,24 @@ def angle_between(a, b) -> float:
     return math.atan2(math.sqrt(cx * cx + cy * cy + cz * cz), ax * bx + ay * by + az * bz)
 
 
+def unit_from_angles(azimuth: float, elevation: float) -> tuple[float, float, float]:
+    """Unit vector for (azimuth about z, then elevation up), x forward, y left, z up, as floats."""
+    ce = math.cos(elevation)
+    return ce * math.cos(azimuth), ce * math.sin(azimuth), math.sin(elevation)
+
+
+def rotate(r, x: float, y: float, z: float) -> tuple[float, float, float]:
+    """``R @ (x, y, z)`` for a rotation given as its 9 entries, row-major (a list or tuple)."""
+    r0, r1, r2, r3, r4, r5, r6, r7, r8 = r
+    return r0 * x + r1 * y + r2 * z, r3 * x + r4 * y + r5 * z, r6 * x + r7 * y + r8 * z
+
+
+def rotate_t(r, x: float, y: float, z: float) -> tuple[float, float, float]:
+    """``R.T @ (x, y, z)`` (into the rotated frame) for ``r`` as in :func:`rotate`."""
+    r0, r1, r2, r3, r4, r5, r6, r7, r8 = r
+    return r0 * x + r3 * y + r6 * z, r1 * x + r4 * y + r7 * z, r2 * x + r5 * y + r8 * z
+
+
 def solve3(m: np.ndarray, v: np.ndarray) -> np.ndarray:
     """Solve the 3x3 system ``m x = v`` by Cramer's rule (for well-conditioned, e.g. damped, ``m``)."""
     (a, b, c), (d, e, f), (g, h, i) = m.tolist()

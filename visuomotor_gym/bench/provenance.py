@@ -102,3 +102,14 @@ def provenance(command: str | None) -> dict:
         "timestamp_utc": datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
         "command": _scrub(command),
     }
+
+
+def report_benchmark(result: dict, json_path: str | None = None) -> dict:
+    """Print a benchmark's result as JSON and, with ``json_path``, also write it there; return it."""
+    import json
+
+    print(json.dumps(result, indent=2))
+    if json_path:
+        with open(json_path, "w") as f:
+            json.dump(result, f, indent=2)
+    return result

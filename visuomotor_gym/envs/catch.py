@@ -19,7 +19,7 @@ from visuomotor_gym.body import names
 from visuomotor_gym.control.hand import HandController, HandControlParams
 from visuomotor_gym.envs.observation import SECOND_BALL_OBSERVATION, ObservationLayout, catch_observation
 from visuomotor_gym.envs.rewards import REWARD_TERMS, SHAPED_WEIGHTS, SPARSE_WEIGHTS, catch_reward
-from visuomotor_gym.geometry import norm
+from visuomotor_gym.geometry import norm, rotate, rotate_t, unit_from_angles
 from visuomotor_gym.oculomotor.plant import (
     DEG,
     OculomotorParams,
@@ -474,11 +474,8 @@ class EyeCatchEnv(gym.Env):
 
         # --- eye: requested gaze change, in retinal coordinates of the current eye frame --------
         g_az, g_el, g_fix = al[nb + 1 : nb + 4]
-        az, el = g_az * self.gaze_action_range, g_el * self.gaze_action_range
-        ce = math.cos(el)
-        ux, uy, uz = ce * math.cos(az), ce * math.sin(az), math.sin(el)  # direction_from_angles, eye frame
-        r0, r1, r2, r3, r4, r5, r6, r7, r8 = self._eye_rot_flat
-        target = np.array([r0 * ux + r1 * uy + r2 * uz, r3 * ux + r4 * uy + r5 * uz, r6 * ux + r7 * uy + r8 * uz])
+        u = unit_from_angles(g_az * self.gaze_action_range, g_el * self.gaze_action_range)  # eye frame
+        target = np.array(rotate(self._eye_rot_flat, *u))  # world
         plant_step = self.plant.step(target, dt, self.n_substeps, self.np_random)
         lo, hi = self._log_fix
         fix_target = math.exp(lo + (g_fix + 1.0) * 0.5 * (hi - lo))
@@ -768,8 +765,8 @@ class EyeCatchEnv(gym.Env):
         """
         d = self.data
         h0, h1, h2, h3, h4, h5, h6, h7, h8 = d.xmat[self._head_body].tolist()  # head rotation, row-major
-        wx, wy, wz = self.plant.gaze.tolist()
-        gx, gy, gz = h0 * wx + h3 * wy + h6 * wz, h1 * wx + h4 * wy + h7 * wz, h2 * wx + h5 * wy + h8 * wz  # in head
+        head = (h0, h1, h2, h3, h4, h5, h6, h7, h8)
+        gx, gy, gz = rotate_t(head, *self.plant.gaze.tolist())  # gaze in head coordinates
         az = math.atan2(gy, gx)
         el = math.atan2(gz, math.hypot(gx, gy))
         az_c = min(max(az, self._az_range[0]), self._az_range[1])
@@ -786,10 +783,9 @@ class EyeCatchEnv(gym.Env):
         self._eye_rot_flat = flat
         if az_c != az or el_c != el:
             self.plant.constrain(np.array(flat[0::3]))
-        ox, oy, oz = self._eye_offset_list
         px, py, pz = d.xpos[self._head_body].tolist()
-        eye = [px + h0 * ox + h1 * oy + h2 * oz, py + h3 * ox + h4 * oy + h5 * oz, pz + h6 * ox + h7 * oy + h8 * oz]
-        self._eye_pos_list = eye
+        ox, oy, oz = rotate(head, *self._eye_offset_list)
+        self._eye_pos_list = [px + ox, py + oy, pz + oz]
         self._eye_in_head = (az_c, el_c)
         qpos = d.qpos
         qpos[self._eye_qpos_az] = az_c
@@ -828,14 +824,13 @@ class EyeCatchEnv(gym.Env):
             return [0.0, 0.0, 0.0], [0.0, 0.0, 0.0], False
         d = self.data
         bq, bd = self._balls[k][0], self._balls[k][1]
-        r0, r1, r2, r3, r4, r5, r6, r7, r8 = self._eye_rot_flat
+        rot = self._eye_rot_flat
         ex, ey, ez = self._eye_pos_list
         bx, by, bz = d.qpos[bq : bq + 3].tolist()
         vx, vy, vz = d.qvel[bd : bd + 3].tolist()
         rx, ry, rz = bx - ex, by - ey, bz - ez
-        # R^T (p - r) and R^T v: Eyecatch Eq. 6-7
-        pos_eye = [r0 * rx + r3 * ry + r6 * rz, r1 * rx + r4 * ry + r7 * rz, r2 * rx + r5 * ry + r8 * rz]
-        vel_eye = [r0 * vx + r3 * vy + r6 * vz, r1 * vx + r4 * vy + r7 * vz, r2 * vx + r5 * vy + r8 * vz]
+        pos_eye = list(rotate_t(rot, rx, ry, rz))  # R^T (p - r) and R^T v: Eyecatch Eq. 6-7
+        vel_eye = list(rotate_t(rot, vx, vy, vz))
         # Retinal slip: line-of-sight angular velocity minus the gaze's own angular velocity over the
         # step (pursuit, or the head carrying a clamped eye), perpendicular to the line of sight.
         inv_dt = 1.0 / self.dt
@@ -843,6 +838,7 @@ class EyeCatchEnv(gym.Env):
         dt = self.dt
         ux, uy, uz = vx - (ex - px) / dt, vy - (ey - py) / dt, vz - (ez - pz) / dt
         ax, ay, az = self._prev_gaze
+        r0, r3, r6 = rot[0::3]  # the line of sight now
         wx, wy, wz = (ay * r6 - az * r3) * inv_dt, (az * r0 - ax * r6) * inv_dt, (ax * r3 - ay * r0) * inv_dt
         dist2 = rx * rx + ry * ry + rz * rz
         sx = (ry * uz - rz * uy) / dist2 - wx

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from visuomotor_gym.geometry import angle_between, cross
+from visuomotor_gym.geometry import angle_between, cross, unit_from_angles
 
 DEG = math.pi / 180.0
 
@@ -89,8 +89,7 @@ def minimum_jerk(u: np.ndarray | float):
 
 def direction_from_angles(azimuth: float, elevation: float) -> np.ndarray:
     """Unit vector for (azimuth about z, then elevation up): x forward, y left, z up."""
-    ce = math.cos(elevation)
-    return np.array([ce * math.cos(azimuth), ce * math.sin(azimuth), math.sin(elevation)])
+    return np.array(unit_from_angles(azimuth, elevation))
 
 
 def angles_from_direction(direction: np.ndarray) -> tuple[float, float]:
