@@ -2,8 +2,7 @@
 
 For each agent, 200 pinned throws through the common evaluator, then per throw: the angle between the
 line of sight and the true ball (median over the flight), the share of the flight with the ball
-within 2 deg and 10 deg of the line of sight, saccades per throw, the grasp action and the size of
-the hand residual. Writes a table (markdown, stdout) and a PNG of gaze error against time.
+within 2 deg and 10 deg of the line of sight, and saccades per throw. Writes a table (markdown, stdout) and a PNG of gaze error against time.
 
     python docs/baselines/ppo_gaze.py --env EyeCatch-v0 --agents belief_intercept eyecatch ppo:RUN ... \
         --out docs/baselines/images/ppo_gaze_EyeCatch-v0.png
@@ -29,16 +28,13 @@ def gaze_error_deg(tr) -> np.ndarray:
 
 
 def summarise(result) -> dict:
-    med, within2, within10, sacc, grasp, resid = [], [], [], [], [], []
+    med, within2, within10, sacc = [], [], [], []
     for tr in result.traces:
         err = gaze_error_deg(tr)[1:]
         med.append(np.median(err))
         within2.append(np.mean(err < 2.0))
         within10.append(np.mean(err < 10.0))
         sacc.append(int(tr.saccade_onset.sum()))
-        act = tr.action[1:]
-        grasp.append(np.mean(act[:, 3]))
-        resid.append(np.mean(np.linalg.norm(act[:, :3], axis=1)))
     return {
         "catch": result.summary["catch_rate"],
         "median gaze error (deg)": float(np.median(med)),
