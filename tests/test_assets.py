@@ -64,3 +64,28 @@ def test_env_var_override_and_missing_asset(tmp_path, monkeypatch):
     monkeypatch.setenv(assets.ASSETS_ENV_VAR, str(tmp_path / "nope"))
     with pytest.raises(FileNotFoundError, match="not a directory"):
         assets.assets_dir()
+
+
+def test_compiled_catch_models_are_unchanged_by_the_shared_head_eye_fragment():
+    """The head+eye subtree moved into ``common/head_eye.xml`` (shared by every body): the compiled
+    catch models must be byte-identical to the ones compiled before the move (MJB sha256, recorded
+    per MuJoCo version because the binary format may change between releases)."""
+    import hashlib
+    import json
+    import tempfile
+    from pathlib import Path
+
+    import mujoco
+
+    from visuomotor_gym.assets import asset_path
+
+    recorded = json.loads((Path(__file__).parent / "golden" / "compiled_models.json").read_text())
+    if mujoco.__version__ not in recorded:
+        pytest.skip(f"no compiled-model digest recorded for MuJoCo {mujoco.__version__}")
+    for scene, digest in recorded[mujoco.__version__].items():
+        model = mujoco.MjModel.from_xml_path(str(asset_path(scene)))
+        with tempfile.TemporaryDirectory() as tmp:
+            path = Path(tmp) / "model.mjb"
+            mujoco.mj_saveModel(model, str(path), None)
+            assert hashlib.sha256(path.read_bytes()).hexdigest() == digest, scene
+    assert "common/head_eye.xml" in asset_path("common/upper_body.xml").read_text()
