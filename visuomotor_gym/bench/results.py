@@ -69,6 +69,8 @@ def build_results(eval_result, command: str | None) -> dict:
         "caught": int(s["caught"]),
         "catch_rate": float(s["catch_rate"]),
         "catch_rate_ci95": [float(x) for x in s["catch_rate_ci95"]],
+        "success_rate": float(s["success_rate"]),
+        "success_rate_ci95": [float(x) for x in s["success_rate_ci95"]],
         "gaze_realism": s["gaze_realism"],
         "latency_ms": latency,
         "control_period_ms": period_ms,
@@ -181,6 +183,8 @@ def _semantic_problems(obj: dict) -> list[tuple[str, str]]:
             out.append(("$.catch_rate_ci95", f"interval [{low}, {high}] is not the 95 % Wilson interval of "
                                               f"{caught}/{episodes}, [{expected[0]}, {expected[1]}]"))
 
+    out += _success_problems(obj, episodes if episodes_ok else None, rate, env_id)
+
     seeds = obj.get("seeds")
     if isinstance(seeds, dict) and _is_int(seed) and episodes_ok:
         if _is_int(seeds.get("first")) and seeds["first"] != seed:
@@ -202,6 +206,39 @@ def _semantic_problems(obj: dict) -> list[tuple[str, str]]:
         values = [latency.get(k) for k in ("p50", "p95", "max")]
         if all(_is_num(v) for v in values) and not values[0] <= values[1] <= values[2]:
             out.append(("$.latency_ms", f"expected p50 <= p95 <= max, got {values}"))
+
+    run = obj.get("run")
+    if isinstance(run, dict):
+        steps, wall, per_s = run.get("env_steps"), run.get("wall_time_s"), run.get("env_steps_per_s")
+        if _is_int(steps) and _is_num(wall) and wall > 0 and _is_num(per_s):
+            expected_rate = steps / wall
+            if abs(per_s - expected_rate) > TOLERANCE * max(1.0, expected_rate):
+                out.append(("$.run.env_steps_per_s", f"env_steps_per_s = {per_s} differs from env_steps / "
+                                                       f"wall_time_s = {steps}/{wall} = {expected_rate}"))
+    return out
+
+
+def _success_problems(obj: dict, episodes: int | None, catch_rate, env_id) -> list[tuple[str, str]]:
+    """``success_rate`` (optional: results written before it lack the pair) is k / episodes for an
+    integer k, its interval is the Wilson interval of k, and on a catch env id success is the catch."""
+    from visuomotor_gym.registration import CATCH_ENV_IDS
+
+    rate, ci = obj.get("success_rate"), obj.get("success_rate_ci95")
+    if not _is_num(rate) or episodes is None:
+        return []
+    out = []
+    k = round(rate * episodes)
+    if abs(rate - k / episodes) > TOLERANCE:
+        out.append(("$.success_rate", f"success_rate = {rate} is not a whole number of successes out of "
+                                       f"episodes = {episodes}"))
+    elif isinstance(ci, list) and len(ci) == 2 and all(_is_num(x) for x in ci) and 0 <= k <= episodes:
+        expected = _wilson(k, episodes)
+        if expected is not None and any(abs(a - b) > TOLERANCE for a, b in zip(ci, expected)):
+            out.append(("$.success_rate_ci95", f"interval [{ci[0]}, {ci[1]}] is not the 95 % Wilson interval "
+                                                f"of {k}/{episodes}, [{expected[0]}, {expected[1]}]"))
+    if env_id in CATCH_ENV_IDS and _is_num(catch_rate) and abs(rate - catch_rate) > TOLERANCE:
+        out.append(("$.success_rate", f"success_rate = {rate} differs from catch_rate = {catch_rate}: on a "
+                                       f"catch env id ({env_id}) success is the catch"))
     return out
 
 

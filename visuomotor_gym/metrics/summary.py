@@ -39,6 +39,20 @@ def to_json_safe(obj):
     return obj
 
 
+def episode_success(trace) -> bool:
+    """Whether an episode met its task's goal, for any task family.
+
+    A trace that carries its own ``success`` flag (a task module that is not catching) is taken at
+    its word; a catch trace succeeds when the ball was caught (for two balls: every ball, as
+    ``caught`` already means there), so for the catch family ``success_rate == catch_rate``.
+    """
+    success = getattr(trace, "success", None)
+    extras = getattr(trace, "extras", None)
+    if success is None and isinstance(extras, dict):
+        success = extras.get("success")
+    return bool(trace.caught if success is None else success)
+
+
 def summarize(traces: Sequence) -> dict:
     """Every benchmark number for a set of episodes, as plain JSON-serialisable Python (None = undefined).
 
@@ -46,6 +60,9 @@ def summarize(traces: Sequence) -> dict:
 
     * ``episodes``, ``caught`` (count), ``catch_rate``, ``catch_rate_ci95`` ([low, high], Wilson 95 %),
       ``diverged`` (count; physics divergences count as not caught);
+    * ``success_rate``, ``success_rate_ci95``: the family-neutral rate of episodes that met the task's
+      goal (:func:`episode_success`; for catching it is the catch rate) with its Wilson 95 % interval,
+      so a leaderboard can rank tasks that do not catch anything;
     * ``gaze_realism``: ``{"score", "components": {name: {"value", "score", "episodes"}}}``
       (:func:`~visuomotor_gym.metrics.realism.gaze_realism`);
     * ``latency_ms``: ``{"p50", "p95", "max"}`` policy compute time per step;
@@ -66,11 +83,15 @@ def summarize(traces: Sequence) -> dict:
     failed = [tr for tr in valid if not tr.caught]
     rts = [reaction_times(tr) for tr in valid]
     low, high = wilson_interval(caught, n)
+    succeeded = sum(episode_success(tr) for tr in traces)
+    s_low, s_high = wilson_interval(succeeded, n)
     out = {
         "episodes": n,
         "caught": caught,
         "catch_rate": caught / n if n else float("nan"),
         "catch_rate_ci95": [low, high],
+        "success_rate": succeeded / n if n else float("nan"),
+        "success_rate_ci95": [s_low, s_high],
         "diverged": diverged,
         "gaze_realism": gaze_realism(valid),
         "latency_ms": latency_summary(traces),
