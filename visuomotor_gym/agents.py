@@ -65,13 +65,33 @@ def is_deterministic(spec: str) -> bool:
     return _REGISTRY[name][2]
 
 
+# Agents whose spec is ``name:<path>`` (everything after the colon is one file path, which may hold
+# '=' or ','), rather than ``name:key=value,...`` overrides.
+PATH_AGENTS = ("ppo",)
+
+
+class PolicyFileError(ValueError):
+    """A policy file named by an agent spec cannot be loaded (missing, corrupt, not a policy)."""
+
+
+class PolicyFileNotFound(FileNotFoundError, PolicyFileError):
+    """The policy file of an agent spec does not exist (a FileNotFoundError and a ValueError)."""
+
+
 def parse_agent_spec(spec: str) -> tuple[str, dict[str, Any]]:
-    """``"eyecatch:alpha=1,beta=x"`` -> ``("eyecatch", {"alpha": 1, "beta": "x"})``."""
-    name, _, rest = spec.partition(":")
+    """``"eyecatch:alpha=1,beta=x"`` -> ``("eyecatch", {"alpha": 1, "beta": "x"})``;
+    ``"ppo:runs/a=b/model.zip"`` -> ``("ppo", {"path": "runs/a=b/model.zip"})`` (:data:`PATH_AGENTS`)."""
+    if not isinstance(spec, str):
+        raise ValueError(f"an agent spec is a string such as 'eyecatch', got {spec!r}")
+    name, colon, rest = spec.partition(":")
     if name not in _REGISTRY:
         raise ValueError(f"unknown agent {name!r}; known agents: {agent_names()}")
     overrides: dict[str, Any] = {}
-    if rest and "=" not in rest:  # "ppo:<path>": one positional argument
+    if name in PATH_AGENTS:
+        if colon and not rest.strip():
+            raise ValueError(f"agent spec {spec!r} names no file: use {name}:<path to the policy file>")
+        return name, ({"path": rest} if rest else {})
+    if rest and "=" not in rest:  # "name:<path>": one positional argument
         return name, {"path": rest}
     if rest:
         for item in rest.split(","):
@@ -148,10 +168,23 @@ def _belief_mpc(env_id, action_dim, seed, **kw):
 
 def _ppo(env_id, action_dim, seed, path=None, **kw):
     if path is None:
-        raise ValueError("the ppo agent needs a policy file: ppo:<path to model.zip or run folder>")
+        raise ValueError("the ppo agent needs a policy file: ppo:<path to model.zip, run folder or policy .npz>")
+    import zipfile
+
     from visuomotor_gym.baselines.ppo.agent import PPOAgent
 
-    return PPOAgent(path, env_id=env_id, **kw)
+    try:
+        return PPOAgent(path, env_id=env_id, **kw)
+    except FileNotFoundError as exc:
+        raise PolicyFileNotFound(str(exc)) from None
+    except (zipfile.BadZipFile, KeyError, EOFError, OSError, RuntimeError, UnicodeDecodeError) as exc:
+        # A corrupt zip, a zip without SB3's members, a truncated file... (not a user-facing traceback)
+        raise PolicyFileError(
+            f"cannot load the PPO policy {path!r}: {type(exc).__name__}: {exc} (give a model.zip saved by "
+            f"`vmgym train ppo`, its run folder, or a policy .npz written by `vmgym leaderboard submit`)"
+        ) from None
+    except ValueError as exc:
+        raise PolicyFileError(f"cannot load the PPO policy {path!r}: {exc}") from None
 
 
 register_agent("random", lambda env_id, action_dim, seed, **kw: RandomAgent(action_dim, seed, **kw),

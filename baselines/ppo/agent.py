@@ -1,22 +1,51 @@
 """A trained PPO / RecurrentPPO policy behind the common ``predict`` interface (``ppo:<path>``).
 
-``path`` is the ``model.zip`` a training run saved (or a folder holding it), with ``ppo_meta.json``
-beside it, or a *packed* policy (:func:`pack_policy`: one ``.zip`` with ``ppo_meta.json`` inside and
-a fresh optimizer, about a third of the size; the leaderboard keeps these). The meta gives the
-algorithm, the belief features and hand action used in training, and the observation normalisation
-statistics, which this agent applies itself (no pickled VecNormalize).
+``path`` is one of:
+
+* the ``model.zip`` a training run saved (or a folder holding it), with ``ppo_meta.json`` beside it;
+* a *packed* SB3 zip (:func:`pack_policy`: ``ppo_meta.json`` inside, a fresh optimizer);
+* a **pickle-free policy file** (``.npz``, :func:`pack_npz`): the actor's weights as ``.npy`` arrays
+  plus ``policy.json``, a JSON record of the architecture (layers, activations, action bounds) and of
+  the training meta (belief features, hand action, observation normalisation). This is what the
+  leaderboard keeps (format ``ppo-npz``).
+
+The meta gives the algorithm, the belief features and hand action used in training, and the
+observation normalisation statistics, which this agent applies itself (no pickled VecNormalize).
+
+**Pickles.** An SB3 ``.zip`` is *not* pickle-free: loading one unpickles (cloudpickle) the objects in
+its ``data`` member, so ``ppo:<model.zip>`` must only be given files you trust, e.g. your own training
+runs. A ``.npz`` policy loads with ``allow_pickle=False`` and no ``torch.load``: the actor is rebuilt
+as a ``torch.nn.Sequential`` from ``policy.json`` and the arrays are copied into it.
+:func:`pack_npz` converts a trusted SB3 PPO model and proves that the rebuilt actor gives the SB3
+model's deterministic actions, bit for bit, on sampled observations.
 """
 
 from __future__ import annotations
 
 import io
 import json
+import math
 import zipfile
 from pathlib import Path
 
 import numpy as np
 
 META_NAME = "ppo_meta.json"
+
+# ---- the pickle-free policy file (format "ppo-npz")
+NPZ_FORMAT = "ppo-npz"
+NPZ_FORMAT_VERSION = 1
+NPZ_RECORD = "policy.json"
+# Modelling choices bounding what a policy file may make the loader read (a zip can claim any size):
+# the committed policies are ~0.7 MB with 6 arrays; 64 MiB and 64 members leave room for much larger
+# MLPs while refusing zip bombs before anything is decompressed.
+NPZ_MAX_BYTES = 64 * 1024 * 1024
+NPZ_MAX_MEMBERS = 64
+NPZ_ACTIVATIONS = ("tanh", "relu", "elu", "leaky_relu", "silu", "gelu", "sigmoid")
+# Observations on which pack_npz proves the rebuilt actor equal to the SB3 model (modelling choice:
+# 2000 single-observation calls take well under a second and cover the clipped normalised range).
+NPZ_PROOF_OBSERVATIONS = 2000
+_ZIP_DATE = (1980, 1, 1, 0, 0, 0)  # fixed member dates: the same model packs to the same bytes
 
 
 def resolve(path: str | Path) -> tuple[Path, Path | None]:
@@ -76,14 +105,326 @@ def pack_policy(path: str | Path) -> bytes:
     return buf.getvalue()
 
 
+# ------------------------------------------------------------------ pickle-free policy (ppo-npz)
+
+
+class PolicyFileError(ValueError):
+    """A ``ppo-npz`` policy file is malformed; the message says what is wrong."""
+
+
+def _activation_name(module) -> str:
+    import torch.nn as nn
+
+    names = {nn.Tanh: "tanh", nn.ReLU: "relu", nn.ELU: "elu", nn.LeakyReLU: "leaky_relu", nn.SiLU: "silu",
+             nn.GELU: "gelu", nn.Sigmoid: "sigmoid"}
+    for cls, name in names.items():
+        if type(module) is cls:
+            if cls is nn.LeakyReLU and module.negative_slope != 0.01:
+                break
+            if cls is nn.ELU and module.alpha != 1.0:
+                break
+            if cls is nn.GELU and module.approximate != "none":
+                break
+            return name
+    raise ValueError(f"activation {module!r} has no pickle-free form (known: {', '.join(NPZ_ACTIVATIONS)})")
+
+
+def _activation_module(name: str):
+    import torch.nn as nn
+
+    table = {"tanh": nn.Tanh, "relu": nn.ReLU, "elu": nn.ELU, "leaky_relu": nn.LeakyReLU, "silu": nn.SiLU,
+             "gelu": nn.GELU, "sigmoid": nn.Sigmoid}
+    if name not in table:
+        raise PolicyFileError(f"unknown activation {name!r} (known: {', '.join(NPZ_ACTIVATIONS)})")
+    return table[name]()
+
+
+def _npy_bytes(array: np.ndarray) -> bytes:
+    buf = io.BytesIO()
+    np.lib.format.write_array(buf, np.ascontiguousarray(array), allow_pickle=False)
+    return buf.getvalue()
+
+
+def _write_npz(record: dict, arrays: dict[str, np.ndarray]) -> bytes:
+    """A zip that ``np.load(..., allow_pickle=False)`` reads: ``policy.json`` plus one ``.npy`` per
+    array, with fixed member dates and order, so the same weights give the same bytes."""
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w", compression=zipfile.ZIP_DEFLATED) as zf:
+        zf.writestr(zipfile.ZipInfo(NPZ_RECORD, date_time=_ZIP_DATE),
+                    json.dumps(record, indent=2, sort_keys=True, allow_nan=False) + "\n",
+                    compress_type=zipfile.ZIP_DEFLATED)
+        for name in sorted(arrays):
+            zf.writestr(zipfile.ZipInfo(f"{name}.npy", date_time=_ZIP_DATE), _npy_bytes(arrays[name]),
+                        compress_type=zipfile.ZIP_DEFLATED)
+    return buf.getvalue()
+
+
+def read_npz(data: bytes) -> tuple[dict, dict[str, np.ndarray]]:
+    """``(record, arrays)`` of a ``ppo-npz`` file, read without unpickling anything.
+
+    Refuses (``PolicyFileError``): a file that is not a zip, members other than ``policy.json`` and
+    ``*.npy``, more than :data:`NPZ_MAX_MEMBERS` members or :data:`NPZ_MAX_BYTES` uncompressed
+    (checked before decompressing), arrays that are not finite float32/float64 (an object array
+    needs pickle: ``allow_pickle=False`` refuses it), and a record of another format.
+    """
+    try:
+        zf = zipfile.ZipFile(io.BytesIO(data))
+    except zipfile.BadZipFile as exc:
+        raise PolicyFileError(f"not a {NPZ_FORMAT} policy file (not a zip: {exc})") from None
+    with zf:
+        infos = zf.infolist()
+        if len(infos) > NPZ_MAX_MEMBERS:
+            raise PolicyFileError(f"{len(infos)} members, more than the {NPZ_MAX_MEMBERS} allowed")
+        total = sum(i.file_size for i in infos)
+        if total > NPZ_MAX_BYTES:
+            raise PolicyFileError(f"{total} bytes uncompressed, more than the {NPZ_MAX_BYTES} allowed")
+        names = [i.filename for i in infos]
+        if len(set(names)) != len(names):
+            raise PolicyFileError("a member name appears twice")
+        if NPZ_RECORD not in names:
+            raise PolicyFileError(f"no {NPZ_RECORD} inside: not a {NPZ_FORMAT} policy file")
+        arrays: dict[str, np.ndarray] = {}
+        for name in names:
+            if name == NPZ_RECORD:
+                continue
+            if not name.endswith(".npy") or "/" in name or name.startswith("."):
+                raise PolicyFileError(f"unexpected member {name!r} (only {NPZ_RECORD} and <name>.npy)")
+            raw = zf.read(name)
+            if len(raw) > NPZ_MAX_BYTES:  # a lying header: the stored size was smaller
+                raise PolicyFileError(f"member {name!r} is larger than declared")
+            try:
+                array = np.lib.format.read_array(io.BytesIO(raw), allow_pickle=False)
+            except (ValueError, OSError, EOFError) as exc:
+                raise PolicyFileError(f"member {name!r} is not a plain .npy array: {exc}") from None
+            if array.dtype not in (np.float32, np.float64):
+                raise PolicyFileError(f"array {name!r} has dtype {array.dtype}; only float32/float64 allowed")
+            if not np.all(np.isfinite(array)):
+                raise PolicyFileError(f"array {name!r} holds NaN or inf")
+            arrays[name[:-4]] = array
+        try:
+            record = json.loads(zf.read(NPZ_RECORD).decode("utf-8"),
+                                parse_constant=lambda c: (_ for _ in ()).throw(ValueError(c)))
+        except (UnicodeDecodeError, ValueError) as exc:
+            raise PolicyFileError(f"{NPZ_RECORD} is not valid JSON: {exc}") from None
+    if not isinstance(record, dict) or record.get("format") != NPZ_FORMAT:
+        raise PolicyFileError(f"{NPZ_RECORD} is not a {NPZ_FORMAT} record")
+    if record.get("format_version") != NPZ_FORMAT_VERSION:
+        raise PolicyFileError(f"format_version must be {NPZ_FORMAT_VERSION}, got {record.get('format_version')!r}")
+    return record, arrays
+
+
+def _check_record(record: dict, arrays: dict[str, np.ndarray]) -> None:
+    """Every field the loader uses is present and consistent with the arrays (shapes chain)."""
+    def need(obj, key, kind, where):
+        value = obj.get(key) if isinstance(obj, dict) else None
+        if not isinstance(value, kind) or isinstance(value, bool) and kind is not bool:
+            raise PolicyFileError(f"{where}.{key} must be {getattr(kind, '__name__', kind)}, got {value!r}")
+        return value
+
+    allowed = {"format", "format_version", "network", "meta", "source"}
+    extra = sorted(set(record) - allowed)
+    if extra:
+        raise PolicyFileError(f"unknown keys {extra} in {NPZ_RECORD} (allowed: {sorted(allowed)})")
+    net = need(record, "network", dict, "$")
+    meta = need(record, "meta", dict, "$")
+    if need(meta, "algo", str, "$.meta") != "PPO":
+        raise PolicyFileError(f"$.meta.algo must be 'PPO', got {meta['algo']!r}")
+    obs_dim = need(net, "obs_dim", int, "$.network")
+    action_dim = need(net, "action_dim", int, "$.network")
+    layers = need(net, "layers", list, "$.network")
+    if not layers:
+        raise PolicyFileError("$.network.layers is empty")
+    width = obs_dim
+    for i, layer in enumerate(layers):
+        where = f"$.network.layers[{i}]"
+        w = arrays.get(need(layer, "weight", str, where))
+        b = arrays.get(need(layer, "bias", str, where))
+        if w is None or b is None:
+            raise PolicyFileError(f"{where}: array {layer['weight']!r} or {layer['bias']!r} is missing")
+        if w.ndim != 2 or w.shape[1] != width or b.shape != (w.shape[0],):
+            raise PolicyFileError(f"{where}: weight {w.shape} / bias {b.shape} do not follow a {width}-wide input")
+        act = layer.get("activation")
+        if act is not None:
+            _activation_module(act)
+        if i == len(layers) - 1 and act is not None:
+            raise PolicyFileError(f"{where}: the action layer has no activation, got {act!r}")
+        width = w.shape[0]
+    if width != action_dim:
+        raise PolicyFileError(f"the last layer gives {width} actions, $.network.action_dim says {action_dim}")
+    for key in ("action_low", "action_high"):
+        bound = need(net, key, list, "$.network")
+        if len(bound) != action_dim or not all(isinstance(x, (int, float)) and not isinstance(x, bool)
+                                               and math.isfinite(x) for x in bound):
+            raise PolicyFileError(f"$.network.{key} must be {action_dim} finite numbers")
+    if "obs_mean" in meta:
+        for key in ("obs_mean", "obs_var"):
+            v = meta.get(key)
+            if not isinstance(v, list) or not all(isinstance(x, (int, float)) and not isinstance(x, bool)
+                                                  and math.isfinite(x) for x in v):
+                raise PolicyFileError(f"$.meta.{key} must be a list of finite numbers")
+        if len(meta["obs_mean"]) != obs_dim or len(meta["obs_var"]) != obs_dim:
+            raise PolicyFileError(f"$.meta.obs_mean/obs_var must have {obs_dim} entries (the network's input)")
+
+
+class NpzActor:
+    """The deterministic actor of a ``ppo-npz`` file: a ``torch.nn.Sequential`` built from the JSON
+    record, with the arrays copied in; ``__call__(obs) -> action`` as SB3's ``predict(deterministic=True)``
+    computes it for a flat Box observation (batch of one, float32, action clipped to the action space)."""
+
+    def __init__(self, record: dict, arrays: dict[str, np.ndarray]):
+        import torch
+        import torch.nn as nn
+
+        _check_record(record, arrays)
+        net = record["network"]
+        modules = []
+        for layer in net["layers"]:
+            w, b = arrays[layer["weight"]], arrays[layer["bias"]]
+            linear = nn.Linear(w.shape[1], w.shape[0], bias=True)
+            with torch.no_grad():
+                linear.weight.copy_(torch.from_numpy(np.array(w, dtype=np.float32)))
+                linear.bias.copy_(torch.from_numpy(np.array(b, dtype=np.float32)))
+            modules.append(linear)
+            if layer.get("activation") is not None:
+                modules.append(_activation_module(layer["activation"]))
+        self.net = nn.Sequential(*modules).eval()
+        for param in self.net.parameters():
+            param.requires_grad_(False)
+        self.obs_dim = int(net["obs_dim"])
+        self.low = np.asarray(net["action_low"], dtype=np.float32)
+        self.high = np.asarray(net["action_high"], dtype=np.float32)
+        self._torch = torch
+
+    def __call__(self, obs: np.ndarray) -> np.ndarray:
+        torch = self._torch
+        x = np.asarray(obs, dtype=np.float32).reshape(1, self.obs_dim)
+        with torch.no_grad():
+            out = self.net(torch.as_tensor(x)).numpy()
+        return np.clip(out.reshape(-1, self.low.shape[0]), self.low, self.high)[0]
+
+
+def npz_from_model(model, meta: dict) -> bytes:
+    """The ``ppo-npz`` bytes of a loaded SB3 ``PPO`` model (MlpPolicy on a flat Box observation)."""
+    from gymnasium import spaces
+    from stable_baselines3.common.distributions import DiagGaussianDistribution
+    from stable_baselines3.common.torch_layers import FlattenExtractor
+
+    policy = model.policy
+    if meta.get("algo") != "PPO" or type(model).__name__ != "PPO":
+        raise ValueError(f"only PPO (MlpPolicy) policies have a pickle-free form; this is {meta.get('algo')!r} "
+                         f"(RecurrentPPO's LSTM is not supported yet)")
+    obs_space, act_space = model.observation_space, model.action_space
+    if not isinstance(obs_space, spaces.Box) or len(obs_space.shape) != 1:
+        raise ValueError(f"needs a flat Box observation space, got {obs_space}")
+    if not isinstance(act_space, spaces.Box) or len(act_space.shape) != 1:
+        raise ValueError(f"needs a flat Box action space, got {act_space}")
+    if policy.squash_output or policy.use_sde or not isinstance(policy.action_dist, DiagGaussianDistribution):
+        raise ValueError("needs a diagonal Gaussian policy without squashing or gSDE (SB3 PPO's default)")
+    if not isinstance(policy.features_extractor, FlattenExtractor) or (
+        not policy.share_features_extractor and not isinstance(policy.pi_features_extractor, FlattenExtractor)
+    ):
+        raise ValueError("needs SB3's FlattenExtractor (MlpPolicy)")
+    arrays, layers = {}, []
+    pending = None
+    for module in list(policy.mlp_extractor.policy_net) + [policy.action_net]:
+        if type(module).__name__ == "Linear":
+            k = len(layers)
+            name = "action" if module is policy.action_net else f"pi.{k}"
+            arrays[f"{name}.weight"] = module.weight.detach().cpu().numpy().astype(np.float32)
+            arrays[f"{name}.bias"] = module.bias.detach().cpu().numpy().astype(np.float32)
+            layers.append({"weight": f"{name}.weight", "bias": f"{name}.bias", "activation": None})
+            pending = layers[-1]
+        else:
+            if pending is None or pending["activation"] is not None:
+                raise ValueError(f"unexpected module {module!r} in the policy network")
+            pending["activation"] = _activation_name(module)
+    keep = {k: v for k, v in meta.items() if not str(k).startswith("_")}
+    import stable_baselines3
+
+    record = {
+        "format": NPZ_FORMAT,
+        "format_version": NPZ_FORMAT_VERSION,
+        "network": {
+            "kind": "mlp",
+            "description": "deterministic SB3 PPO actor: x = clip((obs - obs_mean) / sqrt(obs_var + epsilon), "
+                           "+-clip_obs) as float32 (after the belief features when meta.belief), then "
+                           "Linear/activation layers in order, then the action clipped to [action_low, action_high]",
+            "obs_dim": int(obs_space.shape[0]),
+            "action_dim": int(act_space.shape[0]),
+            "layers": layers,
+            "action_low": [float(x) for x in act_space.low],
+            "action_high": [float(x) for x in act_space.high],
+        },
+        "meta": keep,
+        "source": {"converted_from": "stable-baselines3 PPO", "stable_baselines3": stable_baselines3.__version__},
+    }
+    return _write_npz(record, arrays)
+
+
+def prove_npz_equals_model(data: bytes, model, n: int = NPZ_PROOF_OBSERVATIONS, seed: int = 0) -> int:
+    """Raise ValueError unless the actor rebuilt from ``data`` gives ``model.predict(obs, deterministic=True)``
+    bit for bit on ``n`` observations (normal draws scaled to cover the clipped normalised range, plus
+    the corners +-clip); returns ``n``."""
+    record, arrays = read_npz(data)
+    actor = NpzActor(record, arrays)
+    clip = float(record["meta"].get("clip_obs", 10.0))
+    rng = np.random.default_rng(seed)
+    obs = (rng.standard_normal((n, actor.obs_dim)) * (clip / 3.0)).astype(np.float32)
+    obs[0], obs[1 % n] = clip, -clip
+    for i in range(n):
+        expected, _ = model.predict(obs[i], deterministic=True)
+        got = actor(obs[i])
+        if not np.array_equal(np.asarray(expected, dtype=np.float32), got):
+            raise ValueError(f"the pickle-free actor differs from the SB3 model on observation {i}: "
+                             f"{got.tolist()} vs {np.asarray(expected).tolist()}")
+    return n
+
+
+def pack_npz(path: str | Path) -> bytes:
+    """Convert a trained PPO run (folder, ``model.zip`` with its meta, or a packed zip) into the
+    pickle-free ``ppo-npz`` bytes, after proving equal actions (:func:`prove_npz_equals_model`).
+
+    Loading the SB3 zip unpickles it: do this only with your own (trusted) model. A ``.npz`` given
+    here is returned as it is, after it is read and checked.
+    """
+    p = Path(path)
+    if p.is_file() and p.suffix == ".npz":
+        data = p.read_bytes()
+        record, arrays = read_npz(data)
+        _check_record(record, arrays)
+        return data
+    model_path, meta_path = resolve(path)
+    data = model_path.read_bytes()
+    meta = json.loads(meta_path.read_text()) if meta_path is not None else _packed_meta(data)
+    if meta is None:
+        raise ValueError(f"{model_path} has no {META_NAME}")
+    model = _algo_class(meta["algo"]).load(io.BytesIO(data), device="cpu")
+    out = npz_from_model(model, meta)
+    prove_npz_equals_model(out, model)
+    return out
+
+
 class PPOAgent:
     """Deterministic actions of a trained policy for the flat EyeCatch observation."""
 
     def __init__(self, path: str | Path, env_id: str | None = None):
+        p = Path(path)
+        if p.is_file() and p.suffix == ".npz":
+            agent = type(self).from_npz(p.read_bytes(), env_id)
+            self.__dict__.update(agent.__dict__)
+            return
         model_path, meta_path = resolve(path)
         data = model_path.read_bytes()
         meta = json.loads(meta_path.read_text()) if meta_path is not None else _packed_meta(data)
         self._setup(data, meta, env_id)
+
+    @classmethod
+    def from_npz(cls, data: bytes, env_id: str | None = None) -> PPOAgent:
+        """The agent of a pickle-free ``ppo-npz`` file (:func:`pack_npz`); nothing is unpickled."""
+        record, arrays = read_npz(data)
+        agent = cls.__new__(cls)
+        agent._setup(None, record["meta"], env_id, actor=NpzActor(record, arrays))
+        return agent
 
     @classmethod
     def from_bytes(cls, data: bytes, env_id: str | None = None) -> PPOAgent:
@@ -95,12 +436,13 @@ class PPOAgent:
         agent._setup(data, meta, env_id)
         return agent
 
-    def _setup(self, data: bytes, meta: dict, env_id: str | None) -> None:
+    def _setup(self, data: bytes | None, meta: dict, env_id: str | None, actor: NpzActor | None = None) -> None:
         self.meta = meta
         # Evaluating on another env id than the training one is allowed (e.g. a policy trained on
         # EyeCatch-v0 on the ladder); the belief features then follow the env it runs in.
         self.env_id = env_id or self.meta["env_id"]
-        self.model = _algo_class(self.meta["algo"]).load(io.BytesIO(data), device="cpu")
+        self.actor = actor
+        self.model = None if actor is not None else _algo_class(self.meta["algo"]).load(io.BytesIO(data), device="cpu")
         self.features = None
         if self.meta.get("belief"):
             from visuomotor_gym.baselines.ppo.belief import BeliefFeatures
@@ -126,7 +468,9 @@ class PPOAgent:
             obs = self.features(obs)
         if self.mean is not None:
             obs = np.clip((obs - self.mean) / self.std, -self.clip, self.clip).astype(np.float32)
-        if self.meta["algo"] == "RecurrentPPO":
+        if self.actor is not None:
+            action = self.actor(obs)
+        elif self.meta["algo"] == "RecurrentPPO":
             action, self.lstm_state = self.model.predict(
                 obs, state=self.lstm_state, episode_start=np.array([start]), deterministic=True
             )

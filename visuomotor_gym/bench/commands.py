@@ -115,6 +115,34 @@ def print_summary(results: dict, file=None) -> None:
     Console(file=file).print(table)
 
 
+def output_path_problem(path: Path, flag: str) -> str | None:
+    """Why ``path`` cannot be written as an output file (None: it can), checked before any episode runs.
+
+    Refused: a directory; a path under a regular file; a folder that cannot be created or written (a
+    read-only or virtual file system such as /proc, no permission); a name the OS refuses (too long).
+    Writing is proven by creating and removing a temporary file next to the target.
+    """
+    import tempfile
+
+    if path.exists() and path.is_dir():
+        return f"{flag} {path} is a directory; give a file path, e.g. {path / 'results.json'}"
+    parent = path.parent
+    for ancestor in [parent, *parent.parents]:
+        if ancestor.exists():
+            if not ancestor.is_dir():
+                return f"{flag} {path}: {ancestor} is a file, not a folder"
+            break
+    try:
+        parent.mkdir(parents=True, exist_ok=True)
+        with tempfile.NamedTemporaryFile(dir=parent, prefix=f".{path.name[:40]}.", suffix=".probe"):
+            pass
+        if len(path.name.encode("utf-8", "surrogateescape")) > 255:
+            return f"{flag} {path}: the file name is longer than 255 bytes"
+    except OSError as exc:
+        return f"{flag} {path}: cannot write there ({exc.strerror or exc})"
+    return None
+
+
 def _refuse_existing(paths: list[Path | None], force: bool) -> str | None:
     for path in paths:
         if path is not None and path.exists() and not force:
@@ -133,13 +161,18 @@ def main_bench(args: argparse.Namespace) -> int:
     if traces_path is not None and traces_path.suffix != ".npz":
         print(f"error: --traces must name a .npz file, got {traces_path}", file=sys.stderr)
         return 2
+    for path, flag in ((out, "--out"), (traces_path, "--traces")):
+        problem = output_path_problem(path, flag) if path is not None else None
+        if problem:  # before any episode runs
+            print(f"error: {problem}", file=sys.stderr)
+            return 2
     refusal = _refuse_existing([out, traces_path], args.force)  # before spending time on the run
     if refusal:
         print(f"error: {refusal}", file=sys.stderr)
         return 1
     try:
         validate_inputs(args.agent, args.env, args.episodes, args.seed, args.workers)
-    except (ValueError, TypeError) as exc:
+    except (ValueError, TypeError, OSError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     result = evaluate(args.agent, args.env, args.episodes, args.seed, workers=args.workers,
@@ -148,7 +181,7 @@ def main_bench(args: argparse.Namespace) -> int:
         results = build_results(result, canonical_command(args))
         print_summary(results)
         write_results(out, results, force=args.force)
-    except (ResultsError, FileExistsError) as exc:
+    except (ResultsError, OSError) as exc:  # FileExistsError, or the disk failing after the run
         print(f"error: {exc}", file=sys.stderr)
         return 1
     print(f"wrote {out}")

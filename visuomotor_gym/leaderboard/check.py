@@ -2,29 +2,42 @@
 
 Rules (the ``kind`` of a :class:`~visuomotor_gym.leaderboard.problems.Problem`):
 
-* ``protocol``: ``protocol.json`` is readable and well formed;
+* ``protocol``: ``protocol.json`` passes ``protocol_schema.json`` (closed objects, tolerances at
+  most 1 ms / 1 mm);
 * ``layout``: every file under ``results/`` is a results file or an entry record of a
   ``<name>__<env_id>`` entry, each with its partner; every file under ``agents/`` belongs to an entry;
-* ``results``: the results file passes the bench schema and its semantic checks
-  (:func:`visuomotor_gym.bench.results.load_results`: missing fields, unknown env id, a catch rate
-  that is not caught / episodes, a wrong Wilson interval...);
+  ``superseded.json`` passes ``superseded_schema.json``, lists entries that exist, each superseded
+  ``by`` an entry of the same agent on the same env id;
+* ``results``: the results file passes the bench schema (closed at every level, ``run`` required)
+  and its semantic checks (:func:`visuomotor_gym.bench.results.load_results`);
 * ``record``: the entry record passes ``entry_schema.json``;
 * ``provenance``: the results name the commit they ran at, the command that produced them matches
-  their agent, env id, episodes and seed, and the timestamp is not in the future;
+  their agent, env id, episodes, seed and entry name, and the timestamp is not in the future. For a
+  *new* entry (one that is not on the base ref) also: the commit exists in the history of the checked
+  tree, the tree was clean, and the run is not older than its commit;
 * ``consistency``: the record matches its results file (sha256, name, env id, agent), the run follows
   the protocol for its env id (episodes, first seed), the per-episode outcomes are exactly the pinned
   seeds and reproduce the results' caught and diverged counts, time to catch, miss distance,
   first-saccade latency and env steps, and a deterministic agent is not declared stochastic;
-* ``policy``: the policy file exists, its sha256 is the recorded one, and the agent spec still exports
-  to exactly that file;
-* ``rescore``: every entry (but superseded ones) re-played on a sample of its pinned seeds gives the
-  recorded outcomes (caught, diverged, steps exactly; times and distances within the protocol's
-  tolerances). Deterministic agents are re-played seed by seed; stochastic ones are seeded per chunk by
-  the evaluator, so their chunk is replayed up to the seed (an agent that is not seed-reproducible is
-  refused);
+* ``policy``: the policy file exists, its sha256 is the recorded one, its format is current (a retired
+  format, such as the pickled ``sb3-ppo-zip``, only on superseded entries, and never loaded), and the
+  agent spec still exports to exactly that file;
+* ``rescore``: entries are re-played from their policy files, as the evaluator played them. A **new**
+  entry is re-played on **every** pinned seed, and everything the results claim about play is
+  recomputed from those episodes and compared (counts, success and catch rates with their intervals,
+  gaze realism and its components, reaction times, miss distance, time to catch, env steps), and its
+  self-reported latency p95 may not be more than :data:`LATENCY_FACTOR` below the p95 this check
+  measures. An **existing** entry (not superseded) is re-played on ``rescore.sample`` seeds, one per
+  stratum, drawn from the base commit's sha and the entry key: fixed before any pull request, never
+  from submitted bytes. Outcomes must agree (caught, diverged, steps exactly; times and distances
+  within the protocol's tolerances);
 * ``history``: no file of ``results/`` or ``agents/`` that exists at the base ref was deleted or
-  rewritten;
+  rewritten; ``protocol.json`` is not weakened; ``superseded.json`` is append-only and lists only
+  entries admitted on the base (:mod:`.history`);
 * ``pages``: ``README.md`` and ``index.html`` are what ``vmgym leaderboard build`` generates.
+
+Without a base (``--base none``) every entry counts as new (re-scored on every seed, superseded
+entries skipped), and the rules that need git (history, the provenance commit) are skipped with a note.
 """
 
 from __future__ import annotations
@@ -46,6 +59,25 @@ from visuomotor_gym.leaderboard.entries import (
 from visuomotor_gym.leaderboard.problems import KINDS, Problem
 
 SUMMARY_TOLERANCE = 1e-9  # results fields recomputed from the records: same floats, same order
+# A new entry's self-reported latency p95 may be at most this many times below the p95 the check
+# measures on its re-scored episodes. Modelling choice: machines differ (the committed Eyecatch
+# entries measured 0.35 ms idle and 4.4 ms while a training job shared the CPU: x12.5 in the other
+# direction, which is allowed); a claim 10x faster than CI measures is not a faster machine.
+LATENCY_FACTOR = 10.0
+# What a new entry's results must say about play, recomputed from its re-scored episodes.
+RECOMPUTED_FIELDS = (
+    "episodes",
+    "caught",
+    "catch_rate",
+    "catch_rate_ci95",
+    "success_rate",
+    "success_rate_ci95",
+    "diverged",
+    "gaze_realism",
+    "reaction_times_s",
+    "miss_distance_m",
+    "time_to_catch_s",
+)
 
 
 @dataclass
@@ -55,6 +87,7 @@ class CheckReport:
     entries: int = 0
     rescored_entries: int = 0
     rescored_episodes: int = 0
+    new_entries: list[str] = field(default_factory=list)  # keys of entries that are not on the base
     seconds: dict[str, float] = field(default_factory=dict)
 
     @property
@@ -76,6 +109,7 @@ def _close(a, b, tol: float) -> bool:
 
 
 def provenance_problems(entry: Entry, where: str) -> list[Problem]:
+    """Static provenance rules (every entry); :func:`admission_provenance_problems` adds git's."""
     r = entry.results
     prov = r["provenance"]
     out = []
@@ -113,7 +147,7 @@ def provenance_problems(entry: Entry, where: str) -> list[Problem]:
             "--seed": str(r["seed"]),
         }
     elif argv[:3] == ["vmgym", "leaderboard", "submit"]:
-        expected = {"--agent": r["agent"], "--env": r["env_id"]}
+        expected = {"--agent": r["agent"], "--env": r["env_id"], "--name": entry.name}
     else:
         return out + [
             Problem(
@@ -129,9 +163,33 @@ def provenance_problems(entry: Entry, where: str) -> list[Problem]:
                 Problem(
                     where,
                     "provenance",
-                    f"provenance.command has {flag} {given.get(flag)!r} but the results are for {value!r}",
+                    f"provenance.command has {flag} {given.get(flag)!r} but the "
+                    f"{'entry is named' if flag == '--name' else 'results are for'} {value!r}",
                 )
             )
+    return out
+
+
+def admission_provenance_problems(lb: Leaderboard, entry: Entry) -> list[Problem]:
+    """A new entry's provenance against git: a clean tree, a commit in the history of the checked
+    tree (HEAD), and a run no older than that commit (:func:`.history.commit_problems`)."""
+    from visuomotor_gym.leaderboard.history import commit_problems
+
+    prov = entry.results["provenance"]
+    where = lb.rel(entry.results_path)
+    out = []
+    if prov["git_dirty"] is not False:
+        out.append(
+            Problem(
+                where,
+                "provenance",
+                f"provenance.git_dirty is {str(prov['git_dirty']).lower()}: a new entry must be produced "
+                f"from a clean checkout (commit your changes, then submit), so that its git_sha is the "
+                f"code that ran",
+            )
+        )
+    if prov["git_sha"] != "unknown":
+        out += commit_problems(lb.root, prov["git_sha"], prov["timestamp_utc"], where)
     return out
 
 
@@ -273,6 +331,20 @@ def policy_problems(lb: Leaderboard, entry: Entry, export: bool = True) -> list[
         name, _ = parse_agent_spec(entry.results["agent"])
     except ValueError:
         return out  # reported by the consistency rule
+    if pol is not None:
+        from visuomotor_gym.leaderboard.policies import policy_format
+
+        recorded = policy_format(pol["format"])
+        if recorded is not None and recorded.retired is not None and recorded.agent == name:
+            if entry.superseded is None:
+                return [
+                    Problem(
+                        where_rec,
+                        "policy",
+                        f"policy format {pol['format']!r} is retired and is never loaded: {recorded.retired}",
+                    )
+                ]
+            return _hash_problems(lb, entry)  # kept and hash-checked while superseded; never loaded
     fmt = format_for_agent(name)
     if fmt is None:
         if pol is not None:
@@ -285,6 +357,8 @@ def policy_problems(lb: Leaderboard, entry: Entry, export: bool = True) -> list[
             )
         return out
     if pol is None:
+        if entry.superseded is not None:
+            return []  # entered before its agent had a policy format; kept, not re-scored
         return [
             Problem(
                 where_rec,
@@ -297,20 +371,10 @@ def policy_problems(lb: Leaderboard, entry: Entry, export: bool = True) -> list[
         return out
     path = lb.root / pol["file"]
     where = lb.rel(path)
-    if not path.is_file():
-        return [Problem(where, "policy", f"missing: the entry {entry.key} records this policy file")]
+    found = _hash_problems(lb, entry)
+    if found:
+        return found
     data = path.read_bytes()
-    actual = hashlib.sha256(data).hexdigest()
-    if actual != pol["sha256"]:
-        return [
-            Problem(
-                where,
-                "policy",
-                f"sha256 of the policy file is {actual[:16]}..., but its entry "
-                f"{entry.record_path.name} records {pol['sha256'][:16]}...: the policy "
-                f"file changed after submission",
-            )
-        ]
     if export and fmt.reexport and entry.superseded is None:
         try:
             fresh = fmt.export(entry.results["agent"], entry.env_id)
@@ -336,6 +400,77 @@ def policy_problems(lb: Leaderboard, entry: Entry, export: bool = True) -> list[
     return out
 
 
+def _hash_problems(lb: Leaderboard, entry: Entry) -> list[Problem]:
+    pol = entry.policy
+    path = lb.root / pol["file"]
+    where = lb.rel(path)
+    if not path.is_file():
+        return [Problem(where, "policy", f"missing: the entry {entry.key} records this policy file")]
+    actual = hashlib.sha256(path.read_bytes()).hexdigest()
+    if actual != pol["sha256"]:
+        return [
+            Problem(
+                where,
+                "policy",
+                f"sha256 of the policy file is {actual[:16]}..., but its entry "
+                f"{entry.record_path.name} records {pol['sha256'][:16]}...: the policy "
+                f"file changed after submission",
+            )
+        ]
+    return []
+
+
+def family(name: str) -> str:
+    """An entry name without its version suffix: ``eyecatch-v2`` -> ``eyecatch``."""
+    import re
+
+    return re.sub(r"-v[0-9]+$", "", name)
+
+
+def superseded_problems(lb: Leaderboard) -> list[Problem]:
+    """Each listing is superseded ``by`` an entry of the same agent on the same env id: another agent's
+    entry cannot be demoted (the same registered agent, and the same name up to a ``-v<N>`` suffix)."""
+    from visuomotor_gym.agents import parse_agent_spec
+
+    where = lb.rel(lb.root / "superseded.json")
+    by_key = {e.key: e for e in lb.entries}
+    out = []
+
+    def agent_name(e):
+        try:
+            return parse_agent_spec(e.results["agent"])[0] if e.results else None
+        except ValueError:
+            return None
+
+    for key, listing in sorted(lb.superseded.items()):
+        old, new = by_key.get(key), by_key.get(listing["by"])
+        if old is None:
+            continue  # "lists ..., which is no entry" (layout)
+        if new is None:
+            out.append(Problem(where, "layout", f"{key!r} is superseded by {listing['by']!r}, which is no entry"))
+            continue
+        if new.key == old.key:
+            out.append(Problem(where, "layout", f"{key!r} cannot supersede itself"))
+            continue
+        if new.env_id != old.env_id:
+            out.append(
+                Problem(where, "layout", f"{key!r} is superseded by {new.key!r}, an entry on another env id")
+            )
+        same_agent = agent_name(old) is not None and agent_name(old) == agent_name(new)
+        if not same_agent or family(old.name) != family(new.name):
+            out.append(
+                Problem(
+                    where,
+                    "layout",
+                    f"{key!r} (agent {agent_name(old)!r}) is superseded by {new.key!r} (agent "
+                    f"{agent_name(new)!r}): an entry can only be superseded by a newer version of itself "
+                    f"(the same registered agent and the name {family(old.name)!r} or "
+                    f"{family(old.name)}-v<N>); another agent's entry cannot be demoted",
+                )
+            )
+    return out
+
+
 def orphan_problems(lb: Leaderboard) -> list[Problem]:
     agents = lb.root / AGENTS_DIR
     if not agents.is_dir():
@@ -349,53 +484,6 @@ def orphan_problems(lb: Leaderboard) -> list[Problem]:
 
 
 # ------------------------------------------------------------------------------ re-scoring
-
-
-def _chunk_start(seed: int, episodes: int, target: int) -> int:
-    """First seed of the evaluator's chunk holding ``target`` (its agent was built with that seed)."""
-    from visuomotor_gym.bench.evaluate import episode_chunks
-
-    for chunk in episode_chunks(episodes):
-        if seed + chunk.start <= target < seed + chunk.stop:
-            return seed + chunk.start
-    raise ValueError(f"seed {target} is not among the {episodes} pinned seeds from {seed}")
-
-
-def rescore_entry(lb: Leaderboard, entry: Entry, seeds: list[int]) -> list[dict]:
-    """Play ``entry``'s agent (from its policy file, else its spec) on ``seeds``; one record per seed.
-
-    A deterministic agent gets a fresh policy per seed (it behaves after ``reset()`` as fresh). A
-    stochastic agent is seeded per chunk by the evaluator (``make_agent(seed=<chunk's first seed>)``,
-    one stream through the chunk), so its chunk is replayed from the start up to the seed: a seeded
-    agent reproduces; one that draws from elsewhere does not, and is refused.
-    """
-    from visuomotor_gym.agents import is_deterministic, make_agent, parse_agent_spec
-    from visuomotor_gym.bench.evaluate import make_env
-    from visuomotor_gym.bench.trace import run_episode
-    from visuomotor_gym.leaderboard.entries import episode_record
-    from visuomotor_gym.leaderboard.policies import format_for_agent
-
-    r = entry.results
-    name, _ = parse_agent_spec(r["agent"])
-    fmt = format_for_agent(name)
-    data = (lb.root / entry.policy["file"]).read_bytes() if entry.policy is not None else None
-    deterministic = is_deterministic(r["agent"])
-    env = make_env(entry.env_id)
-    try:
-        records = []
-        for s in seeds:
-            start = _chunk_start(r["seed"], r["episodes"], s)
-            if fmt is not None and data is not None:
-                policy = fmt.load(data, entry.env_id)
-            else:
-                action_dim = int(env.action_space.shape[0])
-                policy = make_agent(r["agent"], entry.env_id, action_dim=action_dim, seed=start)
-            for earlier in range(s if deterministic else start, s + 1):
-                trace = run_episode(env, policy, seed=int(earlier), env_id=entry.env_id, agent=r["agent"])
-            records.append(episode_record(trace))
-        return records
-    finally:
-        env.close()
 
 
 def _versions_note(results: dict) -> str:
@@ -426,45 +514,156 @@ def compare_records(recorded: dict, fresh: dict, time_tol: float, dist_tol: floa
     return out
 
 
-def rescore_problems(lb: Leaderboard, entry: Entry, seeds: list[int]) -> list[Problem]:
-    by_seed = {e["seed"]: e for e in entry.record["episodes"]}
+def _differences(path: str, claimed, fresh, tol: float) -> list[str]:
+    """Where ``claimed`` (from a results file) differs from ``fresh`` (recomputed), as ``path: X vs Y``."""
+    if isinstance(fresh, dict):
+        if not isinstance(claimed, dict) or set(claimed) != set(fresh):
+            return [f"{path}: results {claimed!r}, re-scored {fresh!r}"]
+        return [d for k in fresh for d in _differences(f"{path}.{k}", claimed[k], fresh[k], tol)]
+    if isinstance(fresh, list):
+        if not isinstance(claimed, list) or len(claimed) != len(fresh):
+            return [f"{path}: results {claimed!r}, re-scored {fresh!r}"]
+        return [d for i, (a, b) in enumerate(zip(claimed, fresh)) for d in _differences(f"{path}[{i}]", a, b, tol)]
+    if isinstance(fresh, bool) or fresh is None or isinstance(claimed, bool) or claimed is None:
+        return [] if claimed == fresh else [f"{path}: results {claimed!r}, re-scored {fresh!r}"]
+    if isinstance(fresh, (int, float)) and isinstance(claimed, (int, float)):
+        return [] if abs(float(claimed) - float(fresh)) <= tol else [f"{path}: results {claimed!r}, re-scored {fresh!r}"]
+    return [] if claimed == fresh else [f"{path}: results {claimed!r}, re-scored {fresh!r}"]
+
+
+def summary_problems(lb: Leaderboard, entry: Entry, traces: list) -> list[Problem]:
+    """A new entry's results, recomputed from its re-scored episodes (every pinned seed): every play
+    field of :data:`RECOMPUTED_FIELDS`, env steps and control period; and its latency claim."""
+    from visuomotor_gym.metrics import summarize
+    from visuomotor_gym.metrics.summary import latency_summary
+
+    r = entry.results
     where = lb.rel(entry.results_path)
-    unknown = [s for s in seeds if s not in by_seed]
-    if unknown:
-        return [Problem(where, "rescore", f"seeds {unknown} are not among the entry's pinned seeds")]
-    try:
-        fresh = rescore_entry(lb, entry, seeds)
-    except Exception as exc:  # noqa: BLE001 - a policy that cannot be re-played is refused
-        return [Problem(where, "rescore", f"cannot re-play the entry: {type(exc).__name__}: {exc}")]
+    fresh = summarize(traces)
+    diffs = []
+    for key in RECOMPUTED_FIELDS:
+        if key not in r:
+            diffs.append(f"{key}: missing (the evaluator writes it; submit with the current code)")
+            continue
+        diffs += _differences(key, r[key], fresh[key], SUMMARY_TOLERANCE)
+    steps = sum(int(t.steps) for t in traces)
+    if r["run"]["env_steps"] != steps:
+        diffs.append(f"run.env_steps: results {r['run']['env_steps']}, re-scored {steps}")
+    period = 1000.0 * float(traces[0].dt)
+    if abs(r["control_period_ms"] - period) > SUMMARY_TOLERANCE:
+        diffs.append(f"control_period_ms: results {r['control_period_ms']}, re-scored {period}")
     out = []
-    p = lb.protocol
-    for s, rec in zip(seeds, fresh, strict=True):
-        diffs = compare_records(by_seed[s], rec, p.time_tolerance_s, p.distance_tolerance_m)
-        if diffs:
-            out.append(
-                Problem(
-                    where,
-                    "rescore",
-                    f"re-scoring seed {s} disagrees with the recorded outcome: "
-                    f"{'; '.join(diffs)}{_versions_note(entry.results)}",
-                )
+    if diffs:
+        shown = "; ".join(diffs[:6]) + (f"; and {len(diffs) - 6} more" if len(diffs) > 6 else "")
+        out.append(
+            Problem(
+                where,
+                "rescore",
+                f"the results do not match their {len(traces)} re-scored episodes: {shown}"
+                f"{_versions_note(r)}",
             )
+        )
+    measured = latency_summary(traces)["p95"]
+    claimed = r["latency_ms"]["p95"]
+    if claimed is None or (measured == measured and claimed * LATENCY_FACTOR < measured):
+        out.append(
+            Problem(
+                where,
+                "rescore",
+                f"latency_ms.p95 = {claimed} ms is more than {LATENCY_FACTOR:g}x below the p95 this check "
+                f"measured on the re-scored episodes ({measured:.3g} ms): latency is self-reported, but "
+                f"not beyond a machine's difference",
+            )
+        )
     return out
 
 
-def sample_for(lb: Leaderboard, entry: Entry, sample: int | str | None, seeds: list[int] | None) -> list[int]:
-    """The seeds to re-play: ``seeds`` if given, all pinned seeds for ``sample == "all"``, else the
-    protocol's stratified sample (``sample`` overrides its size)."""
+@dataclass
+class _Plan:
+    entry: Entry
+    seeds: list[int]
+    full: bool  # every pinned seed: recompute the summary from the episodes
+
+
+def _plan(lb: Leaderboard, entry: Entry, new: bool, base_sha: str | None, sample, seeds) -> _Plan:
+    """Which seeds of ``entry`` to re-play (see the module doc)."""
     from visuomotor_gym.leaderboard.protocol import sample_seeds
 
     r = entry.results
     pinned = [r["seed"] + i for i in range(r["episodes"])]
     if seeds is not None:
-        return list(seeds)
-    if sample == "all":
-        return pinned
+        return _Plan(entry, [s for s in seeds], False)
+    if new or sample == "all":
+        return _Plan(entry, pinned, True)
     k = lb.protocol.rescore_sample if sample is None else int(sample)
-    return sample_seeds(pinned, k, entry.record["results"]["sha256"])
+    return _Plan(entry, sample_seeds(pinned, k, f"{base_sha}:{entry.key}"), k >= len(pinned))
+
+
+def sample_for(lb: Leaderboard, entry: Entry, base_sha: str, sample: int | None = None) -> list[int]:
+    """The seeds an existing entry is re-scored on against the base commit ``base_sha``."""
+    return _plan(lb, entry, False, base_sha, sample, None).seeds
+
+
+def rescore_entries(lb: Leaderboard, plans: list[_Plan], workers: int = 1, say=None) -> tuple[list[Problem], int]:
+    """Re-play every plan (one pool for all), compare; returns (problems, episodes played)."""
+    from visuomotor_gym.agents import is_deterministic
+    from visuomotor_gym.leaderboard.rescore import chunk_jobs, run_jobs
+
+    problems: list[Problem] = []
+    jobs = []
+    for plan in plans:
+        e, r = plan.entry, plan.entry.results
+        where = lb.rel(e.results_path)
+        pinned = set(range(r["seed"], r["seed"] + r["episodes"]))
+        unknown = [s for s in plan.seeds if s not in pinned]
+        if unknown:
+            problems.append(Problem(where, "rescore", f"seeds {unknown} are not among the entry's pinned seeds"))
+            plan.seeds = [s for s in plan.seeds if s in pinned]
+        data = (lb.root / e.policy["file"]).read_bytes() if e.policy is not None else None
+        fmt = e.policy["format"] if e.policy is not None else None
+        jobs += chunk_jobs(
+            e.key, e.env_id, r["agent"], fmt, data, is_deterministic(r["agent"]), r["seed"], r["episodes"],
+            plan.seeds, plan.full,
+        )
+    results = run_jobs(jobs, workers=workers)
+    by_key: dict[str, list] = {}
+    for job, res in zip(jobs, results, strict=True):
+        by_key.setdefault(job.key, []).append(res)
+    played = 0
+    p = lb.protocol
+    for plan in plans:
+        e = plan.entry
+        where = lb.rel(e.results_path)
+        parts = by_key.get(e.key, [])
+        errors = [res.error for res in parts if res.error]
+        if errors:
+            problems.append(Problem(where, "rescore", f"cannot re-play the entry: {errors[0]}"))
+            if say:
+                say(f"re-scored {e.key}: FAILED to re-play")
+            continue
+        fresh = {seed: rec for res in parts for seed, rec in res.records.items()}
+        played += len(fresh)
+        recorded = {ep["seed"]: ep for ep in e.record["episodes"]}
+        found = []
+        for s in plan.seeds:
+            diffs = compare_records(recorded[s], fresh[s], p.time_tolerance_s, p.distance_tolerance_m)
+            if diffs:
+                found.append(
+                    Problem(
+                        where,
+                        "rescore",
+                        f"re-scoring seed {s} disagrees with the recorded outcome: "
+                        f"{'; '.join(diffs)}{_versions_note(e.results)}",
+                    )
+                )
+        if plan.full and not found:
+            traces = sorted((t for res in parts for t in res.traces), key=lambda t: t.seed)
+            found += summary_problems(lb, e, traces)
+        problems += found
+        if say:
+            what = "every pinned seed, summary recomputed" if plan.full else "sampled seeds"
+            say(f"re-scored {e.key} on {len(plan.seeds)} seeds ({what}): {'DISAGREES' if found else 'agrees'}")
+    return problems, played
 
 
 # ------------------------------------------------------------------------------ the check
@@ -479,15 +678,18 @@ def check_leaderboard(
     pages: bool = True,
     progress=None,
     only: set[str] | None = None,
+    workers: int = 1,
 ) -> CheckReport:
     """Run every rule on the leaderboard at ``root``; returns a :class:`CheckReport`.
 
-    ``base``: git ref the history rule compares with (``"auto"``: origin/main, main or HEAD; None or
-    ``"none"``: skip the rule). ``sample``: re-score sample size (None: the protocol's) or ``"all"``;
-    ``seeds``: re-play exactly these seeds of every entry. ``progress(str)`` gets a
-    line per stage. ``only``: re-score only the entries with these keys (``submit`` checks its own).
+    ``base``: git ref the history rules compare with (``"auto"``: origin/main, main or HEAD; None or
+    ``"none"``: skip them, and count every entry as new). ``sample``: re-score sample size of existing
+    entries (None: the protocol's) or ``"all"``; ``seeds``: re-play exactly these seeds of every entry
+    (debugging: no summary is recomputed). ``progress(str)`` gets a line per stage. ``only``:
+    re-score only the entries with these keys (``submit`` checks its own). ``workers``: processes
+    for re-scoring (1: in this process).
     """
-    from visuomotor_gym.leaderboard.history import history_problems
+    from visuomotor_gym.leaderboard import history
     from visuomotor_gym.leaderboard.pages import stale_page_problems
 
     say = progress or (lambda _msg: None)
@@ -496,55 +698,76 @@ def check_leaderboard(
     lb = load_leaderboard(root)
     report.problems += lb.problems
     report.entries = len(lb.entries)
+
+    # The base: which entries are new, and the history rules.
+    no_base = base is None or str(base).lower() == "none"
+    b = None
+    if no_base:
+        report.notes.append(
+            "history rules skipped (--base none): every entry counts as new (re-scored on every pinned "
+            "seed); provenance commits are not checked against git"
+        )
+    else:
+        b, found = history.load_base(lb.root, base, lb.rel)
+        report.problems += found
+    existing = b.entry_keys if b is not None else set()
+    new_keys = {e.key for e in lb.entries if e.key not in existing}
+    report.new_entries = sorted(new_keys)
+
     static_ok: dict[str, bool] = {}
     for entry in lb.entries:
         report.problems += results_hash_problems(lb, entry)
     for entry in lb.valid_entries:
         before = len(report.problems)
         report.problems += provenance_problems(entry, lb.rel(entry.results_path))
+        if b is not None and entry.key in new_keys:
+            report.problems += admission_provenance_problems(lb, entry)
         report.problems += consistency_problems(lb, entry)
         report.problems += policy_problems(lb, entry)
         static_ok[entry.key] = len(report.problems) == before and not results_hash_problems(lb, entry)
     report.problems += orphan_problems(lb)
+    report.problems += superseded_problems(lb)
     report.seconds["validate"] = time.perf_counter() - t0
     say(
-        f"validated {len(lb.entries)} entries ({len(lb.valid_entries)} loaded) "
-        f"in {report.seconds['validate']:.1f} s"
+        f"validated {len(lb.entries)} entries ({len(lb.valid_entries)} loaded, "
+        f"{len(new_keys)} new) in {report.seconds['validate']:.1f} s"
     )
 
     t1 = time.perf_counter()
-    if rescore and lb.protocol is not None:
+    if rescore and lb.protocol is not None and (b is not None or no_base):
+        plans = []
         for entry in lb.valid_entries:
             if only is not None and entry.key not in only:
                 continue
             if entry.superseded is not None:
-                report.notes.append(f"{entry.key}: superseded, not re-scored ({entry.superseded['reason']})")
+                report.notes.append(
+                    f"{entry.key}: superseded by {entry.superseded['by']}, not re-scored ({entry.superseded['reason']})"
+                )
                 continue
             if not static_ok.get(entry.key):
                 report.notes.append(f"{entry.key}: not re-scored (fix the problems above first)")
                 continue
-            chosen = sample_for(lb, entry, sample, seeds)
-            t = time.perf_counter()
-            found = rescore_problems(lb, entry, chosen)
-            report.problems += found
-            report.rescored_entries += 1
-            report.rescored_episodes += len(chosen)
-            say(
-                f"re-scored {entry.key} on {len(chosen)} seeds in {time.perf_counter() - t:.1f} s: "
-                f"{'DISAGREES' if found else 'agrees'}"
-            )
+            plans.append(_plan(lb, entry, entry.key in new_keys, b.sha if b else None, sample, seeds))
+        found, played = rescore_entries(lb, plans, workers=workers, say=say)
+        report.problems += found
+        report.rescored_entries = len(plans)
+        report.rescored_episodes = played
     elif not rescore:
         report.notes.append("re-scoring skipped (--no-rescore)")
+    else:
+        report.notes.append("re-scoring skipped: the base ref is unusable (see the history problem)")
     report.seconds["rescore"] = time.perf_counter() - t1
 
     t2 = time.perf_counter()
-    if base is None or str(base).lower() == "none":
-        report.notes.append("history rule skipped (--base none)")
-    else:
-        found, note = history_problems(lb.root, base, lb.rel)
-        report.problems += found
-        if note:
-            report.notes.append(f"history: {note}")
+    if b is not None:
+        report.problems += history.immutability_problems(b, lb.rel)
+        report.problems += history.protocol_history_problems(b, lb)
+        report.problems += history.superseded_history_problems(b, lb)
+        report.notes.append(
+            f"history: {sum(len(v) for v in b.files.values())} committed file(s) compared with {b.ref} "
+            f"({b.sha[:12]}); {len(new_keys)} new entr{'y' if len(new_keys) == 1 else 'ies'}"
+            + (f" ({', '.join(sorted(new_keys))})" if new_keys else "")
+        )
     report.seconds["history"] = time.perf_counter() - t2
 
     t3 = time.perf_counter()

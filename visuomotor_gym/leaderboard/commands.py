@@ -83,6 +83,9 @@ def register(subparsers) -> argparse.ArgumentParser:
         "--no-rescore", action="store_true", help="skip re-scoring (quick local check; CI re-scores)"
     )
     c.add_argument("--no-pages", action="store_true", help="skip the stale-page rule")
+    c.add_argument(
+        "--workers", type=int, default=2, help="processes for re-scoring (default 2, CI's cores; 1: in-process)"
+    )
     c.set_defaults(func=main_check)
 
     b = sub.add_parser(
@@ -136,6 +139,12 @@ def main_check(args: argparse.Namespace) -> int:
         except ValueError:
             _err(f"--seeds must be comma-separated integers, got {args.seeds!r}")
             return 2
+    if args.workers < 1:
+        _err(f"--workers must be >= 1, got {args.workers}")
+        return 2
+    if not Path(args.dir).is_dir():
+        _err(f"--dir {args.dir} is not a folder (the leaderboard folder holds protocol.json)")
+        return 2
     print(f"leaderboard check: {Path(args.dir)}")
     report = check_leaderboard(
         args.dir,
@@ -145,6 +154,7 @@ def main_check(args: argparse.Namespace) -> int:
         seeds=seeds,
         pages=not args.no_pages,
         progress=lambda m: print(f"  {m}", flush=True),
+        workers=args.workers,
     )
     print_report(report)
     return 0 if report.ok else 1
@@ -163,6 +173,35 @@ def main_build(args: argparse.Namespace) -> int:
     for path in write_pages(lb):
         print(f"wrote {path}")
     return 0
+
+
+def _submit_input_problem(args: argparse.Namespace, envs: list[str], protocol) -> str | None:
+    """One line saying what is wrong with ``submit``'s arguments, or None."""
+    from visuomotor_gym.leaderboard.entries import check_name
+    from visuomotor_gym.leaderboard.submit import SubmitError, default_name
+
+    if args.workers < 1:
+        return f"--workers must be >= 1, got {args.workers}"
+    unknown = [e for e in envs if protocol.for_env(e) is None]
+    if unknown:
+        return (
+            f"env id {unknown[0]!r} has no protocol in {Path(args.dir) / 'protocol.json'}; the leaderboard "
+            f"accepts {', '.join(protocol.env_ids)} (or --env all)"
+        )
+    try:
+        check_name(args.name if args.name is not None else default_name(args.agent))
+    except (ValueError, SubmitError) as exc:
+        return f"--name: {exc}"
+    if args.from_results is not None and not Path(args.from_results).is_file():
+        return f"--from-results {args.from_results} is not a file"
+    from visuomotor_gym.bench.evaluate import validate_inputs
+
+    first = protocol.for_env(envs[0])
+    try:
+        validate_inputs(args.agent, envs[0], first.episodes, first.seed, args.workers)
+    except (TypeError, ValueError, OSError) as exc:
+        return str(exc)
+    return None
 
 
 def main_submit(args: argparse.Namespace) -> int:
@@ -185,6 +224,19 @@ def main_submit(args: argparse.Namespace) -> int:
     if args.from_results and len(envs) != 1:
         _err("--from-results attaches one results file: give exactly one --env")
         return 2
+    problem = _submit_input_problem(args, envs, protocol)
+    if problem:  # every bad input is refused here, before any episode runs
+        _err(problem)
+        return 2
+    from visuomotor_gym.bench.provenance import git_state
+
+    sha, dirty = git_state()
+    if dirty is not False:
+        print(
+            f"warning: the checkout is {'dirty' if dirty else 'not a git checkout'} (git_sha {sha[:12]}): CI "
+            f"refuses new entries produced from uncommitted code; commit first, then submit",
+            file=sys.stderr,
+        )
     keys: list[str] = []
     written: list[Path] = []
     for env_id in envs:

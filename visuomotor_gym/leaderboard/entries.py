@@ -10,9 +10,10 @@ leaderboard folder:
   (seed, caught, diverged, steps, catch time, miss distance, first-saccade time);
 * ``agents/<key><suffix>``: the policy file (absent for agents with nothing to configure).
 
-``leaderboard/superseded.json`` (optional) lists entries that no longer reproduce because the code
-they ran moved on: they stay on the leaderboard, immutable and hash-checked, but are not re-scored and
-are shown apart. Entries are never deleted or rewritten.
+``leaderboard/superseded.json`` (optional, ``superseded_schema.json``) lists entries retired by a
+newer version of the same agent (``by``), e.g. because the code they ran moved on: they stay on the
+leaderboard, immutable and hash-checked, but are not re-scored and are shown apart. Entries are never
+deleted or rewritten. (Which listings a pull request may add: :mod:`.history`.)
 """
 
 from __future__ import annotations
@@ -25,7 +26,7 @@ from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
 
-from visuomotor_gym.leaderboard.problems import Problem
+from visuomotor_gym.leaderboard.problems import Problem, load_schema, schema_problems
 
 RESULTS_DIR = "results"
 AGENTS_DIR = "agents"
@@ -40,8 +41,17 @@ def entry_key(name: str, env_id: str) -> str:
     return f"{name}__{env_id}"
 
 
+# File names are <name>__<env_id>.entry.json: 100 characters of name keep them well under the 255
+# bytes most file systems allow (modelling choice).
+MAX_NAME_LENGTH = 100
+
+
 def check_name(name: str) -> str:
     """Return ``name`` if it is a valid entry name, else raise ValueError saying why."""
+    if isinstance(name, str) and name == "":
+        raise ValueError("entry name is empty: give --name a name such as eyecatch-tuned")
+    if isinstance(name, str) and len(name) > MAX_NAME_LENGTH:
+        raise ValueError(f"entry name is {len(name)} characters long; at most {MAX_NAME_LENGTH} are allowed")
     if not isinstance(name, str) or not NAME_RE.match(name) or "__" in name:
         raise ValueError(
             f"entry name {name!r} must start with a letter or digit and hold only letters, "
@@ -114,20 +124,9 @@ def dumps_record(record: dict) -> str:
 
 def record_problems(obj) -> list[str]:
     """Schema problems of an entry record, each with its JSON path."""
-    from jsonschema import Draft202012Validator
-
     if not isinstance(obj, dict):
         return [f"$: expected a JSON object, got {type(obj).__name__}"]
-    out = []
-    for err in Draft202012Validator(load_entry_schema()).iter_errors(obj):
-        path = "$" + "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in err.absolute_path)
-        if err.validator == "required" and isinstance(err.instance, dict):
-            out += [
-                f"{path}.{n}: missing required field" for n in err.validator_value if n not in err.instance
-            ]
-        else:
-            out.append(f"{path}: {err.message}")
-    return sorted(set(out))
+    return schema_problems(obj, load_entry_schema())
 
 
 @dataclass
@@ -159,6 +158,7 @@ class Leaderboard:
     protocol: object | None  # Protocol, or None when protocol.json is broken
     entries: list[Entry] = field(default_factory=list)
     problems: list[Problem] = field(default_factory=list)
+    superseded: dict[str, dict] = field(default_factory=dict)  # superseded.json's listings
 
     def rel(self, path: Path) -> str:
         """``path`` relative to the leaderboard folder's parent (``leaderboard/results/x.json``)."""
@@ -213,7 +213,7 @@ def load_leaderboard(root) -> Leaderboard:
         key = p.name[: -len(RECORD_SUFFIX)] if kind == "record" else p.name[: -len(".json")]
         keys.setdefault(key, {})[kind] = p
 
-    superseded = _load_superseded(lb)
+    superseded = lb.superseded = _load_superseded(lb)
     for key, paths in sorted(keys.items()):
         parts = key.split("__")
         results_path = paths.get("results", results_dir / f"{key}.json")
@@ -282,14 +282,15 @@ def _load_superseded(lb: Leaderboard) -> dict[str, dict]:
     except ValueError as exc:
         lb.problems.append(Problem(lb.rel(path), "layout", f"malformed JSON: {exc}"))
         return {}
-    items = obj.get("superseded") if isinstance(obj, dict) else None
-    if not isinstance(items, dict) or not all(
-        isinstance(v, dict) and isinstance(v.get("reason"), str) for v in items.values()
-    ):
+    problems = schema_problems(obj, load_schema("superseded_schema.json"))
+    if problems:
         lb.problems.append(
             Problem(
-                lb.rel(path), "layout", 'expected {"superseded": {"<name>__<env_id>": {"reason": "..."}}}'
+                lb.rel(path),
+                "layout",
+                'expected {"superseded": {"<name>__<env_id>": {"reason": "...", "by": "<name>__<env_id>"}}}: '
+                + "; ".join(problems),
             )
         )
         return {}
-    return items
+    return obj["superseded"]

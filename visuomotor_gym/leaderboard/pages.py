@@ -3,7 +3,7 @@
 Both are pure functions of ``protocol.json`` and the entries (no generation time, no software
 versions, no env registry), so the check regenerates them and compares bytes. The plots are
 hand-written inline SVG (no JavaScript, no external files, no matplotlib version in the bytes):
-catch rate with its 95 % Wilson interval per env id along the observability ladder, the gaze-realism
+success rate with its 95 % Wilson interval per env id along the observability ladder, the gaze-realism
 components as a heat map, and policy latency (p50-p95, max) against the control period.
 """
 
@@ -55,7 +55,11 @@ class Row:
 
 
 def _rows(lb: Leaderboard) -> tuple[list[Row], list[Row]]:
-    """(current rows, superseded rows), in ladder order, then by catch rate (best first), then name."""
+    """(current rows, superseded rows), in ladder order, then by success rate (best first), then name.
+
+    The success rate is the results' family-neutral ``success_rate``; results written before it
+    existed carry only ``catch_rate``, which on the catch env ids is the same number.
+    """
     from visuomotor_gym.agents import is_deterministic, parse_agent_spec
 
     ladder = list(lb.protocol.env_ids) if lb.protocol is not None else []
@@ -78,9 +82,9 @@ def _rows(lb: Leaderboard) -> tuple[list[Row], list[Row]]:
                 name=e.name,
                 agent=r["agent"],
                 env_id=r["env_id"],
-                rate=float(r["catch_rate"]),
-                ci=(float(r["catch_rate_ci95"][0]), float(r["catch_rate_ci95"][1])),
-                caught=int(r["caught"]),
+                rate=float(r.get("success_rate", r["catch_rate"])),
+                ci=tuple(float(x) for x in r.get("success_rate_ci95", r["catch_rate_ci95"])),
+                caught=round(float(r.get("success_rate", r["catch_rate"])) * int(r["episodes"])),
                 episodes=int(r["episodes"]),
                 realism=r["gaze_realism"]["score"],
                 components=r["gaze_realism"]["components"],
@@ -156,7 +160,8 @@ def render_readme(lb: Leaderboard) -> str:
         "vision or a bounce. "
         "[The page with plots](index.html) shows the same entries.",
         "",
-        "| agent | env id | catch rate [95 % CI] | gaze realism | latency p95 | real time | episodes | seeds "
+        "| agent | env id | success rate [95 % CI] | gaze realism | latency p95 (self-reported) | real time "
+        "| episodes | seeds "
         "| verified | commit | date |",
         "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
@@ -169,8 +174,8 @@ def render_readme(lb: Leaderboard) -> str:
             "",
             "Superseded entries (kept, immutable, no longer re-scored):",
             "",
-            "| agent | env id | catch rate [95 % CI] | commit | date | why |",
-            "|---|---|---|---|---|---|",
+            "| agent | env id | success rate [95 % CI] | commit | date | superseded by | why |",
+            "|---|---|---|---|---|---|---|",
         ]
         for r in old:
             lines.append(
@@ -183,6 +188,7 @@ def render_readme(lb: Leaderboard) -> str:
                         fmt_rate(r),
                         r.commit,
                         r.date,
+                        f"`{r.entry.superseded['by']}`",
                         r.entry.superseded["reason"],
                     )
                 )
@@ -193,8 +199,11 @@ def render_readme(lb: Leaderboard) -> str:
         "",
         "*gaze realism*: mean score in [0, 1] of the gaze components against the sourced human reference "
         "table (`visuomotor_gym/metrics/human_reference.json`); *latency*: policy compute time per control "
-        "step; *real time*: latency p95 below the control period; *verified*: entries are "
-        f"re-played by CI on {sample} of their pinned seeds.",
+        "step, as measured by the submitter (CI re-measures it on a new entry's re-scored episodes and "
+        "refuses a claim more than 10x below its own); *success rate*: episodes that met the task's goal "
+        "(on these catch env ids: the catch rate); *real time*: latency p95 below the control period; "
+        "*verified*: a new entry is re-played by CI on every pinned seed, and existing entries on "
+        f"{sample} seeds drawn from the base commit.",
         "",
         "## How the leaderboard is kept honest",
         "",
@@ -203,16 +212,26 @@ def render_readme(lb: Leaderboard) -> str:
         "",
         "* a results file that fails the results schema or its semantic checks (missing field, unknown env "
         "id, catch rate that is not caught / episodes, wrong Wilson interval, inconsistent real-time flag);",
-        "* provenance that does not name a commit, or a command that does not match the entry;",
+        "* a results or entry file with a key the schema does not know (every object is closed), or "
+        "without its `run` block;",
+        "* provenance that does not name a commit, or a command that does not match the entry; for a new "
+        "entry also a commit that is not in the repository's history, a dirty tree, or a run older than "
+        "its commit;",
         "* a run off the protocol (episodes, first seed), per-episode records that are not the pinned seeds "
         "or do not reproduce the results' numbers, or a results file whose sha256 differs from its entry "
         "record;",
-        "* a policy file whose sha256 differs from its entry record, or that the agent spec no longer "
-        "exports to;",
-        f"* an entry whose re-played sample of {sample} pinned seeds (one per stratum, chosen "
-        "from the sha256 of the results file) disagrees with its recorded outcomes;",
+        "* a policy file whose sha256 differs from its entry record, that the agent spec no longer "
+        "exports to, or in a retired format (policy files are JSON or `.npz` arrays with a JSON "
+        "architecture record: nothing is unpickled);",
+        "* a new entry whose re-play on every pinned seed disagrees with its records, or whose results "
+        "(success and catch rates, gaze realism, reaction times, distances, env steps) differ from those "
+        "recomputed from the re-played episodes, or whose latency claim is more than 10x below CI's;",
+        f"* an existing entry whose re-played sample of {sample} pinned seeds (one per stratum, drawn "
+        "from the base commit) disagrees with its recorded outcomes;",
         "* an entry deleted or rewritten relative to the main branch (entries are immutable: retire one by "
-        "listing it in `superseded.json`);",
+        "listing it in `superseded.json`, superseded `by` a newer version of the same agent);",
+        "* a `protocol.json` weakened for existing entries, or a `superseded.json` listing that is removed, "
+        "changed, names a new entry, or demotes another agent's entry;",
         "* pages (this file, `index.html`) that are not what `vmgym leaderboard build` generates.",
         "",
         "## Submitting",
@@ -280,7 +299,7 @@ def _empty(ident: str, label: str) -> str:
 
 def svg_catch_rate(rows: list[Row], ladder: list[str]) -> str:
     """Catch rate with its 95 % interval per env id (x: the ladder), one colour per agent name."""
-    label = "Catch rate with 95 % Wilson interval per env id, along the observability ladder"
+    label = "Success rate (catch rate) with 95 % Wilson interval per env id, along the observability ladder"
     if not rows or not ladder:
         return _empty("plot-catch-rate", label)
     names = _series(rows)
@@ -308,7 +327,7 @@ def svg_catch_rate(rows: list[Row], ladder: list[str]) -> str:
     )
     parts.append(
         f'<text transform="translate(16,{top + ph / 2:.1f}) rotate(-90)" text-anchor="middle" '
-        f'class="label">catch rate</text>'
+        f'class="label">success rate</text>'
     )
     for i, env_id in enumerate(ladder):
         cx, cy = left + step * (i + 0.5), top + ph + 12
@@ -535,8 +554,8 @@ def render_html(lb: Leaderboard) -> str:
     ladder = list(lb.protocol.env_ids) if lb.protocol is not None else []
     sample = lb.protocol.rescore_sample if lb.protocol is not None else "?"
     head = (
-        "<tr><th>agent</th><th>env id</th><th>catch rate [95 % CI]</th><th>gaze realism</th>"
-        "<th>latency p95</th><th>real time</th><th>episodes</th><th>seeds</th><th>verified</th>"
+        "<tr><th>agent</th><th>env id</th><th>success rate [95 % CI]</th><th>gaze realism</th>"
+        "<th>latency p95 (self-reported)</th><th>real time</th><th>episodes</th><th>seeds</th><th>verified</th>"
         "<th>commit</th><th>date</th></tr>"
     )
     body = "\n".join(f'<tr class="entry" data-entry="{E(r.key)}">{_cells_html(r)}</tr>' for r in rows)
@@ -559,7 +578,9 @@ def render_html(lb: Leaderboard) -> str:
         "line of sight, noisy, blind during saccades. Every number comes from the evaluator of "
         "<code>vmgym bench</code> on the standard protocol "
         '(<a href="protocol.json">protocol.json</a>), pinned '
-        f"seeds per env id; CI re-plays every entry on {sample} of its seeds.</p>",
+        f"seeds per env id; CI re-plays a new entry on every pinned seed and existing entries on {sample} "
+        "seeds drawn from the base commit. Latency is self-reported (CI refuses a claim more than 10x "
+        "below its own measurement).</p>",
         '<table id="leaderboard-table"><thead>',
         head,
         "</thead><tbody>",
@@ -585,13 +606,14 @@ def render_html(lb: Leaderboard) -> str:
         parts += [
             "<h2>Superseded entries</h2>",
             '<table id="superseded-table"><thead><tr><th>agent</th><th>env id</th>'
-            "<th>catch rate [95 % CI]</th>"
-            "<th>commit</th><th>date</th><th>why</th></tr></thead><tbody>",
+            "<th>success rate [95 % CI]</th>"
+            "<th>commit</th><th>date</th><th>superseded by</th><th>why</th></tr></thead><tbody>",
         ]
         parts += [
             f'<tr class="superseded" data-entry="{E(r.key)}"><td><code>{E(r.name)}</code></td><td><code>'
             f'{E(r.env_id)}</code></td><td class="num">{E(fmt_rate(r))}</td><td><code>{E(r.commit)}</code>'
-            f'</td><td>{E(r.date)}</td><td class="why">{E(r.entry.superseded["reason"])}</td></tr>'
+            f'</td><td>{E(r.date)}</td><td><code>{E(r.entry.superseded["by"])}</code></td>'
+            f'<td class="why">{E(r.entry.superseded["reason"])}</td></tr>'
             for r in old
         ]
         parts.append("</tbody></table>")
@@ -602,8 +624,12 @@ def render_html(lb: Leaderboard) -> str:
         "provenance naming the commit and the command.</li>",
         "<li>Each entry record holds the sha256 of its results file and policy file and the outcome of every "
         "pinned seed; the records must reproduce the published numbers.</li>",
-        f"<li>Every entry is re-played on {sample} of its pinned seeds (one per stratum) and must agree "
-        "with their records.</li>",
+        "<li>A new entry is re-played from its policy file on every pinned seed; its records and every "
+        "number of its results (success rate, gaze realism, reaction times...) must match the re-played "
+        f"episodes. Existing entries are re-played on {sample} seeds (one per stratum) drawn from the base "
+        "commit.</li>",
+        "<li>Policy files are JSON or <code>.npz</code> arrays with a JSON architecture record: nothing is "
+        "unpickled.</li>",
         "<li>Entries are immutable: CI refuses deleting or rewriting one relative to the main branch.</li>",
         "<li>This page and README.md are regenerated and compared byte for byte.</li>",
         "</ul>",

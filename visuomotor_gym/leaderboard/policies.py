@@ -6,12 +6,24 @@ with ``export``; ``vmgym leaderboard check`` verifies the file's sha256, verifie
 agent spec still exports to exactly these bytes (the spec is reproducible from the file), and
 re-scores the entry with the policy ``load`` builds from the file.
 
-Formats register with :func:`register_policy_format` (one per agent name): ``eyecatch-params``
-here (every :class:`~visuomotor_gym.baselines.eyecatch.EyecatchParams` field, resolved for the env
-id) and ``sb3-ppo-zip`` (a packed stable-baselines3 PPO/RecurrentPPO ``.zip`` with its
-``ppo_meta.json`` inside, from ``ppo:<run folder or zip>``). Agents without a
-format (``oracle``, ``zero``, ``random``: nothing to configure) have no policy file and are re-scored
-from their spec with :func:`visuomotor_gym.agents.make_agent`.
+Formats register with :func:`register_policy_format` (one current format per agent name):
+
+* ``eyecatch-params``: every :class:`~visuomotor_gym.baselines.eyecatch.EyecatchParams` field,
+  resolved for the env id (JSON);
+* ``belief-mpc-params``: every :class:`~visuomotor_gym.baselines.belief_mpc.agent.BeliefMPCParams`
+  field, resolved for the env id (JSON);
+* ``ppo-npz``: a trained PPO actor as ``.npy`` arrays plus a JSON record of its architecture and
+  normalisation (:func:`visuomotor_gym.baselines.ppo.agent.pack_npz`), converted from the SB3 model at
+  submit time. Loading it unpickles nothing and never calls ``torch.load``.
+
+**No policy file is ever unpickled by the check.** Every format's ``load`` reads JSON and plain
+``.npy`` arrays (``allow_pickle=False``) only, and checks every value's type. The retired format
+``sb3-ppo-zip`` (an SB3 zip: loading it runs cloudpickle on its ``data`` member, so a crafted file runs
+code) has no loader: entries that carry it are kept, hash-checked and shown only while superseded
+(``superseded.json``); a current entry with it is refused.
+
+Agents without a format (``oracle``, ``zero``, ``random``, ``belief_intercept``: nothing to configure)
+have no policy file and are re-scored from their spec with :func:`visuomotor_gym.agents.make_agent`.
 """
 
 from __future__ import annotations
@@ -36,6 +48,9 @@ class PolicyFormat:
     # that need not exist where the check runs; the hashed file *is* the policy, and re-scoring it
     # is the check.
     reexport: bool = True
+    # Why the format may no longer be loaded (None: current). A retired format's ``load`` is never
+    # called; its entries are only accepted while superseded.
+    retired: str | None = None
 
 
 _FORMATS: dict[str, PolicyFormat] = {}
@@ -51,11 +66,58 @@ def policy_format(name: str) -> PolicyFormat | None:
 
 
 def format_for_agent(agent_name: str) -> PolicyFormat | None:
-    """The format serving ``agent_name`` (None: the agent has no policy file)."""
+    """The current format serving ``agent_name`` (None: the agent has no policy file)."""
     for fmt in _FORMATS.values():
-        if fmt.agent == agent_name:
+        if fmt.agent == agent_name and fmt.retired is None:
             return fmt
     return None
+
+
+def _typed_params(params, cls, what: str) -> dict:
+    """``params`` checked against the dataclass ``cls``: exactly its fields, each value of its default's
+    JSON type (bool, int, float (an int is accepted), str). Raises ValueError naming the field."""
+    from dataclasses import MISSING, fields
+
+    known = {f.name: f for f in fields(cls)}
+    if not isinstance(params, dict) or set(params) != set(known):
+        missing = sorted(set(known) - set(params or {})) if isinstance(params, dict) else sorted(known)
+        unknown = sorted(set(params or {}) - set(known)) if isinstance(params, dict) else []
+        raise ValueError(f"params must hold exactly the {what} fields (missing {missing}, unknown {unknown})")
+    for name, f in known.items():
+        default = f.default if f.default is not MISSING else None
+        value = params[name]
+        if isinstance(default, bool):
+            ok = isinstance(value, bool)
+        elif isinstance(default, int):
+            ok = isinstance(value, int) and not isinstance(value, bool)
+        elif isinstance(default, float):
+            ok = isinstance(value, (int, float)) and not isinstance(value, bool)
+        elif isinstance(default, str):
+            ok = isinstance(value, str)
+        else:
+            ok = value is None or isinstance(value, (bool, int, float, str))
+        if not ok:
+            raise ValueError(f"params.{name} must be {type(default).__name__}, got {value!r}")
+    return params
+
+
+def _read_json_policy(data: bytes, fmt: str, env_id: str) -> dict:
+    try:
+        obj = json.loads(data.decode("utf-8"), parse_constant=_reject_constant)
+    except (UnicodeDecodeError, ValueError) as exc:
+        raise ValueError(f"not a {fmt} policy file: {exc}") from None
+    if not isinstance(obj, dict) or obj.get("format") != fmt or obj.get("format_version") != 1:
+        raise ValueError(f"not a {fmt} v1 policy file")
+    allowed = {"format", "format_version", "agent", "env_id", "note", "params"}
+    if set(obj) != allowed:
+        raise ValueError(f"a {fmt} policy file holds exactly the keys {sorted(allowed)}, got {sorted(obj)}")
+    if obj.get("env_id") != env_id:
+        raise ValueError(f"the policy file is for {obj.get('env_id')!r}, not {env_id!r}")
+    return obj
+
+
+def _reject_constant(name: str):
+    raise ValueError(f"{name} is not valid JSON")
 
 
 def sha256_bytes(data: bytes) -> str:
@@ -92,48 +154,97 @@ def _eyecatch_export(spec: str, env_id: str) -> bytes:
 
 
 def _eyecatch_load(data: bytes, env_id: str) -> Policy:
-    from dataclasses import fields
-
     from visuomotor_gym.baselines.eyecatch import EyecatchAgent, EyecatchParams
 
-    obj = json.loads(data.decode("utf-8"))
-    if not isinstance(obj, dict) or obj.get("format") != EYECATCH_FORMAT or obj.get("format_version") != 1:
-        raise ValueError(f"not an {EYECATCH_FORMAT} v1 policy file")
-    if obj.get("env_id") != env_id:
-        raise ValueError(f"the policy file is for {obj.get('env_id')!r}, not {env_id!r}")
-    params = obj.get("params")
-    known = {f.name for f in fields(EyecatchParams)}
-    if not isinstance(params, dict) or set(params) != known:
-        missing = sorted(known - set(params or {}))
-        unknown = sorted(set(params or {}) - known)
-        raise ValueError(
-            f"params must hold exactly the EyecatchParams fields (missing {missing}, unknown {unknown})"
-        )
+    obj = _read_json_policy(data, EYECATCH_FORMAT, env_id)
+    params = _typed_params(obj["params"], EyecatchParams, "EyecatchParams")
     return EyecatchAgent(EyecatchParams(**params))
 
 
 register_policy_format(PolicyFormat(EYECATCH_FORMAT, "eyecatch", ".json", _eyecatch_export, _eyecatch_load))
 
 
-# ------------------------------------------------------------------ sb3-ppo-zip
+# ------------------------------------------------------------------ belief-mpc-params
 
-PPO_FORMAT = "sb3-ppo-zip"
+BELIEF_MPC_FORMAT = "belief-mpc-params"
+
+
+def _belief_mpc_export(spec: str, env_id: str) -> bytes:
+    from dataclasses import asdict
+
+    from visuomotor_gym.agents import parse_agent_spec
+    from visuomotor_gym.baselines.belief_mpc import BeliefMPCAgent
+
+    name, overrides = parse_agent_spec(spec)
+    if name != "belief_mpc":
+        raise ValueError(f"the {BELIEF_MPC_FORMAT} format serves the belief_mpc agent, not {name!r}")
+    import visuomotor_gym  # noqa: F401  (registers the ids for gym.spec)
+
+    params = asdict(BeliefMPCAgent.for_env(env_id, **overrides).params)
+    obj = {
+        "format": BELIEF_MPC_FORMAT,
+        "format_version": 1,
+        "agent": spec,
+        "env_id": env_id,
+        "note": "Every BeliefMPCParams field as BeliefMPCAgent.for_env(env_id, **overrides) resolves it; "
+        "the policy is BeliefMPCAgent(BeliefMPCParams(**params)).",
+        "params": params,
+    }
+    return (json.dumps(obj, indent=2, allow_nan=False) + "\n").encode("utf-8")
+
+
+def _belief_mpc_load(data: bytes, env_id: str) -> Policy:
+    from visuomotor_gym.baselines.belief_mpc import BeliefMPCAgent
+    from visuomotor_gym.baselines.belief_mpc.agent import BeliefMPCParams
+
+    obj = _read_json_policy(data, BELIEF_MPC_FORMAT, env_id)
+    params = _typed_params(obj["params"], BeliefMPCParams, "BeliefMPCParams")
+    return BeliefMPCAgent(BeliefMPCParams(**params))
+
+
+register_policy_format(
+    PolicyFormat(BELIEF_MPC_FORMAT, "belief_mpc", ".json", _belief_mpc_export, _belief_mpc_load)
+)
+
+
+# ------------------------------------------------------------------ ppo-npz (and the retired sb3-ppo-zip)
+
+PPO_FORMAT = "ppo-npz"
+RETIRED_PPO_FORMAT = "sb3-ppo-zip"
 
 
 def _ppo_export(spec: str, env_id: str) -> bytes:
     from visuomotor_gym.agents import parse_agent_spec
-    from visuomotor_gym.baselines.ppo.agent import pack_policy
+    from visuomotor_gym.baselines.ppo.agent import pack_npz
 
     name, overrides = parse_agent_spec(spec)
     if name != "ppo" or set(overrides) != {"path"}:
-        raise ValueError(f"the {PPO_FORMAT} format serves ppo:<run folder or model zip>, not {spec!r}")
-    return pack_policy(overrides["path"])
+        raise ValueError(f"the {PPO_FORMAT} format serves ppo:<run folder, model zip or .npz>, not {spec!r}")
+    return pack_npz(overrides["path"])
 
 
 def _ppo_load(data: bytes, env_id: str) -> Policy:
     from visuomotor_gym.baselines.ppo.agent import PPOAgent
 
-    return PPOAgent.from_bytes(data, env_id)
+    return PPOAgent.from_npz(data, env_id)
 
 
-register_policy_format(PolicyFormat(PPO_FORMAT, "ppo", ".zip", _ppo_export, _ppo_load, reexport=False))
+register_policy_format(PolicyFormat(PPO_FORMAT, "ppo", ".npz", _ppo_export, _ppo_load, reexport=False))
+
+
+def _retired(*_args):
+    raise ValueError(f"the {RETIRED_PPO_FORMAT} format is retired: loading an SB3 zip unpickles it")
+
+
+register_policy_format(
+    PolicyFormat(
+        RETIRED_PPO_FORMAT,
+        "ppo",
+        ".zip",
+        _retired,
+        _retired,
+        reexport=False,
+        retired="an SB3 zip cannot be loaded without unpickling (cloudpickle runs code from its data "
+        f"member); re-submit the policy, which writes the pickle-free {PPO_FORMAT} format",
+    )
+)

@@ -16,7 +16,10 @@ import json
 from dataclasses import dataclass
 from pathlib import Path
 
+from visuomotor_gym.leaderboard.problems import load_schema, schema_problems
+
 PROTOCOL_FILE = "protocol.json"
+PROTOCOL_SCHEMA = "protocol_schema.json"
 PROTOCOL_VERSION = 1
 
 
@@ -69,17 +72,29 @@ def _num(obj: dict, key: str, where: str) -> float:
     return float(value)
 
 
+def _reject_constant(name: str):
+    raise ValueError(f"{name} is not valid JSON")
+
+
+def read_protocol_json(text: str):
+    """Parse protocol.json text (NaN / Infinity refused)."""
+    return json.loads(text, parse_constant=_reject_constant)
+
+
 def load_protocol(leaderboard_dir) -> Protocol:
     """Read and check ``<leaderboard_dir>/protocol.json``; raises :class:`ProtocolError`."""
     path = Path(leaderboard_dir) / PROTOCOL_FILE
     try:
-        obj = json.loads(path.read_text(encoding="utf-8"))
+        obj = read_protocol_json(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
         raise ProtocolError(f"{path} is missing: the leaderboard has no protocol") from None
     except ValueError as exc:
         raise ProtocolError(f"{path}: malformed JSON: {exc}") from exc
     if not isinstance(obj, dict):
         raise ProtocolError(f"{path}: expected a JSON object")
+    problems = schema_problems(obj, load_schema(PROTOCOL_SCHEMA))
+    if problems:
+        raise ProtocolError(f"{path}: " + "; ".join(problems))
     if obj.get("protocol_version") != PROTOCOL_VERSION:
         raise ProtocolError(
             f"{path}: protocol_version must be {PROTOCOL_VERSION}, got {obj.get('protocol_version')!r}"
@@ -116,8 +131,12 @@ def sample_seeds(seeds: list[int], k: int, key: str) -> list[int]:
     """``k`` of ``seeds``: one from each of ``k`` equal contiguous strata, spread over the whole run.
 
     The position inside stratum ``j`` is ``sha256(f"{key}:{j}") mod len(stratum)``: deterministic for
-    a given ``key`` (the sha256 of the entry's results file), so anyone re-running the check re-plays
-    the same seeds, yet not fixed in advance for all entries. ``k >= len(seeds)`` gives every seed.
+    a given ``key``, so anyone re-running the check re-plays the same seeds. The check uses it for
+    *existing* entries only, keyed by the base commit and the entry (``"<base sha>:<entry key>"``),
+    which exist before any pull request and are not in the submitter's hands; a new entry is
+    re-scored on every pinned seed. (It was keyed by the sha256 of the results file, which the
+    submitter writes: a forger could vary a float until the sample fell on honest seeds.)
+    ``k >= len(seeds)`` gives every seed.
     """
     n = len(seeds)
     if k >= n:

@@ -108,7 +108,7 @@ def submit_one(
             f"env id {env_id!r} has no protocol in {root / 'protocol.json'}; the leaderboard "
             f"accepts {', '.join(protocol.env_ids)}"
         )
-    name = check_name(name or default_name(agent))
+    name = check_name(name if name is not None else default_name(agent))
     key = entry_key(name, env_id)
     results_path = root / RESULTS_DIR / f"{key}.json"
     record_path = root / RESULTS_DIR / f"{key}{RECORD_SUFFIX}"
@@ -119,8 +119,17 @@ def submit_one(
         )
     try:
         validate_inputs(agent, env_id, proto.episodes, proto.seed, workers)
-    except (TypeError, ValueError) as exc:
+    except (TypeError, ValueError, OSError) as exc:
         raise SubmitError(str(exc)) from exc
+    # The policy file before any episode runs (ppo: converted to the pickle-free ppo-npz and proven
+    # to give the SB3 model's actions), so a bad one is refused at once.
+    fmt0 = format_for_agent(parse_agent_spec(agent)[0])
+    policy_data = None
+    if fmt0 is not None:
+        try:
+            policy_data = fmt0.export(agent, env_id)
+        except (OSError, ValueError, TypeError, KeyError) as exc:
+            raise SubmitError(f"cannot write the {fmt0.name} policy file of {agent!r}: {exc}") from exc
 
     stored = None
     if from_results is not None:
@@ -147,7 +156,7 @@ def submit_one(
     fmt = format_for_agent(agent_name)
     policy = None
     if fmt is not None:
-        data = fmt.export(agent, env_id)
+        data = policy_data
         policy_path = root / AGENTS_DIR / f"{key}{fmt.suffix}"
         if policy_path.exists():
             if policy_path.read_bytes() != data:
