@@ -13,7 +13,8 @@ import pytest
 
 import visuomotor_gym  # noqa: F401  (registers the ids)
 from visuomotor_gym.baselines.oracle import InterceptOracle
-from visuomotor_gym.envs.catch import HAND_WORKSPACE, SEAT_ORIGIN
+from visuomotor_gym.body.seated import HAND_WORKSPACE
+from visuomotor_gym.core.frames import SEAT_ORIGIN
 
 ORACLE_ID = "EyeCatchOracle-v0"
 GRAVITY = np.array([0.0, 0.0, -9.81])

@@ -383,7 +383,7 @@ def test_joint_control(env_id):
     u.reset(seed=1)
     for _ in range(60):
         obs, *_ = u.step(action)
-    lo, hi = u._body_range[:, 0], u._body_range[:, 1]
+    lo, hi = u.body.joint_range[:, 0], u.body.joint_range[:, 1]
     target = lo + (setpoint + 1.0) * 0.5 * (hi - lo)
     np.testing.assert_allclose(obs[ObservationLayout().slices["body_qpos"]], target, atol=0.02)
     assert np.all(np.isfinite(obs))
@@ -417,7 +417,7 @@ def test_hand_target_at_workspace_edge_does_not_diverge(target):
 
 
 def test_hand_control_reaches_target():
-    from visuomotor_gym.envs.catch import HAND_WORKSPACE
+    from visuomotor_gym.body.seated import HAND_WORKSPACE
 
     env = gym.make("EyeCatch-v0").unwrapped
     target_seat = np.array([0.35, -0.3, 0.6])
@@ -644,7 +644,8 @@ def _corrupt(env, how: str) -> None:
     elif how == "qvel_nan":
         d.qvel[:] = np.nan
     elif how == "ball_qpos_nan":
-        d.qpos[env._ball_qpos : env._ball_qpos + 3] = np.nan
+        q = env.task.balls[0].qpos_adr
+        d.qpos[q : q + 3] = np.nan
     elif how == "qfrc_nan":  # produces a NaN qacc
         d.qfrc_applied[:] = np.nan
     else:

@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 
 import visuomotor_gym  # noqa: F401
-from visuomotor_gym.envs.catch import HAND_WORKSPACE, SEAT_ORIGIN
+from visuomotor_gym.body.seated import HAND_WORKSPACE
+from visuomotor_gym.core.frames import SEAT_ORIGIN
 
 
 def to_action(point_world):
@@ -37,7 +38,7 @@ def test_joint_control_drives_joints_to_setpoints():
     env = gym.make("EyeCatchOracle-v0", control="joint").unwrapped
     env.reset(seed=0)
     action = np.zeros(16, dtype=np.float32)
-    ranges = env._body_range
+    ranges = env.body.joint_range
     goal = ranges[:, 0] + 0.5 * (ranges[:, 1] - ranges[:, 0])  # action 0 -> mid-range
     for _ in range(60):
         obs, *_ = env.step(action)
@@ -50,7 +51,7 @@ def test_action_encoder_neck_ranges_match_the_model():
     from visuomotor_gym.envs.actions import NECK_RANGE_DEG, hand_action
 
     env = gym.make("EyeCatch-v0").unwrapped
-    np.testing.assert_allclose(np.radians(NECK_RANGE_DEG), env._neck_range, atol=1e-9)
+    np.testing.assert_allclose(np.radians(NECK_RANGE_DEG), env.head.range, atol=1e-9)
     a = hand_action([0.4, -0.2, 1.0], True, head=(np.radians(40.0), np.radians(-25.0)))
     assert a[3] == 1.0 and a[7] == pytest.approx(0.5) and a[8] == pytest.approx(-0.5)  # -25 of -50 deg
     np.testing.assert_allclose(a[:3], to_action([0.4, -0.2, 1.0]), atol=1e-6)

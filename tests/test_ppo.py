@@ -123,7 +123,7 @@ def test_belief_intercept_base_catches_with_exact_vision_and_maps_residuals():
     import gymnasium as gym
 
     from visuomotor_gym.baselines.ppo.belief import BeliefFeatures
-    from visuomotor_gym.envs.catch import HAND_WORKSPACE
+    from visuomotor_gym.body.seated import HAND_WORKSPACE
 
     env = gym.make("EyeCatchOracle-v0")
     obs, _ = env.reset(seed=3)

@@ -11,7 +11,9 @@ import pytest
 import visuomotor_gym  # noqa: F401
 from visuomotor_gym.assets import asset_path
 from visuomotor_gym.body import names
-from visuomotor_gym.envs.catch import HAND_WORKSPACE, SEAT_ORIGIN, EyeCatchEnv
+from visuomotor_gym.body.seated import HAND_WORKSPACE
+from visuomotor_gym.core.frames import SEAT_ORIGIN
+from visuomotor_gym.envs.catch import EyeCatchEnv
 from visuomotor_gym.envs.observation import SECOND_BALL_OBSERVATION, ObservationLayout, catch_observation
 from visuomotor_gym.scenarios.throws import ThrowDistribution, sample_second_throw, sample_throw
 

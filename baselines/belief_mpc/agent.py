@@ -48,7 +48,7 @@ from visuomotor_gym.baselines.eyecatch import KalmanParams
 from visuomotor_gym.baselines.eyecatch.agent import SHOULDER_WORLD
 
 from visuomotor_gym.envs.actions import hand_action
-from visuomotor_gym.envs.catch import SEAT_ORIGIN
+from visuomotor_gym.core.frames import SEAT_ORIGIN
 from visuomotor_gym.envs.observation import ObservationLayout, catch_observation
 from visuomotor_gym.registration import env_vision
 from visuomotor_gym.vision.foveation import VisionParams

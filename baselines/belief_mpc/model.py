@@ -50,10 +50,13 @@ alternative Eom compare against in their Fig. 4.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.linalg import solveh_banded
+
+from visuomotor_gym.core.head import neck_range_deg
+from visuomotor_gym.oculomotor.plant import OculomotorParams
 
 from .belief import (
     ObservationNoise,
@@ -89,10 +92,11 @@ class PlannerWeights:
 class Limits:
     """Bounds enforced softly by the planner (degrees, m/s)."""
 
-    eye_azimuth_deg: tuple[float, float] = (-44.2, 44.2)  # Eom 4.1
-    eye_elevation_deg: tuple[float, float] = (-47.1, 27.7)  # Eom 4.1
-    neck_yaw_deg: tuple[float, float] = (-80.0, 80.0)  # envs_assets/common/upper_body.xml
-    neck_pitch_deg: tuple[float, float] = (-50.0, 40.0)
+    # One source each: the eye ranges of OculomotorParams (Eom 4.1), the neck joints of the head+eye MJCF.
+    eye_azimuth_deg: tuple[float, float] = OculomotorParams().eye_azimuth_range_deg
+    eye_elevation_deg: tuple[float, float] = OculomotorParams().eye_elevation_range_deg
+    neck_yaw_deg: tuple[float, float] = field(default_factory=lambda: neck_range_deg()[0])
+    neck_pitch_deg: tuple[float, float] = field(default_factory=lambda: neck_range_deg()[1])
     eye_speed_deg_s: float = 800.0  # B of Eom 4.1 (peak saccade speed)
     hand_speed_m_s: float = 2.0  # Eyecatch 4.3
     range_margin_deg: float = 4.0  # keep this far inside the eye range (the env clamps at it)

@@ -37,7 +37,7 @@ from dataclasses import dataclass, fields, replace
 import numpy as np
 
 from visuomotor_gym.envs.actions import NECK_RANGE_DEG, hand_action
-from visuomotor_gym.envs.catch import SEAT_ORIGIN
+from visuomotor_gym.core.frames import SEAT_ORIGIN
 from visuomotor_gym.envs.observation import ObservationLayout
 from visuomotor_gym.oculomotor.plant import angles_from_direction, direction_from_angles, minimum_jerk
 from visuomotor_gym.registration import env_vision

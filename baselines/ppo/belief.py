@@ -28,7 +28,7 @@ import numpy as np
 from visuomotor_gym.baselines.eyecatch.agent import EyecatchAgent
 
 from visuomotor_gym.envs.actions import hand_target_action
-from visuomotor_gym.envs.catch import SEAT_ORIGIN
+from visuomotor_gym.core.frames import SEAT_ORIGIN
 from visuomotor_gym.envs.observation import ObservationLayout
 
 N_BELIEF = 10

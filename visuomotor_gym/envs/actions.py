@@ -7,10 +7,12 @@ import math
 
 import numpy as np
 
-from visuomotor_gym.envs.catch import HAND_WORKSPACE, SEAT_ORIGIN
+from visuomotor_gym.body.seated import HAND_WORKSPACE
+from visuomotor_gym.core.frames import SEAT_ORIGIN
+from visuomotor_gym.core.head import neck_range_deg
 from visuomotor_gym.oculomotor.plant import OculomotorParams
 
-NECK_RANGE_DEG = ((-80.0, 80.0), (-50.0, 40.0))  # yaw, pitch: envs_assets/common/upper_body.xml
+NECK_RANGE_DEG = neck_range_deg()  # yaw, pitch (degrees), read from envs_assets/common/head_eye.xml
 _FIX = OculomotorParams().fixation_range_m
 _LOG_FIX = (math.log(_FIX[0]), math.log(_FIX[1]))
 

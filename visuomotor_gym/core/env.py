@@ -1,0 +1,314 @@
+"""``VisuomotorEnv``: the Gymnasium skeleton every family shares.
+
+A concrete env builds its parts in ``__init__`` and calls :meth:`VisuomotorEnv._assemble`:
+
+* ``body`` - a body from :mod:`visuomotor_gym.body` (its action blocks, servo commands,
+  proprioception, its frame);
+* ``eye`` (:class:`~visuomotor_gym.core.eye.Eye`), ``head`` (:class:`~visuomotor_gym.core.head.Head`)
+  and ``retina`` (:class:`~visuomotor_gym.core.retina.Retina`) - the same for every body;
+* ``task`` - a module of :mod:`visuomotor_gym.tasks` (scene state, visual targets, observation
+  blocks, per-substep checks, evaluation, info).
+
+The skeleton owns the rest: action checks, the reset/step order, the physics loop with its
+divergence monitor, observation assembly from the declared blocks (the task's percepts, eye, head,
+body, the task's own state), info, rendering and pickling. The action is the body's blocks, then
+``gaze`` (2), ``fixation`` (1) and ``head`` (2).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import warnings
+
+import gymnasium as gym
+import mujoco
+import numpy as np
+
+from visuomotor_gym.assets import asset_path
+from visuomotor_gym.core import args
+from visuomotor_gym.core.eye import EYE_ACTION_STRUCTURE, EYE_BLOCKS
+from visuomotor_gym.core.head import HEAD_ACTION_STRUCTURE, HEAD_BLOCKS
+from visuomotor_gym.core.observation import ObservationLayout
+
+OBS_MODES = ("flat", "dict")
+_BAD_STATE_WARNINGS = (mujoco.mjtWarning.mjWARN_BADQPOS, mujoco.mjtWarning.mjWARN_BADQVEL,
+                       mujoco.mjtWarning.mjWARN_BADQACC)
+
+
+class VisuomotorEnv(gym.Env):
+    """The shared skeleton (see the module docstring). Not registered itself."""
+
+    metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 50}
+    # Camera sets of ``render_camera``; a family may override (names from its scene).
+    render_cameras: dict[str, tuple[str, ...]] = {}
+    eye_camera: str = ""
+
+    # --- construction -------------------------------------------------------------------------
+    def _load_physics(self, scene: str, control_dt: float) -> None:
+        """Compile ``scene`` (a file in ``envs_assets/``) and fix the control period."""
+        self.model = mujoco.MjModel.from_xml_path(str(asset_path(scene)))
+        self.data = mujoco.MjData(self.model)
+        physics_dt = float(self.model.opt.timestep)
+        self.n_substeps = args.whole_multiple(control_dt, physics_dt, "control_dt", minimum=1)
+        self.dt = self.n_substeps * physics_dt
+        self.metadata = {**self.metadata, "render_fps": int(round(1.0 / self.dt))}
+        self._bad_warnings = [int(w) for w in _BAD_STATE_WARNINGS]
+
+    def _assemble(self, *, body, eye, head, retina, task, obs_mode: str, width: int, height: int) -> None:
+        """Attach the parts, build the spaces and the observation layout."""
+        self.body, self.eye, self.head, self.retina, self.task = body, eye, head, retina, task
+        self.plant = eye.plant
+        self.frame = body.frame
+        self.obs_mode = args.choice(obs_mode, OBS_MODES, "obs_mode")
+        self.action_structure = {**body.action_structure, **EYE_ACTION_STRUCTURE, **HEAD_ACTION_STRUCTURE}
+        self._n_body_act = body.n_action
+        self.action_space = gym.spaces.Box(-1.0, 1.0, shape=(sum(self.action_structure.values()),), dtype=np.float32)
+        self.layout = ObservationLayout(
+            tuple(task.leading_blocks) + EYE_BLOCKS + HEAD_BLOCKS + tuple(body.observation_blocks)
+            + tuple(task.trailing_blocks)
+        )
+        self.observation_structure = self.layout.structure
+        self.observation_space = self.layout.flat_space() if obs_mode == "flat" else self.layout.dict_space()
+        self.width = args.integer(width, "width", low=1, high=8192)
+        self.height = args.integer(height, "height", low=1, high=8192)
+        self._renderers: dict[str, mujoco.Renderer] = {}
+        self._viewer = None
+        self._warned_human = False
+        self._needs_reset = True  # step() before the first reset() is an error
+        self._warned_after_end = False
+        self._reset_parts()
+
+    @classmethod
+    def _argument_names(cls) -> list[str]:
+        import inspect
+
+        params = inspect.signature(cls.__init__).parameters
+        return [p for p in params if p not in ("self", "unknown")]
+
+    def _reject_unknown(self, unknown: dict) -> None:
+        if unknown:
+            raise TypeError(
+                f"{type(self).__name__} got unknown argument(s) {sorted(unknown)}; "
+                f"allowed: {sorted(self._argument_names())}"
+            )
+
+    # --- Gymnasium API ------------------------------------------------------------------------
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        super().reset(seed=seed)
+        if options:
+            raise ValueError(f"reset options are not supported; got {sorted(options)}")
+        m, d = self.model, self.data
+        mujoco.mj_resetData(m, d)
+        self._reset_parts()
+        self.body.reset_pose(d)
+        self.head.reset(d)
+        d.ctrl[:] = 0.0
+        self.task.reset_episode(d, self.np_random)
+        mujoco.mj_forward(m, d)
+        # Live views of MuJoCo's bad-state warning counters (reading one costs ~0.1 us).
+        self._warning_stats = [d.warning[i] for i in self._bad_warnings]
+        self._warning_total = sum(w.number for w in self._warning_stats)
+        self._half_timestep = 0.5 * float(m.opt.timestep)
+
+        point, offset = self.task.initial_gaze()
+        gaze, distance = self.eye.look_at(d, point, offset)
+        self.eye.reset(d, gaze, self.task.initial_fixation(distance))
+        self.body.start(d)
+        obs = self._observe(saccading=False)
+        self._last_obs = obs.copy()
+        self._needs_reset = False
+        self._ended = False
+        self._warned_after_end = False
+        info = self._info(caught=False, missed=False, diverged=False, terms={})
+        info.update(self.task.reset_info())
+        return self._format(obs), info
+
+    def step(self, action):
+        if self._needs_reset:
+            raise RuntimeError(f"{type(self).__name__}.step() called before reset(); call env.reset(seed=...) first")
+        if self._ended and not self._warned_after_end:
+            gym.logger.warn(
+                "step() called after the episode ended (terminated=True); call reset(). "
+                "The simulation goes on, but its outcome is no longer scored."
+            )
+            self._warned_after_end = True
+        a, al = self._check_action(action)  # al: the same values in a list (cheaper to read than slices)
+        m, d = self.model, self.data
+        dt = self.dt
+        nb = self._n_body_act
+        plant_step = self.eye.command(al[nb], al[nb + 1], al[nb + 2], dt, self.n_substeps, self.np_random)
+        self.head.command(d, al[nb + 3], al[nb + 4], dt)
+        self.body.command(d, a, al, dt)
+        self.task.before_physics(d)
+
+        caught, diverged = self._simulate()
+        if diverged:
+            self._ended = True
+            info = self._info(caught=False, missed=False, diverged=True, terms={})
+            return self._format(self._last_obs.copy()), 0.0, True, False, info
+        mujoco.mj_kinematics(m, d)
+        mujoco.mj_comPos(m, d)
+        caught = caught or self.task.check_substep(d)
+        self.eye.apply(d)
+        obs = self._observe(saccading=plant_step.saccading)
+        self._last_obs = obs.copy()  # the fallback after divergence; the caller may edit ``obs``
+        self.eye.end_step()
+
+        reward, terms, terminated, task_info = self.task.evaluate(d, caught, a, self.eye)
+        info = self._generic_info(diverged=False, terms=terms)
+        info.update(task_info)
+        info["saccade_onset"] = plant_step.saccade_started
+        self._ended = self._ended or terminated
+        if self.render_mode == "human":
+            self.render()
+        return self._format(obs), reward, terminated, False, info
+
+    def render(self):
+        if self.render_mode is None:
+            gym.logger.warn("render() called without a render_mode; pass render_mode='rgb_array' or 'human'")
+            return None
+        mujoco.mj_kinematics(self.model, self.data)  # the eye joints were written after the last step
+        if self.render_mode == "human":
+            return self._render_human()
+        frames = [self._render_camera(c) for c in self.render_cameras[self.render_camera]]
+        return frames[0] if len(frames) == 1 else np.concatenate(frames, axis=1)
+
+    def close(self):
+        for r in self._renderers.values():
+            r.close()
+        self._renderers = {}
+        if self._viewer is not None:
+            self._viewer.close()
+            self._viewer = None
+
+    def __getstate__(self):
+        state = self.__dict__.copy()
+        state["_renderers"] = {}
+        state["_viewer"] = None
+        state.pop("_warning_stats", None)  # views into self.data: rebuilt on load
+        return state
+
+    def __setstate__(self, state):
+        self.__dict__.update(state)
+        if "_warning_total" in state:
+            self._warning_stats = [self.data.warning[i] for i in self._bad_warnings]
+
+    # --- pieces of a step ---------------------------------------------------------------------
+    def _reset_parts(self) -> None:
+        self.task.reset_state()
+        self.eye.reset_state()
+        self.retina.reset()
+
+    def _check_action(self, action) -> tuple[np.ndarray, list]:
+        """The action as float64, clipped to [-1, 1], and the same values as a list; errors say why not."""
+        if type(action) is np.ndarray and action.shape == self.action_space.shape and action.dtype.kind == "f":
+            a = action.astype(np.float64)  # the common case: a float array of the right shape
+        else:
+            try:
+                a = np.asarray(action)
+            except (TypeError, ValueError) as exc:
+                raise ValueError(f"action must be a numeric array of shape {self.action_space.shape}; got {action!r}") from exc
+            if a.dtype.kind not in "biuf":
+                raise ValueError(
+                    f"action must be a real numeric array of shape {self.action_space.shape}; got dtype {a.dtype}"
+                )
+            a = a.astype(np.float64)
+            if a.shape != self.action_space.shape:
+                raise ValueError(
+                    f"action must have shape {self.action_space.shape} (blocks {self.action_structure}), got shape {a.shape}"
+                )
+        values = a.tolist()
+        if not math.isfinite(sum(values)) and not all(map(math.isfinite, values)):  # NaN or inf somewhere
+            bad = np.flatnonzero(~np.isfinite(a)).tolist()
+            raise ValueError(f"action contains NaN or inf at index {bad}: {values}; actions must be finite in [-1, 1]")
+        if min(values) < -1.0 or max(values) > 1.0:
+            a = np.clip(a, -1.0, 1.0)
+            values = a.tolist()
+        return a, values
+
+    def _simulate(self) -> tuple[bool, bool]:
+        """Run the physics substeps; return (the task's substep check fired, diverged)."""
+        m, d = self.model, self.data
+        fired = False
+        t_expected = d.time + self.dt
+        task = self.task
+        if not task.needs_substep_checks(d):
+            mujoco.mj_step(m, d, nstep=self.n_substeps)
+        else:  # the task's event (a catch) may happen within this step: check every substep
+            for _ in range(self.n_substeps):
+                mujoco.mj_step(m, d)
+                if not fired and task.check_substep(d):
+                    fired = True
+        # MuJoCo checks qpos/qvel/qacc every substep (NaN, inf or > 1e10), counts a warning and resets
+        # the data (time back to 0) when one is bad: either sign is our divergence signal.
+        total = self._warning_stats[0].number + self._warning_stats[1].number + self._warning_stats[2].number
+        return fired, total != self._warning_total or abs(d.time - t_expected) > self._half_timestep
+
+    def _observe(self, saccading: bool) -> np.ndarray:
+        d = self.data
+        samples = self.retina.sample(d, self.task.targets, self.eye, saccading, self.np_random)
+        values: list = []
+        self.task.observe_leading(values, samples)
+        self.eye.observe(values, self.frame)
+        self.head.observe(values, d)
+        self.body.observe(values, d)
+        self.task.observe_trailing(values, samples, d)
+        return np.array(values, dtype=np.float32)
+
+    def _format(self, obs: np.ndarray):
+        if self.obs_mode == "flat":
+            return obs
+        return self.layout.to_dict(obs)
+
+    def _generic_info(self, *, diverged: bool, terms: dict) -> dict:
+        d = self.data
+        plant = self.plant
+        info = {
+            "is_success": bool(self.task.success),
+            "physics_diverged": diverged,
+            "reward_terms": terms,
+            "in_saccade": plant.saccade is not None,
+            "saccade_onset": False,
+            "time": float(d.time),
+            "hand_pos": self.body.hand_pos(d).copy(),
+            "gaze_dir": plant.gaze.copy(),
+            "eye_pos": np.array(self.eye.pos_list),
+        }
+        info.update(self.head.info(d))
+        return info
+
+    def _info(self, *, caught: bool, missed: bool, diverged: bool, terms: dict) -> dict:
+        """Step information. The true state in here is for scoring only: never feed it to a policy."""
+        info = self._generic_info(diverged=diverged, terms=terms)
+        info.update(self.task.info(self.data, caught=caught, missed=missed, diverged=diverged))
+        return info
+
+    # --- rendering ----------------------------------------------------------------------------
+    def _render_camera(self, camera: str) -> np.ndarray:
+        renderer = self._renderers.get(camera)
+        if renderer is None:
+            renderer = mujoco.Renderer(self.model, self.height, self.width)
+            self._renderers[camera] = renderer
+        renderer.update_scene(self.data, camera=camera)
+        if camera != self.eye_camera:
+            self.eye.draw(renderer.scene)
+        return renderer.render().copy()
+
+    def _render_human(self):
+        headless = not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+        if headless or os.environ.get("MUJOCO_GL", "glfw") in ("egl", "osmesa"):
+            if not self._warned_human:
+                warnings.warn(
+                    "render_mode='human' needs a display and MUJOCO_GL=glfw; nothing is shown. "
+                    "Use render_mode='rgb_array' headless.",
+                    stacklevel=2,
+                )
+                self._warned_human = True
+            return None
+        if self._viewer is None:
+            import mujoco.viewer
+
+            self._viewer = mujoco.viewer.launch_passive(self.model, self.data)
+        self._viewer.sync()
+        return None

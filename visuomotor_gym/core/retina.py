@@ -1,0 +1,112 @@
+"""The retina: what the eye perceives of the scene's visual targets.
+
+A :class:`VisualTarget` is anything visible (a ball, an obstacle, a stepping stone, a pedestrian, a
+shelf object) with a world position and velocity. :meth:`Retina.sample` turns each target into one
+visual sample per control step through the foveated noise model of
+:mod:`visuomotor_gym.vision.foveation` (Eyecatch Eq. 1-3), with saccadic suppression, the field of
+view and the visual-delay line. The sample is ``(position, velocity, visible)`` in the eye frame at
+sampling time (lists of floats; zeros when not visible).
+"""
+
+from __future__ import annotations
+
+from collections import deque
+
+import mujoco
+import numpy as np
+
+from visuomotor_gym.geometry import rotate_t
+from visuomotor_gym.vision import foveation
+from visuomotor_gym.vision.foveation import VisionParams
+
+VISION_MODES = ("foveated", "full_view", "oracle")
+
+
+def nothing() -> tuple[list, list, bool]:
+    """The sample of a target that is not seen."""
+    return [0.0, 0.0, 0.0], [0.0, 0.0, 0.0], False
+
+
+class VisualTarget:
+    """Something the eye can see. Subclasses give its world position and velocity as arrays
+    (:meth:`state`) and say when the scene hides it (``hidden``: behind its thrower, out of play, not
+    yet placed); the retina decides the rest (field of view, saccades, noise, delay)."""
+
+    name: str = "target"
+    hidden: bool = False
+
+    def state(self, data: mujoco.MjData) -> tuple[np.ndarray, np.ndarray]:
+        raise NotImplementedError
+
+
+class FreeBodyTarget(VisualTarget):
+    """A target on a free joint: position and velocity are its qpos/qvel (world)."""
+
+    def __init__(self, name: str, qpos_adr: int, dof_adr: int) -> None:
+        self.name = name
+        self.qpos_adr = int(qpos_adr)
+        self.dof_adr = int(dof_adr)
+
+    def state(self, data: mujoco.MjData) -> tuple[np.ndarray, np.ndarray]:
+        q, v = self.qpos_adr, self.dof_adr
+        return data.qpos[q : q + 3], data.qvel[v : v + 3]
+
+
+class Retina:
+    """Visual samples of targets.
+
+    Parameters
+    ----------
+    mode : str
+        ``"foveated"`` (noise grows with eccentricity, nothing outside the field of view or during a
+        saccade), ``"full_view"`` (foveal noise everywhere; ``params.foveated`` must be False) or
+        ``"oracle"`` (the true state, noiseless).
+    params : VisionParams
+    delay_steps : int
+        Visual latency in control steps: a sample reaches the observation this many steps later
+        (nothing is seen before the first one arrives).
+    dt : float
+        Control period (s), for retinal slip.
+    """
+
+    def __init__(self, mode: str, params: VisionParams, delay_steps: int, dt: float) -> None:
+        if mode not in VISION_MODES:
+            raise ValueError(f"vision={mode!r} is not one of {list(VISION_MODES)}")
+        self.mode = mode
+        self.params = params
+        self.delay_steps = int(delay_steps)
+        self.dt = float(dt)
+        self.reset()
+
+    def reset(self) -> None:
+        self._delay: deque = deque(maxlen=self.delay_steps + 1)
+
+    def sample(self, data: mujoco.MjData, targets, eye, saccading: bool, rng: np.random.Generator) -> list:
+        """One sample per target (in order), after the visual-delay line."""
+        samples = [self._see(data, t, eye, saccading, rng) for t in targets]
+        if self.delay_steps:
+            self._delay.append(samples)
+            if len(self._delay) <= self.delay_steps:  # nothing has reached the brain yet
+                return [nothing() for _ in targets]
+            return self._delay[0]
+        return samples
+
+    def _see(self, data, target: VisualTarget, eye, saccading: bool, rng) -> tuple[list, list, bool]:
+        if target.hidden:
+            return nothing()
+        if self.mode == "oracle":
+            pos_eye, vel_eye = eye.to_eye(*target.state(data))
+            return pos_eye.tolist(), vel_eye.tolist(), True
+        vp = self.params
+        if vp.foveated and saccading:  # saccadic suppression
+            return nothing()
+        pos, vel = target.state(data)
+        ex, ey, ez = eye.pos_list
+        bx, by, bz = pos.tolist()
+        vx, vy, vz = vel.tolist()
+        rx, ry, rz = bx - ex, by - ey, bz - ez
+        rot = eye.rot_flat
+        pos_eye = list(rotate_t(rot, rx, ry, rz))  # R^T (p - r) and R^T v: Eyecatch Eq. 6-7
+        vel_eye = list(rotate_t(rot, vx, vy, vz))
+        retinal_speed = eye.retinal_speed(rx, ry, rz, vx, vy, vz, self.dt)
+        return foveation.perceive(pos_eye, vel_eye, retinal_speed, vp, rng)
