@@ -1,0 +1,658 @@
+"""The walker's scripted gait: a footstep-level interface on a kinematic gait that physics servos track.
+
+No learned gait (issue 12, DESIGN 2.0.1): the pelvis follows a trajectory planned through the
+footholds, the legs follow analytic two-link inverse kinematics toward planned foot poses, and MuJoCo
+contacts between the legs and the obstacles decide what happens. The agent chooses footsteps, as the
+high-level controller of footstep-planner gaits such as DeepLoco does.
+
+Timing (one *step* = heel strike to the other foot's heel strike; step ``j`` lands foothold ``j`` at
+time ``j * step_s``; even ``j`` = left foot)::
+
+    heel strike of j      toe-off of j-1          mid-stance of j        heel strike of j+1
+    |-- double support --|--------- swing of the other foot (j-1 -> j+1) ----------|
+    0                   0.1 s                    0.3 s                            0.5 s
+
+* **Footstep action.** :meth:`WalkerGait.set_next_footstep` stores ``(length, lateral, clearance)``;
+  at the mid-stance of foothold ``j`` the latest one is *latched* for foothold ``j + 2``, the next step
+  of the same foot: ``length`` forward of foothold ``j + 1``, ``lateral`` beside the nominal step width,
+  ``clearance`` = the lowest sole point's height during the carry phase of that swing. The foot lifts
+  ~0.3 s after the latch and lands ~0.7 s after it (the window from mid-stance to toe-off is when humans
+  use vision to choose the next foothold: Matthis, Barton & Fajen 2017, PNAS). Without a command the
+  nominal footstep is used.
+* **Pelvis.** Waypoints at each mid-stance (over the stance ankle, a little ahead, shifted toward the
+  stance foot) joined by a Catmull-Rom spline in time: each segment is fixed when it starts (its four
+  waypoints are known then), so the trajectory is C1 and never replanned. Height: a cosine bob peaking
+  at mid-stance (the head translates with the foot cycle, Iwao et al. seed 003, Fig. 4), lowered where a
+  long step needs it so both legs reach.
+* **Feet.** Stance: heel rocker during double support, flat, toe rocker from heel-off to toe-off (Perry's
+  gait phases). Swing: the ankle moves horizontally on a minimum-jerk profile while the lowest sole point
+  rises to ``clearance``, holds, and comes down onto the heel.
+* **Servos.** Every gait joint has an integrated-velocity servo (``force = kp (act - q) - kv q'``). Once
+  per control step the gait sets the setpoint velocity so the setpoint ramps (inside MuJoCo, every
+  substep) to the next target plus a velocity lead ``(kv + damping) / kp * q'_target``, which cancels the
+  servo's velocity lag: the joint tracks ``q_target`` with feed-forward, without Python per substep.
+* **Events** (:meth:`WalkerGait.check_contacts`, cheap when nothing touches: it returns at once when
+  ``data.ncon == 0``, and feet never touch the floor): a *trip* is a leg touching an obstacle in any other
+  way than a foot landing or standing on it; a *misstep* is a stance foot on an obstacle, or a swing foot
+  coming down onto an obstacle's top (contact normal within 45 deg of vertical) in the last part of its
+  swing.
+
+The ground is flat at z = 0 and supports the feet by construction: the floor is not in contact with the
+feet, the gait puts the stance soles at z = 0 (see ``envs_assets/README.md``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import mujoco
+import numpy as np
+
+from visuomotor_gym.body import walker_names as wn
+
+DEG = math.pi / 180.0
+LEFT, RIGHT = 0, 1
+
+
+@dataclass(frozen=True)
+class GaitParams:
+    """Timing, geometry and limits of the scripted gait (SI units; angles in degrees)."""
+
+    # 0.5 s per step = 120 steps/min (issue 12: ~0.5 s per step; free walking cadence is ~100-120
+    # steps/min); with the nominal 0.65 m step the speed is 1.3 m/s, inside the comfortable speeds of
+    # adults, 1.27-1.46 m/s (Bohannon 1997, Age Ageing 26:15).
+    step_s: float = 0.5
+    # Each double support is 10 % of the stride (Perry's gait phases: loading response 0-10 %).
+    double_support_s: float = 0.1
+    # Heel rise at ~31 % of the stride (Perry: terminal stance 31-50 %, toe-off at 60 %).
+    heel_off_s: float = 0.31
+    nominal_step_m: float = 0.65
+    # Step length and lateral offset limits of the action (modelling choice: what the leg reaches in
+    # 0.5 s with the pelvis lowered at most ~5 cm).
+    step_range_m: tuple[float, float] = (0.25, 0.95)
+    lateral_range_m: tuple[float, float] = (-0.3, 0.3)
+    # Lateral distance between the feet (modelling choice within the ~0.10-0.13 m reported for
+    # preferred walking); feet never come closer than ``min_step_width_m`` (they would cross).
+    step_width_m: float = 0.12
+    min_step_width_m: float = 0.06
+    # The lowest sole point's height in the carry phase of the swing (action "toe clearance").
+    # Nominal 5 cm and 2-45 cm range: modelling choice (covers the 5-30 cm obstacles of issue 12 with
+    # ~10-15 cm to spare).
+    nominal_clearance_m: float = 0.05
+    clearance_range_m: tuple[float, float] = (0.02, 0.45)
+    # Hip-joint height at mid-stance and the vertical excursion of the pelvis (and head) per step,
+    # peak to peak: modelling choice within the 3-5 cm usually reported for the centre of mass at
+    # 1.2-1.4 m/s (e.g. Orendurff et al. 2004, J Rehabil Res Dev 41:829 [recalled]).
+    pelvis_height_m: float = 0.915
+    bob_m: float = 0.04
+    # Pelvis side-to-side amplitude toward the stance foot, and how far ahead of the stance ankle it
+    # passes at mid-stance (modelling choices: COM sway ~4 cm peak to peak; the COM passes over the
+    # mid-foot, a few cm ahead of the ankle).
+    sway_m: float = 0.02
+    pelvis_lead_m: float = 0.04
+    # Foot angle to the floor at heel strike (toe up) and at toe-off (toe down): modelling choices
+    # (a neutral ankle under a shank inclined ~20-25 deg at initial contact; a steep push-off).
+    heel_strike_deg: float = 20.0
+    toe_off_deg: float = 45.0
+    # Swing profile, in fractions of the swing: the sole reaches the clearance at ``swing_rise``,
+    # starts down at ``swing_fall``; the ankle moves horizontally between ``swing_move`` (modelling choice).
+    swing_rise: float = 0.3
+    swing_fall: float = 0.7
+    swing_move: tuple[float, float] = (0.1, 0.9)
+    # Arm swing amplitude about the shoulder, opposite to the legs (modelling choice).
+    arm_swing_deg: float = 15.0
+    # The IK never asks for more than this fraction of the hip-ankle reach (the knee keeps >= ~16 deg).
+    max_reach: float = 0.99
+
+
+def _smooth(s: float) -> float:
+    """Minimum-jerk (quintic) 0 -> 1 on s in [0, 1], clipped outside."""
+    if s <= 0.0:
+        return 0.0
+    if s >= 1.0:
+        return 1.0
+    return s * s * s * (10.0 + s * (-15.0 + 6.0 * s))
+
+
+@dataclass
+class GaitEvent:
+    """One trip or misstep: when, what, which leg part touched which obstacle (pool index)."""
+
+    time: float
+    kind: str  # "trip" or "misstep"
+    side: int  # 0 left, 1 right
+    part: str  # "foot", "shin" or "thigh"
+    obstacle: int
+    normal_z: float
+
+
+@dataclass
+class FootPlan:
+    """A foot's planned pose at one instant (path frame u forward, v left; z up)."""
+
+    u: float
+    v: float
+    z: float  # ankle height
+    pitch: float  # radians, toe up positive
+    stance: bool
+    swing_fraction: float  # 0..1 in swing, -1 in stance
+    sole_h: float = 0.0  # planned height of the lowest sole point
+
+
+@dataclass
+class _Leg:
+    qpos: list = field(default_factory=list)
+    dof: list = field(default_factory=list)
+    lo: list = field(default_factory=list)
+    hi: list = field(default_factory=list)
+
+
+class ObstaclePool:
+    """The scene's pre-allocated obstacle boxes: placed, resized and parked per episode.
+
+    Each obstacle is a mocap body with one box geom. Resizing writes the geom's half-sizes and the
+    bounding volumes MuJoCo's collision broad- and mid-phase read (``geom_rbound``, ``geom_aabb``, the
+    body's BVH box), so the model is compiled once and obstacles stay real contact geometry.
+    """
+
+    PARK_Z = -5.0  # metres: parked obstacles sit under the floor, 40 m behind the start
+
+    def __init__(self, model: mujoco.MjModel) -> None:
+        m = model
+        self.geoms = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, n) for n in wn.WALKER_OBSTACLES]
+        self.bodies = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, n) for n in wn.WALKER_OBSTACLES]
+        self.mocap = [int(m.body_mocapid[b]) for b in self.bodies]
+        self.bvh = [int(m.body_bvhadr[b]) for b in self.bodies]
+        self._park = [m.body_pos[b].copy() for b in self.bodies]
+        self.index_of_geom = {g: i for i, g in enumerate(self.geoms)}
+        self.boxes: list[tuple[float, float, float, float, float] | None] = [None] * len(self.geoms)
+
+    def __len__(self) -> int:
+        return len(self.geoms)
+
+    def park_all(self, model: mujoco.MjModel, data: mujoco.MjData) -> None:
+        for i in range(len(self.geoms)):
+            self.park(model, data, i)
+
+    def park(self, model: mujoco.MjModel, data: mujoco.MjData, i: int) -> None:
+        """Move obstacle ``i`` out of the way (under the floor, behind the start) and mark it unused."""
+        data.mocap_pos[self.mocap[i]] = self._park[i]
+        data.mocap_quat[self.mocap[i]] = (1.0, 0.0, 0.0, 0.0)
+        self.boxes[i] = None
+
+    def place(self, model: mujoco.MjModel, data: mujoco.MjData, i: int, x: float, y: float,
+              length: float, width: float, height: float, yaw: float = 0.0, rgba=None) -> None:
+        """Stand obstacle ``i`` on the floor: footprint centre (x, y), ``length`` along its x axis (the
+        walking direction when ``yaw`` is the path heading), ``width`` across, ``height`` up (metres)."""
+        if min(length, width, height) <= 0.0:
+            raise ValueError(f"obstacle sizes must be positive, got {(length, width, height)}")
+        g = self.geoms[i]
+        half = (0.5 * length, 0.5 * width, 0.5 * height)
+        model.geom_size[g] = half
+        model.geom_rbound[g] = math.sqrt(half[0] ** 2 + half[1] ** 2 + half[2] ** 2)
+        model.geom_aabb[g] = (0.0, 0.0, 0.0) + half
+        if self.bvh[i] >= 0:
+            model.bvh_aabb[self.bvh[i]] = (0.0, 0.0, 0.0) + half
+        if rgba is not None:
+            model.geom_rgba[g] = rgba
+        data.mocap_pos[self.mocap[i]] = (x, y, half[2])
+        data.mocap_quat[self.mocap[i]] = (math.cos(0.5 * yaw), 0.0, 0.0, math.sin(0.5 * yaw))
+        # World-aligned footprint bounds, for the cheap "is anything near" test.
+        c, s = abs(math.cos(yaw)), abs(math.sin(yaw))
+        ex, ey = c * half[0] + s * half[1], s * half[0] + c * half[1]
+        self.boxes[i] = (x - ex, x + ex, y - ey, y + ey, height)
+
+    def near(self, x: float, y: float, radius: float) -> bool:
+        """Whether any placed obstacle's footprint comes within ``radius`` of (x, y)."""
+        for box in self.boxes:
+            if box is not None:
+                dx = max(box[0] - x, 0.0, x - box[1])
+                dy = max(box[2] - y, 0.0, y - box[3])
+                if dx * dx + dy * dy <= radius * radius:
+                    return True
+        return False
+
+
+class WalkerGait:
+    """Scripted gait of the walker (``envs_assets/walker.xml``): footstep commands in, servo setpoints out.
+
+    Use::
+
+        gait = WalkerGait(model)
+        gait.reset(model, data, x=0.0, y=0.0, yaw=0.0)     # walking at the nominal speed, left heel down at (x, y)
+        every control step (dt = n_substeps * timestep):
+            gait.set_next_footstep(length, lateral, clearance)   # latched at the next mid-stance
+            gait.advance(data, dt)                              # sets the servos' ctrl for this step
+            for each substep: mujoco.mj_step(model, data); gait.check_contacts(data)
+            # (or WalkerGait.step_physics, which skips the checks when no obstacle is near)
+    """
+
+    # Reach of the pelvis to an obstacle that a foot or shin could touch (m): feet are <= ~1 m away.
+    CONTACT_RADIUS_M = 1.3
+
+    def __init__(self, model: mujoco.MjModel, params: GaitParams | None = None) -> None:
+        self.p = p = params or GaitParams()
+        m = self.model = model
+        ts = float(m.opt.timestep)
+        self.timestep = ts
+
+        def ticks(seconds: float, what: str) -> int:
+            n = round(seconds / ts)
+            if n <= 0 or abs(n * ts - seconds) > 1e-9:
+                raise ValueError(f"{what}={seconds} s is not a whole number of {ts} s physics steps")
+            return n
+
+        self.T = ticks(p.step_s, "step_s")
+        self.T_ds = ticks(p.double_support_s, "double_support_s")
+        self.T_ho = ticks(p.heel_off_s, "heel_off_s")
+        self.T_mid = self.T_ds + (self.T - self.T_ds) // 2  # mid-stance = mid-swing of the other foot
+        if not self.T_ds < self.T_mid < self.T_ho < self.T + self.T_ds:
+            raise ValueError("gait timing must satisfy double support < mid-stance < heel-off < toe-off")
+
+        def jid(name):
+            j = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, name)
+            if j < 0:
+                raise ValueError(f"the model has no joint {name!r}: is it envs_assets/{wn.WALKER_SCENE}?")
+            return j
+
+        def bid(name):
+            return mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, name)
+
+        def sid(name):
+            return mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, name)
+
+        # Geometry read from the compiled model (one source: the XML).
+        thigh = bid(wn.WALKER_THIGHS[LEFT])
+        self.hip_y = float(m.body_pos[thigh][1])  # hip joint offset from the pelvis origin (left, +y)
+        self.L1 = -float(m.body_pos[bid(wn.WALKER_SHINS[LEFT])][2])
+        self.L2 = -float(m.body_pos[bid(wn.WALKER_FEET[LEFT])][2])
+        self.h_ankle = -float(m.site_pos[sid(wn.WALKER_SOLES[LEFT])][2])
+        self.l_toe = float(m.site_pos[sid(wn.WALKER_TOES[LEFT])][0])
+        self.l_heel = -float(m.site_pos[sid(wn.WALKER_HEELS[LEFT])][0])
+        self.d_max = p.max_reach * (self.L1 + self.L2)
+
+        joints = [jid(n) for n in wn.WALKER_GAIT_JOINTS]
+        self._qpos_idx = [int(m.jnt_qposadr[j]) for j in joints]
+        self._dof_idx = [int(m.jnt_dofadr[j]) for j in joints]
+        acts = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, n) for n in wn.WALKER_GAIT_ACTUATORS]
+        if min(acts) < 0:
+            raise ValueError("the model lacks some walker gait actuators")
+        self._act = np.array(acts)
+        if not np.array_equal(self._act, np.arange(acts[0], acts[0] + len(acts))):
+            raise ValueError("walker gait actuators must be consecutive")
+        self._ctrl = slice(acts[0], acts[0] + len(acts))
+        adr = [int(m.actuator_actadr[a]) for a in acts]
+        self._actslice = slice(adr[0], adr[0] + len(adr))
+        kp = m.actuator_gainprm[acts, 0]
+        kv = -m.actuator_biasprm[acts, 2]
+        damping = m.dof_damping[self._dof_idx]
+        self._lead = ((kv + damping) / kp).tolist()  # velocity lead of each servo setpoint (s)
+        rng = m.jnt_range[joints]
+        limited = m.jnt_limited[joints].astype(bool)
+        margin = 1.0 * DEG
+        self._lo = [float(r[0]) + margin if lim else -math.inf for r, lim in zip(rng, limited)]
+        self._hi = [float(r[1]) - margin if lim else math.inf for r, lim in zip(rng, limited)]
+
+        self.pelvis_body = bid(wn.WALKER_PELVIS)
+        self.sole_sites = [sid(n) for n in wn.WALKER_SOLES]
+        leg_geoms = {}
+        for side in (LEFT, RIGHT):
+            for part, name in zip(("thigh", "shin", "foot"), wn.WALKER_LEG_GEOMS[side]):
+                leg_geoms[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, name)] = (side, part)
+        self._leg_geoms = leg_geoms
+        self.pool = ObstaclePool(m)
+        self._ob_geom = self.pool.index_of_geom
+        self._n_ctrl_ticks = 0
+        self.reset_plan(0.0, 0.0, 0.0)
+
+    # ------------------------------------------------------------------ plan
+    def reset_plan(self, x: float, y: float, yaw: float) -> None:
+        """Nominal footholds around the start: foothold 0 (left) at the path origin (x, y)."""
+        p = self.p
+        self.origin = (float(x), float(y))
+        self.yaw = float(yaw)
+        self._c, self._s = math.cos(self.yaw), math.sin(self.yaw)
+        self.tick = 0
+        self.u = {}
+        self.v = {}
+        self.clearance = {}
+        half = 0.5 * p.step_width_m
+        for j in range(-3, 2):
+            self.u[j] = j * p.nominal_step_m
+            self.v[j] = half if j % 2 == LEFT else -half
+            self.clearance[j] = p.nominal_clearance_m
+        self.commanded = {}  # foothold index -> the (length, lateral, clearance) latched for it
+        self.pending = None
+        self.next_latch_tick = self.T_mid  # mid-stance of foothold 0 latches foothold 2
+        self.events: list[GaitEvent] = []
+        self.tripped = False
+        self.misstepped = False
+        self._touching: set = set()  # (side, part, obstacle) in contact at the last check
+        self._reported: set = set()  # (kind, side, foothold, obstacle) already reported
+
+    @staticmethod
+    def side_of(j: int) -> int:
+        return j % 2  # 0 = left (even footholds), 1 = right
+
+    def set_next_footstep(self, length: float, lateral: float = 0.0, clearance: float | None = None) -> None:
+        """The footstep to take next (metres): latched for the next step of the foot now in mid-stance.
+
+        ``length``: forward distance from the previous foothold (the other foot's); ``lateral``: offset
+        from the nominal step width, positive to the left; ``clearance``: height of the lowest sole point
+        over the swing's carry phase. Values are clipped to the ranges of :class:`GaitParams`."""
+        p = self.p
+        for name, value in (("length", length), ("lateral", lateral), ("clearance", clearance)):
+            if value is not None and not math.isfinite(value):
+                raise ValueError(f"footstep {name} must be finite, got {value}")
+        c = p.nominal_clearance_m if clearance is None else clearance
+        self.pending = (
+            min(max(float(length), p.step_range_m[0]), p.step_range_m[1]),
+            min(max(float(lateral), p.lateral_range_m[0]), p.lateral_range_m[1]),
+            min(max(float(c), p.clearance_range_m[0]), p.clearance_range_m[1]),
+        )
+
+    def _latch(self) -> None:
+        """Mid-stance of foothold k: fix foothold k + 2 from the pending command (or the nominal one)."""
+        p = self.p
+        k = (self.next_latch_tick - self.T_mid) // self.T
+        j = k + 2
+        cmd = self.pending or (p.nominal_step_m, 0.0, p.nominal_clearance_m)
+        self.pending = None
+        length, lateral, clearance = cmd
+        sign = 1.0 if self.side_of(j) == LEFT else -1.0
+        width = max(p.step_width_m + sign * lateral, p.min_step_width_m)
+        self.u[j] = self.u[j - 1] + length
+        self.v[j] = self.v[j - 1] + sign * width
+        self.clearance[j] = clearance
+        self.commanded[j] = cmd
+        for old in [i for i in self.u if i < j - 5]:
+            del self.u[old], self.v[old], self.clearance[old]
+        self.next_latch_tick += self.T
+
+    # ------------------------------------------------------------------ kinematic plan at one tick
+    def _pelvis_uv(self, tick: int) -> tuple[float, float]:
+        """Catmull-Rom through the mid-stance waypoints (uniform in time)."""
+        p = self.p
+        j = (tick - self.T_mid) // self.T  # segment from waypoint j to j + 1
+        s = (tick - self.T_mid - j * self.T) / self.T
+        pts = []
+        for i in (j - 1, j, j + 1, j + 2):
+            sign = 1.0 if self.side_of(i) == LEFT else -1.0
+            pts.append((self.u[i] + p.pelvis_lead_m, self.v[i] - sign * (0.5 * p.step_width_m - p.sway_m)))
+        out = []
+        s2, s3 = s * s, s * s * s
+        for a in range(2):
+            p0, p1, p2, p3 = pts[0][a], pts[1][a], pts[2][a], pts[3][a]
+            out.append(0.5 * (2.0 * p1 + (p2 - p0) * s + (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3) * s2
+                              + (3.0 * p1 - p0 - 3.0 * p2 + p3) * s3))
+        return out[0], out[1]
+
+    def _foot_from_pivot(self, pu: float, pivot_x: float, pitch: float) -> tuple[float, float]:
+        """Ankle (u, z) of a foot pitched by ``pitch`` whose sole point at foot-x ``pivot_x`` is on the
+        ground at u = ``pu``."""
+        c, s = math.cos(pitch), math.sin(pitch)
+        # ankle = pivot + R(pitch) (-pivot_x, h_ankle), R rotating x toward z (toe up positive)
+        return pu - pivot_x * c - self.h_ankle * s, -pivot_x * s + self.h_ankle * c
+
+    def _stance_foot(self, j: int, s_tick: int) -> FootPlan:
+        p = self.p
+        u, v = self.u[j], self.v[j]
+        if s_tick < self.T_ds:  # heel rocker
+            pitch = p.heel_strike_deg * DEG * (1.0 - _smooth(s_tick / self.T_ds))
+            au, az = self._foot_from_pivot(u - self.l_heel, -self.l_heel, pitch)
+        elif s_tick < self.T_ho:
+            pitch, au, az = 0.0, u, self.h_ankle
+        else:  # toe rocker until toe-off
+            pitch = -p.toe_off_deg * DEG * _smooth((s_tick - self.T_ho) / (self.T + self.T_ds - self.T_ho))
+            au, az = self._foot_from_pivot(u + self.l_toe, self.l_toe, pitch)
+        return FootPlan(au, v, az, pitch, True, -1.0)
+
+    def _swing_foot(self, j_from: int, j_to: int, tau: float) -> FootPlan:
+        p = self.p
+        a0u, _ = self._foot_from_pivot(self.u[j_from] + self.l_toe, self.l_toe, -p.toe_off_deg * DEG)
+        a1u, _ = self._foot_from_pivot(self.u[j_to] - self.l_heel, -self.l_heel, p.heel_strike_deg * DEG)
+        m0, m1 = p.swing_move
+        prog = _smooth((tau - m0) / (m1 - m0))
+        au = a0u + (a1u - a0u) * prog
+        av = self.v[j_from] + (self.v[j_to] - self.v[j_from]) * prog
+        pitch = (-p.toe_off_deg * (1.0 - _smooth(tau / 0.4)) + p.heel_strike_deg * _smooth((tau - 0.6) / 0.4)) * DEG
+        if tau < p.swing_rise:
+            lift = _smooth(tau / p.swing_rise)
+        elif tau > p.swing_fall:
+            lift = _smooth((1.0 - tau) / (1.0 - p.swing_fall))
+        else:
+            lift = 1.0
+        h = self.clearance[j_to] * lift
+        sp, cp = math.sin(pitch), math.cos(pitch)
+        lowest = min(self.l_toe * sp, -self.l_heel * sp) - self.h_ankle * cp  # sole corners vs the ankle
+        return FootPlan(au, av, h - lowest, pitch, False, tau, h)
+
+    def feet_at(self, tick: int) -> tuple[FootPlan, FootPlan]:
+        """Both feet's planned poses at ``tick`` (physics steps since reset), (left, right)."""
+        k = tick // self.T  # the current step: foothold k landed last
+        s = tick - k * self.T
+        lead = self._stance_foot(k, s)
+        if s < self.T_ds:
+            trail = self._stance_foot(k - 1, s + self.T)
+        else:
+            trail = self._swing_foot(k - 1, k + 1, (s - self.T_ds) / (self.T - self.T_ds))
+        return (lead, trail) if self.side_of(k) == LEFT else (trail, lead)
+
+    def targets_at(self, tick: int) -> list[float]:
+        """Joint targets of every gait joint (``WALKER_GAIT_JOINTS`` order) at ``tick``."""
+        p = self.p
+        pu, pv = self._pelvis_uv(tick)
+        phase = 2.0 * math.pi * ((tick - self.T_mid) % self.T) / self.T
+        z = p.pelvis_height_m - 0.5 * p.bob_m * (1.0 - math.cos(phase))
+        feet = self.feet_at(tick)
+        # Lower the pelvis where a leg would otherwise over-reach (long steps).
+        hips = []
+        for side, foot in enumerate(feet):
+            hy = self.hip_y if side == LEFT else -self.hip_y
+            du, dv = foot.u - pu, foot.v - (pv + hy)
+            zmax = foot.z + math.sqrt(max(self.d_max * self.d_max - du * du - dv * dv, 0.0))
+            if zmax < z:
+                z = zmax
+            hips.append((du, dv))
+        c, s = self._c, self._s
+        ox, oy = self.origin
+        out = [ox + c * pu - s * pv, oy + s * pu + c * pv, z, self.yaw]
+        for side, foot in enumerate(feet):
+            fx, fy = hips[side]  # path frame = pelvis heading frame (the pelvis keeps the path heading)
+            roll, hip, knee = self._leg_ik(fx, fy, foot.z - z)
+            ankle = foot.pitch - (hip - knee)
+            ia = 7 + 5 * side  # the ankle pitch's index in the target list
+            n_fix = 0
+            while not foot.stance and not self._lo[ia] <= ankle <= self._hi[ia] and n_fix < 4:
+                # A high swing behind the body needs more dorsiflexion than the ankle has: let the foot
+                # hang at the ankle's limit and raise the ankle so the lowest sole point keeps its height
+                # (a few fixed-point passes: the raised ankle changes the shank's angle a little).
+                pitch = min(max(ankle, self._lo[ia]), self._hi[ia]) + (hip - knee)
+                sp, cp = math.sin(pitch), math.cos(pitch)
+                lowest = min(self.l_toe * sp, -self.l_heel * sp) - self.h_ankle * cp
+                roll, hip, knee = self._leg_ik(fx, fy, foot.sole_h - lowest - z)
+                ankle = pitch - (hip - knee)
+                n_fix += 1
+            out += [roll, hip, knee, ankle, -roll]
+        arm = p.arm_swing_deg * DEG * math.cos(math.pi * (tick % (2 * self.T)) / self.T)
+        out += [-arm, arm]  # left arm back when the left foot lands
+        lo, hi = self._lo, self._hi
+        return [min(max(q, lo[i]), hi[i]) for i, q in enumerate(out)]
+
+    def _leg_ik(self, fx: float, fy: float, fz: float) -> tuple[float, float, float]:
+        """Hip roll, hip pitch and knee placing the ankle at (fx, fy, fz) from the hip joint (pelvis
+        heading frame): roll turns the leg's plane toward the ankle, then the two-link law of cosines in
+        that plane (the knee bends backward); beyond ``max_reach`` the leg stays at that reach."""
+        L1, L2 = self.L1, self.L2
+        roll = math.atan2(fy, -fz)
+        dperp = math.sqrt(fy * fy + fz * fz)
+        d2 = min(fx * fx + dperp * dperp, self.d_max * self.d_max)
+        cos_k = (d2 - L1 * L1 - L2 * L2) / (2.0 * L1 * L2)
+        knee = math.acos(min(max(cos_k, -1.0), 1.0))
+        hip = math.atan2(fx, dperp) + math.atan2(L2 * math.sin(knee), L1 + L2 * math.cos(knee))
+        return roll, hip, knee
+
+    # ------------------------------------------------------------------ MuJoCo side
+    def reset(self, model: mujoco.MjModel, data: mujoco.MjData, x: float = 0.0, y: float = 0.0,
+              yaw: float = 0.0) -> None:
+        """Start walking at the nominal speed: left heel striking at the path origin (x, y), heading
+        ``yaw``; joint positions, velocities and servo setpoints consistent with the plan; obstacles
+        are left as they are (see :class:`ObstaclePool`)."""
+        self.reset_plan(x, y, yaw)
+        q0 = self.targets_at(0)
+        qm, qp = self.targets_at(-1), self.targets_at(1)
+        qd = [(b - a) / (2.0 * self.timestep) for a, b in zip(qm, qp)]
+        for i, (qa, qv) in enumerate(zip(q0, qd)):
+            data.qpos[self._qpos_idx[i]] = qa
+            data.qvel[self._dof_idx[i]] = qv
+        data.act[self._actslice] = [q + lead * v for q, v, lead in zip(q0, qd, self._lead)]
+        data.ctrl[self._ctrl] = qd
+        self.t0 = float(data.time)
+        mujoco.mj_forward(model, data)
+
+    def advance(self, data: mujoco.MjData, dt: float) -> None:
+        """Plan the next ``dt`` seconds (a whole number of physics steps): latch footsteps whose
+        mid-stance falls in it, and set every gait servo's setpoint velocity so that its setpoint
+        reaches the target (with velocity lead) at the end of the step."""
+        n = round(dt / self.timestep)
+        if n < 1 or abs(n * self.timestep - dt) > 1e-9:
+            raise ValueError(f"dt={dt} is not a whole number of {self.timestep} s physics steps")
+        end = self.tick + n
+        while self.next_latch_tick <= end:
+            self._latch()
+        q1 = self.targets_at(end)
+        q0 = self.targets_at(end - 1)
+        rate = 1.0 / self.timestep
+        act = data.act[self._actslice].tolist()
+        inv_dt = 1.0 / (n * self.timestep)
+        data.ctrl[self._ctrl] = [
+            (b + lead * (b - a) * rate - s) * inv_dt for a, b, s, lead in zip(q0, q1, act, self._lead)
+        ]
+        self.tick = end
+
+    # ------------------------------------------------------------------ contacts
+    def phase_of(self, side: int, tick: int) -> tuple[bool, float]:
+        """(in stance, swing fraction or -1) of foot ``side`` at ``tick``."""
+        k = tick // self.T
+        s = tick - k * self.T
+        if self.side_of(k) == side or s < self.T_ds:
+            return True, -1.0
+        return False, (s - self.T_ds) / (self.T - self.T_ds)
+
+    def foothold_of(self, side: int, tick: int) -> int:
+        """The foothold foot ``side`` stands on (stance) or is swinging to (swing) at ``tick``."""
+        k = tick // self.T
+        if self.side_of(k) == side:
+            return k
+        return k - 1 if tick - k * self.T < self.T_ds else k + 1
+
+    def check_contacts(self, data: mujoco.MjData) -> bool:
+        """Classify leg-obstacle contacts; return True when a new trip or misstep began.
+
+        A touch (a leg part's side on one obstacle) is classified when it begins: a foot in stance, or
+        a foot in the last part of its swing touching an obstacle's top (normal within 45 deg of
+        vertical), is a *misstep*; anything else a *trip*. While the touch lasts it is not classified
+        again, a swing foot touching the obstacle it stood on at its last foothold is leaving it (part
+        of that misstep, not a trip), and each (kind, side, foothold, obstacle) is reported once."""
+        if data.ncon == 0:
+            if self._touching:
+                self._touching.clear()
+            return False
+        tick = self.tick_of(data)
+        geom = data.contact.geom
+        frame = data.contact.frame
+        touching = set()
+        new = False
+        for i in range(data.ncon):
+            g1, g2 = int(geom[i, 0]), int(geom[i, 1])
+            if g1 in self._ob_geom:
+                ob, leg = self._ob_geom[g1], self._leg_geoms.get(g2)
+                nz = float(frame[i, 2])  # MuJoCo's normal points from geom1 to geom2: here up = leg above
+            else:
+                ob, leg = self._ob_geom.get(g2), self._leg_geoms.get(g1)
+                nz = -float(frame[i, 2])
+            if ob is None or leg is None:
+                continue
+            side, part = leg
+            touch = (side, part, ob)
+            touching.add(touch)
+            if touch in self._touching:
+                continue
+            stance, tau = self.phase_of(side, tick)
+            j = self.foothold_of(side, tick)
+            if not stance and ("misstep", side, j - 2, ob) in self._reported:
+                continue  # leaving the obstacle it stood on: part of that misstep
+            landing = part == "foot" and (stance or (tau >= self.p.swing_fall and abs(nz) > math.sqrt(0.5)))
+            kind = "misstep" if landing else "trip"
+            key = (kind, side, j, ob)
+            if key in self._reported:
+                continue
+            self._reported.add(key)
+            if kind == "misstep":
+                self.misstepped = True
+            else:
+                self.tripped = True
+            self.events.append(GaitEvent(float(data.time) - self.t0, kind, side, part, ob, nz))
+            new = True
+        self._touching = touching
+        return new
+
+    def tick_of(self, data: mujoco.MjData) -> int:
+        return round((float(data.time) - self.t0) / self.timestep)
+
+    def step_physics(self, model: mujoco.MjModel, data: mujoco.MjData, n_substeps: int) -> bool:
+        """Run ``n_substeps`` physics steps, checking contacts after each one when an obstacle is
+        near the pelvis (else one ``mj_step`` call); return True when a trip or misstep began."""
+        x, y = float(data.qpos[self._qpos_idx[0]]), float(data.qpos[self._qpos_idx[1]])
+        if not self.pool.near(x, y, self.CONTACT_RADIUS_M):
+            mujoco.mj_step(model, data, nstep=n_substeps)
+            return False
+        new = False
+        for _ in range(n_substeps):
+            mujoco.mj_step(model, data)
+            new |= self.check_contacts(data)
+        return new
+
+    # ------------------------------------------------------------------ read-outs for tasks
+    @property
+    def time(self) -> float:
+        """Gait time (s) of the last planned target."""
+        return self.tick * self.timestep
+
+    def step_phase(self, tick: int | None = None) -> float:
+        """Fraction of the current step (0 at a heel strike) — the cycle of the head bob."""
+        t = self.tick if tick is None else tick
+        return (t % self.T) / self.T
+
+    def stride_phase(self, tick: int | None = None) -> float:
+        """Fraction of the stride (0 at a left heel strike)."""
+        t = self.tick if tick is None else tick
+        return (t % (2 * self.T)) / (2 * self.T)
+
+    @property
+    def next_footstep_index(self) -> int:
+        """Index of the foothold that the next latch (at the coming mid-stance) will fix."""
+        return (self.next_latch_tick - self.T_mid) // self.T + 2
+
+    @property
+    def next_latch_time(self) -> float:
+        """Gait time (s) of the coming mid-stance, when the pending footstep is read."""
+        return self.next_latch_tick * self.timestep
+
+    def current_step(self, tick: int | None = None) -> int:
+        """Index of the foothold that landed last."""
+        return (self.tick if tick is None else tick) // self.T
+
+    def foothold_world(self, j: int) -> tuple[float, float]:
+        """World (x, y) of planned foothold ``j`` (the sole point under the ankle when flat)."""
+        u, v = self.u[j], self.v[j]
+        return self.origin[0] + self._c * u - self._s * v, self.origin[1] + self._s * u + self._c * v
+
+    def feet_world(self, data: mujoco.MjData) -> np.ndarray:
+        """(2, 3) sole-site positions, left then right."""
+        return data.site_xpos[self.sole_sites].copy()
+
+    def pelvis_pose(self, data: mujoco.MjData) -> tuple[np.ndarray, float]:
+        """Pelvis world position and heading (rad)."""
+        return data.xpos[self.pelvis_body].copy(), float(data.qpos[self._qpos_idx[3]])
