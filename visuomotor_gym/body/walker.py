@@ -366,8 +366,6 @@ class WalkerGait:
         self.v[j] = self.v[j - 1] + sign * width
         self.clearance[j] = clearance
         self.commanded[j] = cmd
-        for old in [i for i in self.u if i < j - 5]:
-            del self.u[old], self.v[old], self.clearance[old]
         self.next_latch_tick += self.T
 
     # ------------------------------------------------------------------ kinematic plan at one tick

@@ -1,0 +1,286 @@
+"""The walker body and its scripted gait (``envs_assets/walker.xml``, ``visuomotor_gym/body/walker.py``).
+
+Real MuJoCo physics and contacts throughout: the servos track the gait, obstacles are real geoms, and
+trips and missteps are read from ``data.contact``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import mujoco
+import numpy as np
+import pytest
+
+from visuomotor_gym import assets
+from visuomotor_gym.body import names
+from visuomotor_gym.body import walker_names as wn
+from visuomotor_gym.body.walker import GaitParams, WalkerGait
+
+OBJ = {
+    "body": mujoco.mjtObj.mjOBJ_BODY,
+    "joint": mujoco.mjtObj.mjOBJ_JOINT,
+    "actuator": mujoco.mjtObj.mjOBJ_ACTUATOR,
+    "geom": mujoco.mjtObj.mjOBJ_GEOM,
+    "site": mujoco.mjtObj.mjOBJ_SITE,
+    "camera": mujoco.mjtObj.mjOBJ_CAMERA,
+}
+DT = 0.02  # control period of the catch family (10 physics substeps)
+NSUB = 10
+
+
+@pytest.fixture(scope="module")
+def model():
+    return mujoco.MjModel.from_xml_path(str(assets.asset_path(wn.WALKER_SCENE)))
+
+
+def walk(model, duration_s, command=None, setup=None, x=0.0, y=0.0, yaw=0.0, record=None, params=None):
+    """Reset a fresh walker, optionally place obstacles (``setup(gait, data)``), and walk
+    ``duration_s`` seconds; ``command(gait)`` returns the footstep to set each control step."""
+    model = model if params is None else mujoco.MjModel.from_xml_path(str(assets.asset_path(wn.WALKER_SCENE)))
+    data = mujoco.MjData(model)
+    gait = WalkerGait(model, params)
+    gait.pool.park_all(model, data)
+    if setup is not None:
+        setup(gait, data)
+    gait.reset(model, data, x, y, yaw)
+    n = round(duration_s / DT)
+    for _ in range(n):
+        if command is not None:
+            gait.set_next_footstep(*command(gait))
+        gait.advance(data, DT)
+        gait.step_physics(model, data, NSUB)
+        if record is not None:
+            record(gait, data)
+    return gait, data
+
+
+def test_model_compiles_and_every_walker_name_resolves(model):
+    for kind, group in wn.WALKER_ALL_NAMES.items():
+        missing = [n for n in group if mujoco.mj_name2id(model, OBJ[kind], n) < 0]
+        assert not missing, f"{kind} names missing from walker.xml: {missing}"
+
+
+def test_every_element_is_named(model):
+    unnamed = []
+    for kind, count in (("joint", model.njnt), ("actuator", model.nu), ("site", model.nsite),
+                        ("camera", model.ncam), ("geom", model.ngeom)):
+        unnamed += [(kind, i) for i in range(count) if not mujoco.mj_id2name(model, OBJ[kind], i)]
+    unnamed += [("body", i) for i in range(1, model.nbody) if not mujoco.mj_id2name(model, OBJ["body"], i)]
+    assert not unnamed
+
+
+def test_walker_carries_the_shared_head_eye_and_root_joints_come_first(model):
+    # The same neck and eye as the seated body (common/head_eye.xml), same ranges.
+    catch = mujoco.MjModel.from_xml_path(str(assets.asset_path("catch.xml")))
+    for j in names.NECK_JOINTS + (names.EYE_AZIMUTH, names.EYE_ELEVATION, names.EYE_FIXATION):
+        np.testing.assert_array_equal(model.joint(j).range, catch.joint(j).range)
+    for i, j in enumerate(wn.WALKER_ROOT_JOINTS):  # RootFrame / the gait read qpos 0..3 as the pelvis pose
+        assert model.jnt_qposadr[model.joint(j).id] == i
+    assert model.body(wn.WALKER_PELVIS).mocapid[0] == -1
+    assert all(model.body(n).mocapid[0] >= 0 for n in wn.WALKER_OBSTACLES)
+    assert 60.0 < model.body_subtreemass[model.body(wn.WALKER_PELVIS).id] < 85.0  # an adult (kg)
+
+
+def test_feet_collide_with_obstacles_only(model):
+    """Legs touch obstacles (contype/conaffinity 2), never the floor, each other or the trunk."""
+    floor = model.geom(wn.WALKER_FLOOR)
+    ob = model.geom(wn.WALKER_OBSTACLES[0])
+
+    def collide(a, b):
+        return bool(a.contype[0] & b.conaffinity[0]) or bool(b.contype[0] & a.conaffinity[0])
+
+    legs = [model.geom(n) for side in wn.WALKER_LEG_GEOMS for n in side]
+    for g in legs:
+        assert collide(g, ob) and not collide(g, floor)
+        assert not any(collide(g, h) for h in legs)
+    assert not collide(ob, floor)
+
+
+def _touchdowns(record_list, side):
+    """Times at which a foot's heel site comes down to the floor (z < 3 mm after being higher)."""
+    out, prev = [], True
+    for t, heels, _, _ in record_list:
+        down = heels[side] < 0.003
+        if down and not prev:
+            out.append(t)
+        prev = down
+    return out
+
+
+def test_flat_15m_walk_nominal_footsteps(model):
+    """15 m on flat ground with nominal footsteps: no events, feet on their footholds, human speed and
+    cadence, the head bobbing once per step."""
+    rows = []
+    heel_sites = [model.site(n).id for n in wn.WALKER_HEELS]
+    eye = model.site(names.EYE_CENTER).id
+    landed = []
+
+    def record(gait, data):
+        rows.append((gait.time, data.site_xpos[heel_sites, 2].copy(), float(data.qpos[0]),
+                     float(data.site_xpos[eye, 2])))
+        k = gait.current_step()
+        if gait.tick - k * gait.T == round(0.2 / gait.timestep):  # 0.2 s after heel strike: foot flat
+            sole = data.site_xpos[gait.sole_sites[gait.side_of(k)]]
+            landed.append((sole[0], sole[1], sole[2]) + gait.foothold_world(k))
+
+    gait, data = walk(model, 12.0, record=record)
+    assert float(data.qpos[0]) > 15.0
+    assert gait.events == [] and not gait.tripped and not gait.misstepped
+    landed = np.array(landed)
+    err = np.hypot(landed[:, 0] - landed[:, 3], landed[:, 1] - landed[:, 4])
+    assert len(landed) >= 22 and err.max() < 0.01, err.max()  # within 1 cm of the commanded foothold
+    assert np.abs(landed[:, 2]).max() < 0.005  # the sole on the floor
+
+    t = np.array([r[0] for r in rows])
+    x = np.array([r[2] for r in rows])
+    steady = t >= 1.0
+    speed = (x[steady][-1] - x[steady][0]) / (t[steady][-1] - t[steady][0])
+    assert 1.2 <= speed <= 1.4, speed  # issue 12: ~1.2-1.4 m/s (Bohannon 1997: 1.27-1.46 comfortable)
+    touch = sorted(_touchdowns(rows, 0) + _touchdowns(rows, 1))
+    step_s = np.diff(touch)
+    assert len(touch) >= 20 and 0.45 <= step_s.mean() <= 0.55 and step_s.std() < 0.01  # ~0.5 s per step
+    # Head bob: the eye rises and falls once per step, a few cm peak to peak, highest near mid-stance.
+    z = np.array([r[3] for r in rows])[steady]
+    assert 0.025 < z.max() - z.min() < 0.06
+    assert 1.55 < z.mean() < 1.68  # eye height ~1.6 m (Iwao's h)
+    spectrum = np.abs(np.fft.rfft(z - z.mean()))
+    freq = np.fft.rfftfreq(len(z), DT)
+    assert abs(freq[spectrum.argmax()] - 1.0 / gait.p.step_s) < 0.1
+
+
+def test_commanded_footsteps_land_where_told(model):
+    """Varied lengths and lateral offsets (read at mid-stance) land within 1 cm of the plan."""
+    rng = np.random.default_rng(3)
+    plan = {}
+
+    def command(gait):
+        j = gait.next_footstep_index
+        if j not in plan:
+            plan[j] = (float(rng.uniform(0.4, 0.9)), float(rng.uniform(-0.15, 0.15)), 0.05)
+        return plan[j]
+
+    landed = {}
+
+    def record(gait, data):
+        k = gait.current_step()
+        if gait.tick - k * gait.T == round(0.2 / gait.timestep):
+            landed[k] = data.site_xpos[gait.sole_sites[gait.side_of(k)], :2].copy()
+
+    gait, _ = walk(model, 8.0, command=command, record=record, x=1.0, y=-2.0, yaw=0.4)
+    assert not gait.events
+    checked = 0
+    for j, cmd in plan.items():
+        if j in landed and j in gait.commanded:
+            assert gait.commanded[j] == cmd  # latched unchanged
+            x, y = gait.foothold_world(j)
+            assert math.hypot(landed[j][0] - x, landed[j][1] - y) < 0.01
+            # The foothold is where the command put it: length along the heading from the previous one.
+            pu, pv = gait.u[j - 1], gait.v[j - 1]
+            assert gait.u[j] - pu == pytest.approx(cmd[0])
+            sign = 1.0 if gait.side_of(j) == 0 else -1.0
+            width = max(gait.p.step_width_m + sign * cmd[1], gait.p.min_step_width_m)  # feet never cross
+            assert gait.v[j] - pv == pytest.approx(sign * width)
+            checked += 1
+    assert checked >= 10
+
+
+def test_footstep_is_read_at_mid_stance_for_the_next_step_of_that_foot(model):
+    data = mujoco.MjData(model)
+    gait = WalkerGait(model)
+    gait.reset(model, data)
+    assert gait.next_footstep_index == 2 and gait.next_latch_time == pytest.approx(0.3)
+    gait.set_next_footstep(0.8, 0.0, 0.1)
+    for _ in range(14):  # up to 0.28 s: not yet read
+        gait.advance(data, DT)
+    assert 2 not in gait.u
+    gait.advance(data, DT)  # 0.30 s: mid-stance of foothold 0
+    assert gait.u[2] == pytest.approx(gait.u[1] + 0.8) and gait.clearance[2] == pytest.approx(0.1)
+    assert gait.next_footstep_index == 3
+    for _ in range(25):  # no command: the nominal footstep
+        gait.advance(data, DT)
+    assert gait.u[3] == pytest.approx(gait.u[2] + gait.p.nominal_step_m)
+
+
+def _bar_at_mid_step(gait, data, height):
+    """A 1 m wide, 5 cm deep bar across the path midway between footholds 4 and 5 (u = 2.925 m)."""
+    u = 0.5 * (gait.u.get(4, 4 * 0.65) + gait.u.get(5, 5 * 0.65))
+    gait.pool.place(gait.model, data, 0, u, 0.0, 0.05, 1.0, height)
+
+
+def _clearance_over(steps, clearance):
+    def command(gait):
+        return (0.65, 0.0, clearance if gait.next_footstep_index in steps else 0.05)
+    return command
+
+
+def test_low_clearance_over_a_bar_trips(model):
+    gait, data = walk(model, 4.0, command=_clearance_over((5, 6), 0.08),
+                      setup=lambda g, d: _bar_at_mid_step(g, d, 0.20))
+    assert gait.tripped and gait.events[0].kind == "trip"
+    first = gait.events[0]
+    assert first.side == 1 and first.part == "foot"  # the right foot swinging to foothold 5 strikes it
+    assert abs(first.normal_z) < 0.5  # against the bar's face
+    assert 2.1 < first.time < 2.5  # during that swing (2.1 .. 2.5 s)
+
+
+def test_enough_clearance_steps_over_the_same_bar(model):
+    gait, data = walk(model, 4.0, command=_clearance_over((5, 6), 0.30),
+                      setup=lambda g, d: _bar_at_mid_step(g, d, 0.20))
+    assert gait.events == [] and not gait.tripped and not gait.misstepped
+    assert float(data.qpos[0]) > 4.5  # both feet are past the bar
+
+
+def test_a_box_under_the_planned_foothold_is_a_misstep(model):
+    def setup(gait, data):  # a 10 cm box under foothold 5 (right foot, u = 3.25 m)
+        gait.pool.place(model, data, 0, 5 * 0.65, -0.06, 0.4, 0.3, 0.10)
+
+    gait, _ = walk(model, 4.0, command=_clearance_over((5,), 0.15), setup=setup)
+    assert gait.misstepped and not gait.tripped
+    assert [(e.kind, e.side) for e in gait.events] == [("misstep", 1)]
+    assert gait.events[0].normal_z > 0.9  # standing on its top
+    # A flat mat (1 cm, like Iwao's 70 cm cloth) stepped on is a misstep too.
+    gait, _ = walk(model, 4.0, setup=lambda g, d: g.pool.place(model, d, 0, 5 * 0.65, 0.0, 0.7, 0.7, 0.01))
+    assert [e.kind for e in gait.events] == ["misstep"] and not gait.tripped
+
+
+def test_resized_obstacles_collide_over_their_whole_extent(model):
+    """A bar made 4 m wide still trips a walker 1.5 m from its centre (sizes and bounding volumes are
+    updated), and a parked pool touches nothing."""
+    def setup(gait, data):
+        gait.pool.place(model, data, 0, 2.925, 1.5, 0.05, 4.0, 0.20)
+
+    gait, _ = walk(model, 3.0, setup=setup)
+    assert gait.tripped
+    gait, data = walk(model, 3.0)
+    assert gait.events == [] and data.ncon == 0
+    with pytest.raises(ValueError, match="positive"):
+        gait.pool.place(model, data, 0, 0.0, 0.0, 0.1, 0.0, 0.1)
+
+
+def test_walking_is_deterministic(model):
+    def run():
+        traj = []
+        walk(model, 3.0, command=_clearance_over((5, 6), 0.08), setup=lambda g, d: _bar_at_mid_step(g, d, 0.2),
+             record=lambda g, d: traj.append(np.concatenate([d.qpos, d.qvel, d.act])))
+        return np.array(traj)
+
+    a, b = run(), run()
+    np.testing.assert_array_equal(a, b)
+
+
+def test_bad_input_is_refused(model):
+    data = mujoco.MjData(model)
+    gait = WalkerGait(model)
+    gait.reset(model, data)
+    with pytest.raises(ValueError, match="finite"):
+        gait.set_next_footstep(float("nan"), 0.0, 0.1)
+    with pytest.raises(ValueError, match="whole number"):
+        gait.advance(data, 0.003)
+    with pytest.raises(ValueError, match="whole number"):
+        WalkerGait(model, GaitParams(step_s=0.5005))
+    # Out-of-range commands are clipped to the stated ranges.
+    gait.set_next_footstep(5.0, -3.0, 9.0)
+    assert gait.pending == (gait.p.step_range_m[1], gait.p.lateral_range_m[0], gait.p.clearance_range_m[1])
+    with pytest.raises(ValueError, match="no joint"):
+        WalkerGait(mujoco.MjModel.from_xml_path(str(assets.asset_path("catch.xml"))))
