@@ -77,6 +77,17 @@ def test_arc_length_parameter_is_relative_cumulative_chord_length():
     np.testing.assert_allclose(H.arc_length_parameter(z), [0.0, 0.3, 0.7, 1.0])
 
 
+def test_a_path_that_rests_at_its_end_still_fits():
+    # A hand at rest for the last samples repeats its end point; s must stay within [0, 1] exactly.
+    rng = np.random.default_rng(RNG_SEED)
+    for _ in range(200):
+        z = np.cumsum(rng.uniform(0.0, 0.1, size=(20, 3)) * [0.1, 0.7, 0.3], axis=0)
+        z = np.vstack([z, np.repeat(z[-1:], 4, axis=0)])
+        s = H.arc_length_parameter(z)
+        assert s.max() == 1.0 and np.all(s[-5:] == 1.0)
+        H.fit_bezier(z, 3)
+
+
 @pytest.mark.parametrize("degree", [2, 3, 4])
 def test_fit_is_the_least_squares_minimiser(degree):
     # Oracle: a generic nonlinear least-squares solver on SS = sum_i |Z_i - C(s_i)|^2 (seed 002 Sec. 3.2),
@@ -249,10 +260,13 @@ def test_faraway_path_ends_timing_and_scale():
     # the "parameter" timing puts the curve parameter, not the arc length, on the Beta CDF
     ctrl = H.faraway_control_points(start, end)
     np.testing.assert_allclose(
-        H.faraway_path(start, end, 51, progress="parameter"), H.bezier(ctrl, H.beta_progress(np.linspace(0, 1, 51)))
+        H.faraway_path(start, end, 51, progress="parameter"),
+        H.bezier(ctrl, H.beta_progress(np.linspace(0, 1, 51))),
     )
     # scale-free: doubling the reach doubles the path about the start
-    np.testing.assert_allclose(H.faraway_path(start, start + 2 * (end - start), 51) - start, 2 * (path - start), atol=1e-9)
+    np.testing.assert_allclose(
+        H.faraway_path(start, start + 2 * (end - start), 51) - start, 2 * (path - start), atol=1e-9
+    )
 
 
 def test_faraway_path_rotates_with_the_body():
@@ -274,7 +288,9 @@ def test_path_distance_identity_symmetry_and_known_value():
     for align in ("arc_length", "time"):
         for reduce in ("mean", "max"):
             assert H.path_distance(a, a, align=align, reduce=reduce) == 0.0
-            assert H.path_distance(a, b, align=align, reduce=reduce) == H.path_distance(b, a, align=align, reduce=reduce)
+            assert H.path_distance(a, b, align=align, reduce=reduce) == H.path_distance(
+                b, a, align=align, reduce=reduce
+            )
     line = H.straight_path(np.zeros(3), np.array([0.5, 0.0, 0.0]), 11)
     shifted = line + [0.0, 0.05, 0.0]
     assert H.path_distance(line, shifted) == pytest.approx(0.05)
@@ -303,7 +319,8 @@ def test_realism_of_the_model_path_and_of_a_straight_reach():
     straight = H.hand_path_realism(H.minimum_jerk_path(start, end, 301), dt=0.005)
     assert straight.curvature_index == pytest.approx(0.0, abs=1e-9)
     assert straight.faraway_max == pytest.approx(
-        H.path_distance(H.minimum_jerk_path(start, end, 301), H.faraway_path(start, end, 301), reduce="max"), rel=1e-3
+        H.path_distance(H.minimum_jerk_path(start, end, 301), H.faraway_path(start, end, 301), reduce="max"),
+        rel=1e-3,
     )
     d = np.linalg.norm(end)
     assert straight.faraway_max_at_median_reach == pytest.approx(straight.faraway_max * 0.567 / d)
@@ -329,7 +346,10 @@ GOOD = np.array([[0.0, 0, 0], [0.1, 0.1, 0], [0.2, 0.1, 0.1], [0.3, 0, 0.1], [0.
         (lambda: H.fit_bezier(GOOD, degree=2.5), "degree must be an integer >= 1"),
         (lambda: H.fit_bezier(GOOD, s=[0, 0.5, 1]), r"s must have shape \(5,\)"),
         (lambda: H.fit_bezier(GOOD, s=[0, 0.6, 0.5, 0.7, 1]), "s must be non-decreasing"),
-        (lambda: H.fit_bezier(np.array([[0.0, 0, 0], [1, 0, 0], [1, 0, 0], [1, 0, 0], [2, 0, 0]])), "do not determine"),
+        (
+            lambda: H.fit_bezier(np.array([[0.0, 0, 0], [1, 0, 0], [1, 0, 0], [1, 0, 0], [2, 0, 0]])),
+            "do not determine",
+        ),
         (lambda: H.bezier(GOOD, 1.5), r"t must lie in \[0, 1\]"),
         (lambda: H.bezier(GOOD[:1], 0.5), "control_points needs at least 2 points"),
         (lambda: H.faraway_path([0, 0, 0], [0, 0, 0], 10), "start and end coincide"),
@@ -338,8 +358,14 @@ GOOD = np.array([[0.0, 0, 0], [0.1, 0.1, 0], [0.2, 0.1, 0.1], [0.3, 0, 0.1], [0.
         (lambda: H.faraway_path([0, 0, 0], [1, 0, 0], 1), "n must be an integer >= 2"),
         (lambda: H.faraway_path([0, 0, 0], [1, 0, 0], 10, hand="both"), "hand must be 'right' or 'left'"),
         (lambda: H.faraway_path([0, 0, 0], [1, 0, 0], 10, progress="time"), "progress must be"),
-        (lambda: H.faraway_path([0, 0, 0], [1, 0, 0], 10, alpha=-1.0), "alpha and beta must be finite and > 0"),
-        (lambda: H.faraway_path([0, 0, 0], [1, 0, 0], 10, forward=[0, 0, 2]), "forward must not be parallel to up"),
+        (
+            lambda: H.faraway_path([0, 0, 0], [1, 0, 0], 10, alpha=-1.0),
+            "alpha and beta must be finite and > 0",
+        ),
+        (
+            lambda: H.faraway_path([0, 0, 0], [1, 0, 0], 10, forward=[0, 0, 2]),
+            "forward must not be parallel to up",
+        ),
         (lambda: H.path_distance(GOOD, GOOD, align="index"), "align must be"),
         (lambda: H.path_distance(GOOD, GOOD, reduce="median"), "reduce must be"),
         (lambda: H.path_distance(GOOD, np.ones((4, 3))), "zero length"),

@@ -214,13 +214,12 @@ def arc_length_parameter(points: ArrayLike) -> np.ndarray:
         Non-decreasing, from 0 to 1.
     """
     z = _points(points, "points", min_points=2)
-    a = np.linalg.norm(np.diff(z, axis=0), axis=1)
-    total = float(a.sum())
-    if total == 0.0:
+    cum = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(z, axis=0), axis=1))])
+    if cum[-1] == 0.0:
         raise ValueError("points has zero length (all points equal): arc length cannot parameterise it")
-    s = np.concatenate([[0.0], np.cumsum(a)]) / total
-    s[-1] = 1.0
-    return s
+    # divide by the running sum's own last value (not a separately rounded total), so repeated points at
+    # the end give exactly 1, never 1 + 1 ulp
+    return np.minimum(cum / cum[-1], 1.0)
 
 
 def fit_bezier(points: ArrayLike, degree: int = 3, s: ArrayLike | None = None) -> np.ndarray:
@@ -347,7 +346,9 @@ def minimum_jerk_path(start: ArrayLike, end: ArrayLike, n: int) -> np.ndarray:
     return straight_path(start, end, n, minimum_jerk_progress(_relative_times(n)))
 
 
-def body_frame(forward: ArrayLike = (1.0, 0.0, 0.0), up: ArrayLike = (0.0, 0.0, 1.0), hand: Hand = "right") -> np.ndarray:
+def body_frame(
+    forward: ArrayLike = (1.0, 0.0, 0.0), up: ArrayLike = (0.0, 0.0, 1.0), hand: Hand = "right"
+) -> np.ndarray:
     """Rows (lateral, forward, up) of the paper's body frame, in world coordinates, shape (3, 3).
 
     ``up`` is normalised; ``forward`` is made orthogonal to it (its horizontal part). Lateral points to
