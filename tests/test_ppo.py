@@ -77,10 +77,10 @@ def test_ppo_entry_is_submitted_and_rescored_from_its_packed_file(tiny_run, tmp_
     (root / "protocol.json").write_text(json.dumps(proto, indent=2))
     assert main(["leaderboard", "submit", "--agent", f"ppo:{tiny_run}", "--name", "ppo-tiny", "--env", "EyeCatch-v0",
                  "--dir", str(root), "--workers", "1", "--no-progress"]) == 0
-    policy = root / "agents" / "ppo-tiny__EyeCatch-v0.zip"
+    policy = root / "agents" / "ppo-tiny__EyeCatch-v0.npz"  # pickle-free (issue 16), converted at submit
     assert policy.is_file()
     record = json.loads((root / "results" / "ppo-tiny__EyeCatch-v0.entry.json").read_text())
-    assert record["policy"]["format"] == "sb3-ppo-zip"
+    assert record["policy"]["format"] == "ppo-npz"
     # The training run may be gone where the check runs: the packed file is the policy.
     moved = tiny_run.parent / "moved"
     tiny_run.rename(moved)
