@@ -127,7 +127,7 @@ class GaitEvent:
     normal_z: float
 
 
-@dataclass
+@dataclass(slots=True)
 class FootPlan:
     """A foot's planned pose at one instant (path frame u forward, v left; z up)."""
 
@@ -228,8 +228,9 @@ class WalkerGait:
             # (or WalkerGait.step_physics, which skips the checks when no obstacle is near)
     """
 
-    # Reach of the pelvis to an obstacle that a foot or shin could touch (m): feet are <= ~1 m away.
-    CONTACT_RADIUS_M = 1.3
+    # Horizontal distance from the pelvis within which an obstacle could touch a leg (m): a toe is at
+    # most ~0.85 m from the pelvis (0.95 m step, toe 0.2 m ahead of the ankle); 1.0 m keeps a margin.
+    CONTACT_RADIUS_M = 1.0
 
     def __init__(self, model: mujoco.MjModel, params: GaitParams | None = None) -> None:
         self.p = p = params or GaitParams()
@@ -293,6 +294,8 @@ class WalkerGait:
         margin = 1.0 * DEG
         self._lo = [float(r[0]) + margin if lim else -math.inf for r, lim in zip(rng, limited)]
         self._hi = [float(r[1]) - margin if lim else math.inf for r, lim in zip(rng, limited)]
+        self._lo_a, self._hi_a = np.array(self._lo), np.array(self._hi)
+        self._lead_a = np.array(self._lead)
 
         self.pelvis_body = bid(wn.WALKER_PELVIS)
         self.sole_sites = [sid(n) for n in wn.WALKER_SOLES]
@@ -325,6 +328,8 @@ class WalkerGait:
         self.commanded = {}  # foothold index -> the (length, lateral, clearance) latched for it
         self.pending = None
         self.next_latch_tick = self.T_mid  # mid-stance of foothold 0 latches foothold 2
+        self._seg_j, self._seg = None, None
+        self._hist: list = []  # the last targets (tick, q), for the velocity lead
         self.events: list[GaitEvent] = []
         self.tripped = False
         self.misstepped = False
@@ -370,20 +375,26 @@ class WalkerGait:
 
     # ------------------------------------------------------------------ kinematic plan at one tick
     def _pelvis_uv(self, tick: int) -> tuple[float, float]:
-        """Catmull-Rom through the mid-stance waypoints (uniform in time)."""
-        p = self.p
+        """Catmull-Rom through the mid-stance waypoints (uniform in time); a segment's cubic is built
+        once, when first needed (its four waypoints are all latched by then)."""
         j = (tick - self.T_mid) // self.T  # segment from waypoint j to j + 1
         s = (tick - self.T_mid - j * self.T) / self.T
+        if self._seg_j != j:
+            self._seg_j, self._seg = j, self._pelvis_segment(j)
+        cu, cv = self._seg
+        return (cu[0] + s * (cu[1] + s * (cu[2] + s * cu[3])), cv[0] + s * (cv[1] + s * (cv[2] + s * cv[3])))
+
+    def _pelvis_segment(self, j: int) -> tuple[tuple, tuple]:
+        p = self.p
         pts = []
         for i in (j - 1, j, j + 1, j + 2):
             sign = 1.0 if self.side_of(i) == LEFT else -1.0
             pts.append((self.u[i] + p.pelvis_lead_m, self.v[i] - sign * (0.5 * p.step_width_m - p.sway_m)))
         out = []
-        s2, s3 = s * s, s * s * s
         for a in range(2):
             p0, p1, p2, p3 = pts[0][a], pts[1][a], pts[2][a], pts[3][a]
-            out.append(0.5 * (2.0 * p1 + (p2 - p0) * s + (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3) * s2
-                              + (3.0 * p1 - p0 - 3.0 * p2 + p3) * s3))
+            out.append((p1, 0.5 * (p2 - p0), 0.5 * (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3),
+                        0.5 * (3.0 * p1 - p0 - 3.0 * p2 + p3)))
         return out[0], out[1]
 
     def _foot_from_pivot(self, pu: float, pivot_x: float, pitch: float) -> tuple[float, float]:
@@ -437,8 +448,9 @@ class WalkerGait:
             trail = self._swing_foot(k - 1, k + 1, (s - self.T_ds) / (self.T - self.T_ds))
         return (lead, trail) if self.side_of(k) == LEFT else (trail, lead)
 
-    def targets_at(self, tick: int) -> list[float]:
-        """Joint targets of every gait joint (``WALKER_GAIT_JOINTS`` order) at ``tick``."""
+    def targets_at(self, tick: int) -> np.ndarray:
+        """Joint targets of every gait joint (``WALKER_GAIT_JOINTS`` order) at ``tick``, inside the
+        joints' ranges."""
         p = self.p
         pu, pv = self._pelvis_uv(tick)
         phase = 2.0 * math.pi * ((tick - self.T_mid) % self.T) / self.T
@@ -475,8 +487,7 @@ class WalkerGait:
             out += [roll, hip, knee, ankle, -roll]
         arm = p.arm_swing_deg * DEG * math.cos(math.pi * (tick % (2 * self.T)) / self.T)
         out += [-arm, arm]  # left arm back when the left foot lands
-        lo, hi = self._lo, self._hi
-        return [min(max(q, lo[i]), hi[i]) for i, q in enumerate(out)]
+        return np.minimum(np.maximum(np.array(out), self._lo_a), self._hi_a)
 
     def _leg_ik(self, fx: float, fy: float, fz: float) -> tuple[float, float, float]:
         """Hip roll, hip pitch and knee placing the ankle at (fx, fy, fz) from the hip joint (pelvis
@@ -499,13 +510,12 @@ class WalkerGait:
         are left as they are (see :class:`ObstaclePool`)."""
         self.reset_plan(x, y, yaw)
         q0 = self.targets_at(0)
-        qm, qp = self.targets_at(-1), self.targets_at(1)
-        qd = [(b - a) / (2.0 * self.timestep) for a, b in zip(qm, qp)]
-        for i, (qa, qv) in enumerate(zip(q0, qd)):
-            data.qpos[self._qpos_idx[i]] = qa
-            data.qvel[self._dof_idx[i]] = qv
-        data.act[self._actslice] = [q + lead * v for q, v, lead in zip(q0, qd, self._lead)]
+        qd = (self.targets_at(1) - self.targets_at(-1)) / (2.0 * self.timestep)
+        data.qpos[self._qpos_idx] = q0
+        data.qvel[self._dof_idx] = qd
+        data.act[self._actslice] = q0 + self._lead_a * qd
         data.ctrl[self._ctrl] = qd
+        self._hist = [(0, q0)]
         self.t0 = float(data.time)
         mujoco.mj_forward(model, data)
 
@@ -520,13 +530,17 @@ class WalkerGait:
         while self.next_latch_tick <= end:
             self._latch()
         q1 = self.targets_at(end)
-        q0 = self.targets_at(end - 1)
-        rate = 1.0 / self.timestep
-        act = data.act[self._actslice].tolist()
-        inv_dt = 1.0 / (n * self.timestep)
-        data.ctrl[self._ctrl] = [
-            (b + lead * (b - a) * rate - s) * inv_dt for a, b, s, lead in zip(q0, q1, act, self._lead)
-        ]
+        # Target velocity at ``end`` by a second-order backward difference over the last targets (the
+        # plan up to a latch never changes, so earlier targets stay valid); after a reset or a change
+        # of dt, from one more evaluation a physics step earlier.
+        h = self._hist
+        if len(h) == 2 and h[1][0] == end - n and h[0][0] == end - 2 * n:
+            qd = (3.0 * q1 - 4.0 * h[1][1] + h[0][1]) * (0.5 / (n * self.timestep))
+        else:
+            qd = (q1 - self.targets_at(end - 1)) / self.timestep
+        self._hist = [h[-1], (end, q1)] if h else [(end, q1)]
+        act = data.act[self._actslice]
+        data.ctrl[self._ctrl] = (q1 + self._lead_a * qd - act) * (1.0 / (n * self.timestep))
         self.tick = end
 
     # ------------------------------------------------------------------ contacts
