@@ -79,6 +79,12 @@ def _assert_same_traces(a: list[EpisodeTrace], b: list[EpisodeTrace]) -> None:
             if f.name in TIMING_FIELDS or f.name == "extras":
                 continue
             va, vb = getattr(ta, f.name), getattr(tb, f.name)
+            if f.name == "task":
+                assert va.keys() == vb.keys(), f"seed {ta.seed}: task fields differ"
+                for k in va:
+                    assert np.array_equal(np.asarray(va[k]), np.asarray(vb[k]), equal_nan=np.asarray(va[k]).dtype.kind == "f"), \
+                        f"seed {ta.seed}: task field {k} differs"
+                continue
             if isinstance(va, np.ndarray):
                 assert va.shape == vb.shape and np.array_equal(va, vb, equal_nan=va.dtype.kind == "f"), \
                     f"seed {ta.seed}: {f.name} differs"

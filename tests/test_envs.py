@@ -26,7 +26,7 @@ from gymnasium.utils.env_checker import data_equivalence
 import visuomotor_gym
 from visuomotor_gym.envs.catch import RENDER_CAMERAS, EyeCatchEnv
 from visuomotor_gym.envs.observation import ObservationLayout
-from visuomotor_gym.envs.rewards import REWARD_TERMS, SHAPED_WEIGHTS
+from visuomotor_gym.tasks.catch_rewards import REWARD_TERMS, SHAPED_WEIGHTS
 
 ENV_IDS = [s.id for s in visuomotor_gym.ENV_SPECS]
 SPECS = {s.id: s for s in visuomotor_gym.ENV_SPECS}

@@ -4,7 +4,7 @@ import math
 
 import pytest
 
-from visuomotor_gym.envs.rewards import SHAPED_WEIGHTS, SPARSE_WEIGHTS, catch_reward
+from visuomotor_gym.tasks.catch_rewards import SHAPED_WEIGHTS, SPARSE_WEIGHTS, catch_reward
 
 
 def test_sparse_reward_is_one_on_catch_only():

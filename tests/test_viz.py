@@ -26,17 +26,20 @@ def synthetic_trace(n=51, gaze=None, hand=None, ball=None, ball_vel=None, eye=No
     ahead = np.tile([1.0, 0.0, 0.0], (n, 1))
     return EpisodeTrace(
         env_id="Synthetic-v0", agent="none", seed=0, dt=DT, t=t,
-        ball_pos=np.tile([3.0, 0.0, 1.2], (n, 1)) if ball is None else np.asarray(ball, float),
-        ball_vel=np.zeros((n, 3)) if ball_vel is None else np.asarray(ball_vel, float),
         gaze_dir=ahead if gaze is None else np.asarray(gaze, float),
         eye_pos=np.tile([0.1, 0.0, 1.2], (n, 1)) if eye is None else np.asarray(eye, float),
         head_dir=ahead if head is None else np.asarray(head, float),
-        hand_pos=np.tile([0.3, -0.2, 0.9], (n, 1)) if hand is None else np.asarray(hand, float),
         in_saccade=np.zeros(n, bool) if in_saccade is None else np.asarray(in_saccade, bool),
         saccade_onset=np.zeros(n, bool) if onset is None else np.asarray(onset, bool),
-        ball_visible=np.ones(n, bool), action=np.full((n, 9), np.nan), latency_s=np.full(n, np.nan),
-        caught=caught, missed=not caught, diverged=False, truncated=False,
-        release_pos=np.array([3.0, 0.0, 1.2]), arrival_pos=np.array([0.3, -0.2, 0.9]), flight_time=1.0,
+        action=np.full((n, 9), np.nan), latency_s=np.full(n, np.nan),
+        success=caught, diverged=False, truncated=False,
+        task=dict(
+            ball_pos=np.tile([3.0, 0.0, 1.2], (n, 1)) if ball is None else np.asarray(ball, float),
+            ball_vel=np.zeros((n, 3)) if ball_vel is None else np.asarray(ball_vel, float),
+            hand_pos=np.tile([0.3, -0.2, 0.9], (n, 1)) if hand is None else np.asarray(hand, float),
+            ball_visible=np.ones(n, bool), missed=not caught,
+            release_pos=np.array([3.0, 0.0, 1.2]), arrival_pos=np.array([0.3, -0.2, 0.9]), flight_time=1.0,
+        ),
     )
 
 

@@ -8,9 +8,9 @@ Importing the package registers every environment id (see :mod:`visuomotor_gym.r
     env = gym.make("EyeCatch-v0")
 """
 
-from visuomotor_gym.registration import CATCH_ENV_IDS, ENV_SPECS, register_envs
+from visuomotor_gym.registration import CATCH_ENV_IDS, ENV_IDS, ENV_SPECS, FAMILIES, register_envs
 
 __version__ = "0.1.0"
-__all__ = ["CATCH_ENV_IDS", "ENV_SPECS", "register_envs", "__version__"]
+__all__ = ["CATCH_ENV_IDS", "ENV_IDS", "ENV_SPECS", "FAMILIES", "register_envs", "__version__"]
 
 register_envs()

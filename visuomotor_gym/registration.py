@@ -13,37 +13,70 @@ import gymnasium as gym
 CATCH_ENTRY_POINT = "visuomotor_gym.envs.catch:EyeCatchEnv"
 CATCH_MAX_EPISODE_STEPS = 125  # 2.5 s at 50 Hz: the longest flight is 1.4 s
 TWO_BALLS_MAX_EPISODE_STEPS = 150  # 3 s: the second ball arrives at most 2.2 s after the first release
+POOR_VISION_SCALE = 10.0  # Eyecatch section 5: every vision noise x10 (81.2 % caught in the paper)
+VISUAL_DELAY_S = 0.1  # the Delayed rung's latency: ~100 ms of human visual processing (modelling choice)
 
 
 @dataclass(frozen=True)
-class EnvSpec:
+class EnvEntry:
+    """One registered id: its entry point, keyword arguments, episode limit, family and a line of text.
+    (Not Gymnasium's ``EnvSpec``, which ``gym.spec(id)`` returns once registered.)"""
+
     id: str
     entry_point: str
     kwargs: dict = field(default_factory=dict)
     max_episode_steps: int = CATCH_MAX_EPISODE_STEPS
     description: str = ""
+    family: str = "catch"
 
 
-# The observability ladder of the catch family (DESIGN 2): same physics, same throw sampler.
-ENV_SPECS: tuple[EnvSpec, ...] = (
-    EnvSpec("EyeCatchOracle-v0", CATCH_ENTRY_POINT, {"vision": "oracle"}, description="true ball state"),
-    EnvSpec("EyeCatchFullView-v0", CATCH_ENTRY_POINT, {"vision": "full_view"},
-            description="noisy, noise independent of gaze"),
-    EnvSpec("EyeCatch-v0", CATCH_ENTRY_POINT, {}, description="foveated vision, saccadic blindness"),
-    EnvSpec("EyeCatchDelayed-v0", CATCH_ENTRY_POINT, {"visual_delay_s": 0.1},
-            description="foveated + 100 ms visual latency"),
-    EnvSpec("EyeCatchPoorVision-v0", CATCH_ENTRY_POINT, {"vision_noise_scale": 10.0},
-            description="foveated, all vision noise x10 (Eyecatch 5)"),
-    EnvSpec("EyeCatchBounce-v0", CATCH_ENTRY_POINT, {"bounce_wall": True},
-            description="foveated; the ball bounces off an invisible wall mid-flight (Eyecatch 5)"),
-    EnvSpec("EyeCatchTwoBalls-v0", CATCH_ENTRY_POINT, {"n_balls": 2}, max_episode_steps=TWO_BALLS_MAX_EPISODE_STEPS,
-            description="foveated; two staggered balls from both sides, catch both (Eom 7)"),
+def vision_rungs(name: str, entry_point: str, *, family: str, max_episode_steps: int, what: str,
+                 kwargs: dict | None = None) -> tuple[EnvEntry, ...]:
+    """The observability ladder of one family, same physics and scenario sampler on every rung:
+    ``<name>Oracle-v0`` (true state of what ``what`` names), ``<name>FullView-v0`` (noise independent
+    of gaze), ``<name>-v0`` (foveated), ``<name>Delayed-v0`` (+100 ms) and ``<name>PoorVision-v0``
+    (every vision noise x10). ``kwargs`` are shared by every rung."""
+    base = dict(kwargs or {})
+
+    def rung(suffix, extra, description):
+        return EnvEntry(f"{name}{suffix}-v0", entry_point, {**base, **extra}, max_episode_steps, description, family)
+
+    return (
+        rung("Oracle", {"vision": "oracle"}, f"true {what} state"),
+        rung("FullView", {"vision": "full_view"}, "noisy, noise independent of gaze"),
+        rung("", {}, "foveated vision, saccadic blindness"),
+        rung("Delayed", {"visual_delay_s": VISUAL_DELAY_S}, "foveated + 100 ms visual latency"),
+        rung("PoorVision", {"vision_noise_scale": POOR_VISION_SCALE}, "foveated, all vision noise x10 (Eyecatch 5)"),
+    )
+
+
+# Every registered id, every family, one list.
+ENV_SPECS: tuple[EnvEntry, ...] = (
+    *vision_rungs("EyeCatch", CATCH_ENTRY_POINT, family="catch", max_episode_steps=CATCH_MAX_EPISODE_STEPS,
+                  what="ball"),
+    EnvEntry("EyeCatchBounce-v0", CATCH_ENTRY_POINT, {"bounce_wall": True},
+             description="foveated; the ball bounces off an invisible wall mid-flight (Eyecatch 5)"),
+    EnvEntry("EyeCatchTwoBalls-v0", CATCH_ENTRY_POINT, {"n_balls": 2}, max_episode_steps=TWO_BALLS_MAX_EPISODE_STEPS,
+             description="foveated; two staggered balls from both sides, catch both (Eom 7)"),
 )
-CATCH_ENV_IDS = tuple(spec.id for spec in ENV_SPECS if spec.entry_point == CATCH_ENTRY_POINT)
+ENV_IDS = tuple(spec.id for spec in ENV_SPECS)
+FAMILIES: dict[str, tuple[str, ...]] = {}
+for _spec in ENV_SPECS:
+    FAMILIES[_spec.family] = FAMILIES.get(_spec.family, ()) + (_spec.id,)
+CATCH_ENV_IDS = FAMILIES["catch"]
+
+
+def family_of(env_id: str) -> str:
+    """The family of a registered id (``"catch"``, ...); ValueError for an unknown id."""
+    bare = env_id.removeprefix("visuomotor_gym:")
+    for spec in ENV_SPECS:
+        if spec.id == bare:
+            return spec.family
+    raise ValueError(f"unknown env id {env_id!r}; known ids: {', '.join(ENV_IDS)}")
 
 
 def env_vision(env_id: str) -> dict:
-    """What the eye of a registered catch env gives its agent, for agents that model their own vision:
+    """What the eye of a registered env gives its agent, for agents that model their own vision:
     ``vision_noise_scale`` (0 for the oracle), ``foveated``, ``visual_delay_s``, ``gaze_action_range_deg``."""
     kw = gym.spec(env_id).kwargs or {}
     return {

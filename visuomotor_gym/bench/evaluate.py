@@ -68,9 +68,9 @@ def episode_chunks(episodes: int) -> list[range]:
 
 
 def _known_env_ids() -> tuple[str, ...]:
-    from visuomotor_gym.registration import CATCH_ENV_IDS
+    from visuomotor_gym.registration import ENV_IDS
 
-    return CATCH_ENV_IDS
+    return ENV_IDS
 
 
 def check_env_id(env_id: str) -> str:

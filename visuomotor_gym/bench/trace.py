@@ -14,38 +14,51 @@ import numpy as np
 
 from visuomotor_gym.agents import Policy
 
-STEP_FIELDS = ("ball_pos", "ball_vel", "gaze_dir", "eye_pos", "head_dir", "hand_pos")
-FLAG_FIELDS = ("in_saccade", "saccade_onset", "ball_visible")
+# Recorded for every family (the eye and head are the same in every body).
+STEP_FIELDS = ("gaze_dir", "eye_pos", "head_dir")
+FLAG_FIELDS = ("in_saccade", "saccade_onset")
+_SCALAR_KINDS = {"env_id": str, "agent": str, "seed": int, "dt": float,
+                 "success": bool, "diverged": bool, "truncated": bool}
 
 
 @dataclass
 class EpisodeTrace:
-    """One episode. Arrays have one row per control step (row 0: after reset). World frame, SI units."""
+    """One episode. Arrays have one row per control step (row 0: after reset). World frame, SI units.
+
+    The fields every family records are attributes; the task's own fields (declared by the env's
+    ``trace_fields()``: the catch family records ``ball_pos``, ``ball_vel``, ``hand_pos``,
+    ``ball_visible`` per step and ``release_pos``, ``arrival_pos``, ``flight_time``, ``missed`` per
+    episode) live in ``task`` and read as attributes too (``trace.ball_pos``).
+    """
 
     env_id: str
     agent: str
     seed: int
     dt: float  # control period, s
-    t: np.ndarray  # (T,) s since the throw
-    ball_pos: np.ndarray  # (T, 3) true ball centre
-    ball_vel: np.ndarray  # (T, 3)
+    t: np.ndarray  # (T,) s since the episode started
     gaze_dir: np.ndarray  # (T, 3) unit line of sight
     eye_pos: np.ndarray  # (T, 3)
     head_dir: np.ndarray  # (T, 3) forward axis of the head
-    hand_pos: np.ndarray  # (T, 3) catch-site centre
     in_saccade: np.ndarray  # (T,) bool: a saccade is in flight at the end of the step
     saccade_onset: np.ndarray  # (T,) bool: a saccade started at the start of this step
-    ball_visible: np.ndarray  # (T,) bool: the eye produced a visual sample this step
     action: np.ndarray  # (T, A); row 0 NaN
     latency_s: np.ndarray  # (T,) policy compute time for the action of this step; row 0 NaN
-    caught: bool
-    missed: bool
+    success: bool  # info["is_success"] at the end
     diverged: bool
     truncated: bool
-    release_pos: np.ndarray  # (3,)
-    arrival_pos: np.ndarray  # (3,) sampled arrival point (approximate in the Bounce variant)
-    flight_time: float  # s
+    task: dict = field(default_factory=dict)  # the task's fields (see the class docstring)
     extras: dict = field(default_factory=dict)
+
+    def __getattr__(self, name: str):
+        task = self.__dict__.get("task")
+        if task is not None and name in task:
+            return task[name]
+        raise AttributeError(f"{type(self).__name__} of {self.__dict__.get('env_id')!r} has no field {name!r}")
+
+    @property
+    def caught(self) -> bool:
+        """The catch family's name for success (every ball caught)."""
+        return self.success
 
     @property
     def steps(self) -> int:
@@ -54,13 +67,17 @@ class EpisodeTrace:
     @property
     def catch_time(self) -> float:
         """Time of the catch (s), NaN if not caught."""
-        return float(self.t[-1]) if self.caught else float("nan")
+        return float(self.t[-1]) if self.success else float("nan")
 
     def to_arrays(self, prefix: str = "") -> dict[str, np.ndarray]:
-        """Flat name -> array mapping (for ``np.savez``)."""
+        """Flat name -> array mapping (for ``np.savez``); task fields under ``task/``."""
         out = {}
         for f in fields(self):
             if f.name == "extras":
+                continue
+            if f.name == "task":
+                for name, value in self.task.items():
+                    out[f"{prefix}task/{name}"] = np.asarray(value)
                 continue
             out[prefix + f.name] = np.asarray(getattr(self, f.name))
         return out
@@ -69,19 +86,18 @@ class EpisodeTrace:
     def from_arrays(cls, arrays, prefix: str = "") -> EpisodeTrace:
         kwargs = {}
         for f in fields(cls):
-            if f.name == "extras":
+            if f.name in ("extras", "task"):
                 continue
             value = arrays[prefix + f.name]
-            if f.name in ("env_id", "agent"):
-                value = str(value)
-            elif f.name == "seed":
-                value = int(value)
-            elif f.name in ("dt", "flight_time"):
-                value = float(value)
-            elif f.name in ("caught", "missed", "diverged", "truncated"):
-                value = bool(value)
-            kwargs[f.name] = value
-        return cls(**kwargs)
+            kind = _SCALAR_KINDS.get(f.name)
+            kwargs[f.name] = kind(value) if kind is not None else value
+        task_prefix = f"{prefix}task/"
+        task = {}
+        for key in arrays.keys():
+            if key.startswith(task_prefix):
+                value = arrays[key]
+                task[key[len(task_prefix):]] = value.item() if value.ndim == 0 else value
+        return cls(**kwargs, task=task)
 
 
 def save_traces(path, traces: list[EpisodeTrace]) -> None:
@@ -100,11 +116,13 @@ def load_traces(path) -> list[EpisodeTrace]:
 
 def run_episode(env, policy: Policy, seed: int, env_id: str, agent: str) -> EpisodeTrace:
     """Play one episode; the policy sees observations only. Returns its trace."""
+    step_fields, flag_fields = env.unwrapped.trace_fields()
     obs, info = env.reset(seed=seed)
+    episode_fields = env.unwrapped.trace_episode_fields()
     if hasattr(policy, "reset"):
         policy.reset()
-    rows = {k: [info[k]] for k in STEP_FIELDS}
-    flags = {k: [bool(info[k])] for k in FLAG_FIELDS}
+    rows = {k: [info[k]] for k in STEP_FIELDS + tuple(step_fields)}
+    flags = {k: [bool(info[k])] for k in FLAG_FIELDS + tuple(flag_fields)}
     t = [info["time"]]
     n_act = env.action_space.shape[0]
     actions = [np.full(n_act, np.nan)]
@@ -120,26 +138,27 @@ def run_episode(env, policy: Policy, seed: int, env_id: str, agent: str) -> Epis
         obs, _, terminated, truncated, step_info = env.step(action)
         actions.append(np.asarray(action, dtype=float).reshape(-1))
         t.append(step_info["time"])
-        for k in STEP_FIELDS:
-            rows[k].append(step_info[k])
-        for k in FLAG_FIELDS:
-            flags[k].append(bool(step_info[k]))
+        for k, column in rows.items():
+            column.append(step_info[k])
+        for k, column in flags.items():
+            column.append(bool(step_info[k]))
         info = step_info
+    arrays = {k: np.asarray(v, dtype=float) for k, v in rows.items()}
+    arrays.update({k: np.asarray(v, dtype=bool) for k, v in flags.items()})
+    task = {k: arrays.pop(k) for k in tuple(step_fields) + tuple(flag_fields)}
+    task.update(episode_fields)
+    task.update(env.unwrapped.trace_final_fields(info))
     return EpisodeTrace(
         env_id=env_id,
         agent=agent,
         seed=seed,
         dt=float(env.unwrapped.dt),
         t=np.asarray(t),
-        **{k: np.asarray(v, dtype=float) for k, v in rows.items()},
-        **{k: np.asarray(v, dtype=bool) for k, v in flags.items()},
+        **arrays,
         action=np.asarray(actions),
         latency_s=np.asarray(latency),
-        caught=bool(info["is_success"]),
-        missed=bool(info["missed"]),
+        success=bool(info["is_success"]),
         diverged=bool(info["physics_diverged"]),
         truncated=bool(truncated),
-        release_pos=np.asarray(env.unwrapped.throw.release_pos),
-        arrival_pos=np.asarray(env.unwrapped.throw.arrival_pos),
-        flight_time=float(env.unwrapped.throw.flight_time),
+        task=task,
     )

@@ -58,6 +58,7 @@ class SeatedBody:
 
     frame = SEAT_FRAME
     observation_blocks = SEATED_BLOCKS
+    trace_step_fields = ("hand_pos",)  # recorded by the evaluator from info
 
     def __init__(self, model: mujoco.MjModel, control: str, hand_params: HandControlParams, dt: float) -> None:
         m = model

@@ -284,6 +284,20 @@ class VisuomotorEnv(gym.Env):
         info.update(self.task.info(self.data, caught=caught, missed=missed, diverged=diverged))
         return info
 
+    # --- what the evaluator records (bench/trace.py) -----------------------------------------
+    def trace_fields(self) -> tuple[tuple[str, ...], tuple[str, ...]]:
+        """The body's and task's per-step ``info`` keys the evaluator records: (float arrays, flags)."""
+        return (tuple(self.body.trace_step_fields) + tuple(self.task.trace_step_fields),
+                tuple(self.task.trace_flag_fields))
+
+    def trace_episode_fields(self) -> dict:
+        """The task's per-episode values, right after ``reset`` (scoring only)."""
+        return self.task.trace_episode_fields()
+
+    def trace_final_fields(self, info: dict) -> dict:
+        """The task's outcome fields from the last step's ``info``."""
+        return self.task.trace_final_fields(info)
+
     # --- rendering ----------------------------------------------------------------------------
     def _render_camera(self, camera: str) -> np.ndarray:
         renderer = self._renderers.get(camera)

@@ -20,7 +20,7 @@ from visuomotor_gym.core.eye import Eye
 from visuomotor_gym.core.head import Head
 from visuomotor_gym.core.retina import VISION_MODES, Retina
 from visuomotor_gym.envs.observation import SECOND_BALL_OBSERVATION, ObservationLayout, catch_observation
-from visuomotor_gym.envs.rewards import REWARD_TERMS, SHAPED_WEIGHTS, SPARSE_WEIGHTS
+from visuomotor_gym.tasks.catch_rewards import REWARD_TERMS, SHAPED_WEIGHTS, SPARSE_WEIGHTS
 from visuomotor_gym.oculomotor.plant import DEG, OculomotorParams
 from visuomotor_gym.scenarios.throws import ThrowDistribution
 from visuomotor_gym.tasks.catch import CatchTask, catch_scene

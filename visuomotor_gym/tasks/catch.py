@@ -13,7 +13,7 @@ import numpy as np
 from visuomotor_gym.body import names
 from visuomotor_gym.core.observation import Block
 from visuomotor_gym.core.retina import FreeBodyTarget
-from visuomotor_gym.envs.rewards import catch_reward
+from visuomotor_gym.tasks.catch_rewards import catch_reward
 from visuomotor_gym.geometry import norm
 from visuomotor_gym.scenarios.throws import BALL_RADIUS, sample_second_throw, sample_throw
 from visuomotor_gym.vision import foveation
@@ -142,6 +142,19 @@ class CatchTask:
     def initial_gaze(self) -> tuple[np.ndarray, tuple[float, float]]:
         """Where gaze starts: the release point (the thrower's hand), with the throw's jitter."""
         return self.throw.release_pos, tuple(self.throw.gaze_offset)
+
+    # --- what the evaluator records ----------------------------------------------------------
+    trace_step_fields = ("ball_pos", "ball_vel")
+    trace_flag_fields = ("ball_visible",)
+
+    def trace_episode_fields(self) -> dict:
+        throw = self.throw
+        return {"release_pos": np.asarray(throw.release_pos), "arrival_pos": np.asarray(throw.arrival_pos),
+                "flight_time": float(throw.flight_time)}
+
+    @staticmethod
+    def trace_final_fields(info: dict) -> dict:
+        return {"missed": bool(info["missed"])}
 
     def initial_fixation(self, distance: float) -> float:
         """The fixation (vergence) distance at reset, given the initial gaze point's true distance."""
