@@ -284,3 +284,17 @@ def test_bad_input_is_refused(model):
     assert gait.pending == (gait.p.step_range_m[1], gait.p.lateral_range_m[0], gait.p.clearance_range_m[1])
     with pytest.raises(ValueError, match="no joint"):
         WalkerGait(mujoco.MjModel.from_xml_path(str(assets.asset_path("catch.xml"))))
+
+
+def test_throughput_benchmark_runs_and_reports_a_ratio(tmp_path):
+    """Tiny-budget smoke run of benchmarks/walker_throughput.py (its numbers are reported, not asserted)."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parent.parent / "benchmarks" / "walker_throughput.py"
+    spec = importlib.util.spec_from_file_location("walker_throughput", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    result = module.main(["--steps", "60", "--repeats", "1", "--json", str(tmp_path / "r.json")])
+    assert result["ratio_walker_over_raw"] > 0 and (tmp_path / "r.json").exists()
+    assert result["substeps_per_control_step"] == 10 and result["trips_and_missteps"] == 0

@@ -90,10 +90,10 @@ class GaitParams:
     # passes at mid-stance (modelling choices: COM sway ~4 cm peak to peak; the COM passes over the
     # mid-foot, a few cm ahead of the ankle).
     sway_m: float = 0.02
-    pelvis_lead_m: float = 0.04
+    pelvis_lead_m: float = 0.06
     # Foot angle to the floor at heel strike (toe up) and at toe-off (toe down): modelling choices
-    # (a neutral ankle under a shank inclined ~20-25 deg at initial contact; a steep push-off).
-    heel_strike_deg: float = 20.0
+    # (a neutral ankle under a shank inclined ~25 deg at initial contact; a steep push-off).
+    heel_strike_deg: float = 25.0
     toe_off_deg: float = 45.0
     # Swing profile, in fractions of the swing: the sole reaches the clearance at ``swing_rise``,
     # starts down at ``swing_fall``; the ankle moves horizontally between ``swing_move`` (modelling choice).
