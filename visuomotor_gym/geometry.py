@@ -32,6 +32,13 @@ def angle_between(a, b) -> float:
     return math.atan2(math.sqrt(cx * cx + cy * cy + cz * cz), ax * bx + ay * by + az * bz)
 
 
+def angles_deg(a, b) -> np.ndarray:
+    """Row-wise angle (deg) between two arrays of vectors (..., 3), same atan2 form as
+    :func:`angle_between` (accurate near 0 and 180 deg); the one vectorised angle helper."""
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    return np.degrees(np.arctan2(np.linalg.norm(np.cross(a, b), axis=-1), np.sum(a * b, axis=-1)))
+
+
 def unit_from_angles(azimuth: float, elevation: float) -> tuple[float, float, float]:
     """Unit vector for (azimuth about z, then elevation up), x forward, y left, z up, as floats."""
     ce = math.cos(elevation)

@@ -49,6 +49,7 @@ from visuomotor_gym.baselines.eyecatch.agent import SHOULDER_WORLD
 
 from visuomotor_gym.envs.actions import hand_action
 from visuomotor_gym.core.frames import SEAT_ORIGIN
+from visuomotor_gym.geometry import angle_between
 from visuomotor_gym.envs.observation import ObservationLayout, catch_observation
 from visuomotor_gym.registration import env_vision
 from visuomotor_gym.vision.foveation import VisionParams
@@ -301,7 +302,7 @@ class BeliefMPCAgent:
         h = self.h
         nxt = self.plan.state_at(t + self.dt, h)
         gaze_target = nxt[0:2]
-        if _angle(gaze, gaze_vector(*gaze_target)) > p.saccade_threshold_deg * DEG:
+        if angle_between(gaze, gaze_vector(*gaze_target)) > p.saccade_threshold_deg * DEG:
             gaze_target = self._saccade_target(t, gaze_target)
         gaze_ret = _retinal(rot, gaze_vector(*gaze_target))
         head_t = self.plan.state_at(t + p.head_lead_s, h)[2:4]
@@ -465,10 +466,6 @@ class BeliefMPCAgent:
 
     def _action(self, hand_target, gaze_ret, head, fixation) -> np.ndarray:
         return hand_action(hand_target, self.grasp, gaze_ret, head, fixation, self.gaze_range)
-
-
-def _angle(a: np.ndarray, b: np.ndarray) -> float:
-    return math.atan2(float(np.linalg.norm(np.cross(a, b))), float(a @ b))
 
 
 def _retinal(rot: np.ndarray, direction: np.ndarray) -> tuple[float, float]:

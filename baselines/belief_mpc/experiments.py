@@ -23,6 +23,8 @@ from pathlib import Path
 
 import numpy as np
 
+from visuomotor_gym.geometry import angles_deg
+
 FOVEA_DEG = 5.0  # "looking at" an object: within 5 deg of the line of sight (metrics.gaze.FOVEA_DEG)
 ALPHAS = (0.0, 0.2, 0.4)
 TWO_BALL_METHODS = {
@@ -30,11 +32,6 @@ TWO_BALL_METHODS = {
     "distance sum": "belief_mpc:gaze_cost=distance",
     "Eyecatch, sequential": "eyecatch-sequential",
 }
-
-
-def _angle_deg(a, b):
-    a, b = np.asarray(a, float), np.asarray(b, float)
-    return np.degrees(np.arctan2(np.linalg.norm(np.cross(a, b), axis=-1), np.sum(a * b, axis=-1)))
 
 
 # ----------------------------------------------------------------------------------------------
@@ -105,12 +102,12 @@ def record_parallel(spec, env_id, seeds, workers):
 # gaze measures
 # ----------------------------------------------------------------------------------------------
 def eccentricities(ep, key="ball_pos"):
-    return _angle_deg(ep["gaze_dir"], ep[key] - ep["eye_pos"])
+    return angles_deg(ep["gaze_dir"], ep[key] - ep["eye_pos"])
 
 
 def single_ball_gaze(trace) -> dict:
     """From an EpisodeTrace: saccades, time on the ball (after the first 100 ms), on-ball episodes."""
-    ecc = _angle_deg(trace.gaze_dir, trace.ball_pos - trace.eye_pos)
+    ecc = angles_deg(trace.gaze_dir, trace.ball_pos - trace.eye_pos)
     t = np.asarray(trace.t)
     keep = t >= 0.1
     on = ecc[keep] <= FOVEA_DEG

@@ -14,16 +14,15 @@ from __future__ import annotations
 
 import numpy as np
 
+from visuomotor_gym.geometry import angles_deg
+
 FOVEA_DEG = 5.0  # "ball on the fovea": within 5 deg of the line of sight (our choice)
 DEAD_ZONE_DEG = 20.0  # head dead zone, Eyecatch Sec. 4.2 Eq. 17 (0.349 rad) [Leigh & Zee 1999]
 DEAD_ZONE_TOLERANCE_DEG = 5.0  # allowance above the dead zone before a row is non-compliant (our choice)
 
 
 # --- geometry ------------------------------------------------------------------------------------
-def angle_deg(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Row-wise angle (deg) between vectors ``a`` and ``b`` (atan2 form: accurate near 0 and 180 deg)."""
-    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
-    return np.degrees(np.arctan2(np.linalg.norm(np.cross(a, b), axis=-1), np.sum(a * b, axis=-1)))
+angle_deg = angles_deg  # row-wise angle (deg): visuomotor_gym.geometry.angles_deg
 
 
 # --- saccade timing ------------------------------------------------------------------------------

@@ -43,6 +43,7 @@ from pathlib import Path
 import numpy as np
 
 from visuomotor_gym.bench.trace import EpisodeTrace
+from visuomotor_gym.geometry import angles_deg
 
 BALL_COLOR = "0.45"
 GAZE_COLOR = "tab:red"
@@ -79,19 +80,13 @@ def direction_angles(directions, frame: np.ndarray | None = None) -> tuple[np.nd
     return az, el
 
 
-def angle_between_deg(a, b) -> np.ndarray:
-    """Row-wise angle (deg) between two arrays of vectors (accurate for small and large angles)."""
-    a, b = unit(a), unit(b)
-    return np.degrees(np.arctan2(np.linalg.norm(np.cross(a, b), axis=-1), np.sum(a * b, axis=-1)))
-
-
 def angular_speed_deg_s(directions, dt) -> np.ndarray:
     """Mean angular speed (deg/s) between successive direction rows: ``angle(d[k-1], d[k]) / dt``.
 
     ``dt`` is a scalar or one value per interval (length ``len(directions) - 1``).
     """
     d = np.asarray(directions, dtype=float)
-    return angle_between_deg(d[:-1], d[1:]) / np.asarray(dt, dtype=float)
+    return angles_deg(d[:-1], d[1:]) / np.asarray(dt, dtype=float)
 
 
 def tangential_speed(positions, dt) -> np.ndarray:
@@ -134,7 +129,7 @@ def gaze_ball_angles(trace: EpisodeTrace, origin: str = "eye") -> dict[str, np.n
         "gaze_el": gaze_el,
         "ball_az": np.degrees(np.unwrap(np.radians(ball_az))),
         "ball_el": ball_el,
-        "error_deg": angle_between_deg(gaze, ball_dir),
+        "error_deg": angles_deg(gaze, ball_dir),
     }
 
 
