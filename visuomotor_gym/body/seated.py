@@ -136,6 +136,9 @@ class SeatedBody:
         """The catch site (world), a live view."""
         return data.site_xpos[self.catch_site]
 
+    def info(self, data: mujoco.MjData) -> dict:
+        return {"hand_pos": data.site_xpos[self.catch_site].copy()}
+
     def grasp_closed(self, data: mujoco.MjData, fraction: float) -> bool:
         """Whether the fingers are closed beyond ``fraction`` of their range."""
         return data.qpos[self._grasp_qpos] >= fraction * self.grasp_max

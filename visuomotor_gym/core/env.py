@@ -1,6 +1,7 @@
 """``VisuomotorEnv``: the Gymnasium skeleton every family shares.
 
-A concrete env builds its parts in ``__init__`` and calls :meth:`VisuomotorEnv._assemble`:
+A concrete env builds its parts in ``__init__`` and calls :meth:`VisuomotorEnv._assemble` (the
+protocols a body and a task implement are in :mod:`visuomotor_gym.core.parts`):
 
 * ``body`` - a body from :mod:`visuomotor_gym.body` (its action blocks, servo commands,
   proprioception, its frame);
@@ -120,7 +121,7 @@ class VisuomotorEnv(gym.Env):
         self._needs_reset = False
         self._ended = False
         self._warned_after_end = False
-        info = self._info(caught=False, missed=False, diverged=False, terms={})
+        info = self._info(diverged=False, terms={})
         info.update(self.task.reset_info())
         return self._format(obs), info
 
@@ -142,20 +143,20 @@ class VisuomotorEnv(gym.Env):
         self.body.command(d, a, al, dt)
         self.task.before_physics(d)
 
-        caught, diverged = self._simulate()
+        fired, diverged = self._simulate()
         if diverged:
             self._ended = True
-            info = self._info(caught=False, missed=False, diverged=True, terms={})
+            info = self._info(diverged=True, terms={})
             return self._format(self._last_obs.copy()), 0.0, True, False, info
         mujoco.mj_kinematics(m, d)
         mujoco.mj_comPos(m, d)
-        caught = caught or self.task.check_substep(d)
+        fired = fired or self.task.check_substep(d)  # the event (a catch) on the final kinematics
         self.eye.apply(d)
         obs = self._observe(saccading=plant_step.saccading)
         self._last_obs = obs.copy()  # the fallback after divergence; the caller may edit ``obs``
         self.eye.end_step()
 
-        reward, terms, terminated, task_info = self.task.evaluate(d, caught, a, self.eye)
+        reward, terms, terminated, task_info = self.task.evaluate(d, fired, a, self.eye)
         info = self._generic_info(diverged=False, terms=terms)
         info.update(task_info)
         info["saccade_onset"] = plant_step.saccade_started
@@ -271,17 +272,18 @@ class VisuomotorEnv(gym.Env):
             "in_saccade": plant.saccade is not None,
             "saccade_onset": False,
             "time": float(d.time),
-            "hand_pos": self.body.hand_pos(d).copy(),
             "gaze_dir": plant.gaze.copy(),
             "eye_pos": np.array(self.eye.pos_list),
         }
         info.update(self.head.info(d))
+        info.update(self.body.info(d))
         return info
 
-    def _info(self, *, caught: bool, missed: bool, diverged: bool, terms: dict) -> dict:
-        """Step information. The true state in here is for scoring only: never feed it to a policy."""
+    def _info(self, *, diverged: bool, terms: dict) -> dict:
+        """Reset or divergence information (nothing happened this step). The true state in here is for
+        scoring only: never feed it to a policy."""
         info = self._generic_info(diverged=diverged, terms=terms)
-        info.update(self.task.info(self.data, caught=caught, missed=missed, diverged=diverged))
+        info.update(self.task.info(self.data, diverged=diverged))
         return info
 
     # --- what the evaluator records (bench/trace.py) -----------------------------------------

@@ -306,7 +306,7 @@ class CatchTask:
         return next((k for k in range(self.n_balls) if self.balls[k].status is BallStatus.FLYING), 0)
 
     def evaluate(self, data: mujoco.MjData, caught: bool, a: np.ndarray, eye) -> tuple[float, dict, bool, dict]:
-        """After a step: ``(reward, terms, terminated, info fields)``."""
+        """After a step (``caught``: a substep check fired): ``(reward, terms, terminated, info fields)``."""
         d = data
         k = self.shaping_ball()
         ball = self.balls[k].pos(d)
@@ -325,8 +325,9 @@ class CatchTask:
         terminated = (caught if self.n_balls == 1 else self.success) or missed
         return reward, terms, terminated, self.info(d, caught=caught, missed=missed)
 
-    def info(self, data: mujoco.MjData, *, caught: bool, missed: bool, diverged: bool = False) -> dict:
-        """The task's step information (true state: for scoring only, never for a policy)."""
+    def info(self, data: mujoco.MjData, *, caught: bool = False, missed: bool = False, diverged: bool = False) -> dict:
+        """The task's step information (true state: for scoring only, never for a policy). At reset and
+        after a divergence nothing was caught or missed."""
         d = data
         b0 = self.balls[0]
         info = {
