@@ -1,6 +1,6 @@
 """The walker's scripted gait: a footstep-level interface on a kinematic gait that physics servos track.
 
-No learned gait (issue 12, DESIGN 2.0.1): the pelvis follows a trajectory planned through the
+No learned gait (as footstep-planner controllers such as DeepLoco do): the pelvis follows a trajectory planned through the
 footholds, the legs follow analytic two-link inverse kinematics toward planned foot poses, and MuJoCo
 contacts between the legs and the obstacles decide what happens. The agent chooses footsteps, as the
 high-level controller of footstep-planner gaits such as DeepLoco does.

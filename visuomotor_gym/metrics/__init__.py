@@ -1,4 +1,4 @@
-"""Benchmark metrics computed from episode traces (DESIGN.md section 4).
+"""Benchmark metrics computed from episode traces (success with a Wilson interval, gaze realism against a sourced human table, latency, outcome measures).
 
 Everything here is pure numpy on :class:`visuomotor_gym.bench.trace.EpisodeTrace` objects (any object
 with the same attributes works), so the evaluator, plots and tests share one definition of each number.

@@ -1,4 +1,4 @@
-"""The throw distribution of the catch family (DESIGN section 2.6), drawn from ``np_random`` only.
+"""The throw distribution of the catch family (Eyecatch section 5: throws from a few metres, flights of about a second), drawn from ``np_random`` only.
 
 A throw is sampled *backwards* from where it should arrive:
 
