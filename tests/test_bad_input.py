@@ -243,3 +243,66 @@ def test_reset_with_empty_or_no_options_is_fine(env):
     obs_a, _ = env.reset(seed=1, options=None)
     obs_b, _ = env.reset(seed=1, options={})
     np.testing.assert_array_equal(obs_a, obs_b)
+
+
+# ----------------------------------------------------------------------------------------------
+# constructor arguments that used to be accepted but wrong (issue 16): each refused at construction,
+# with the argument's name in the message
+# ----------------------------------------------------------------------------------------------
+@pytest.mark.parametrize(
+    "kwargs, error, pattern",
+    [
+        ({"reward_weights": {"catch": float("nan")}}, ValueError, r"reward_weights\['catch'\] must be a finite"),
+        ({"reward": "shaped", "reward_weights": {"approach": float("inf")}}, ValueError, r"reward_weights\['approach'\]"),
+        ({"reward_weights": [("catch", 1.0)]}, TypeError, r"reward_weights must be a dict"),
+        ({"vision_noise_scale": 1e40}, ValueError, r"vision_noise_scale must be in \[0, 1000\]"),
+        ({"vision_noise_scale": "10"}, TypeError, r"vision_noise_scale must be a real number"),
+        ({"gaze_action_range_deg": float("inf")}, ValueError, r"gaze_action_range_deg must be a finite number"),
+        ({"control_dt": float("inf")}, ValueError, r"control_dt must be a finite number"),
+        ({"control_dt": 0.003}, ValueError, r"control_dt=0.003 must be a positive whole multiple"),
+        ({"visual_delay_s": float("inf")}, ValueError, r"visual_delay_s must be a finite number"),
+        ({"visual_delay_s": 0.05}, ValueError, r"visual_delay_s=0.05 must be a non-negative whole multiple"),
+        ({"bounce_wall": "no"}, TypeError, r"bounce_wall must be True or False, got 'no'"),
+        ({"bounce_wall": 1}, TypeError, r"bounce_wall must be True or False"),
+        ({"record_plant": "yes"}, TypeError, r"record_plant must be True or False"),
+        ({"throw_distribution": {"second_max_flight_s": 0.0}, "n_balls": 2}, ValueError, r"second_max_flight_s"),
+        ({"throw_distribution": {"second_stagger_s": (-0.1, 0.2)}}, ValueError, r"second_stagger_s must be positive"),
+        ({"width": -1}, ValueError, r"width must be an integer in \[1, 8192\]"),
+        ({"height": 2.5}, TypeError, r"height must be an integer"),
+        ({"catch_radius": 0.0}, ValueError, r"catch_radius must be in \(0, 0.5\]"),
+        ({"release_after_catch_s": float("nan")}, ValueError, r"release_after_catch_s must be a finite"),
+    ],
+)
+def test_bad_constructor_argument_is_refused_with_its_name(kwargs, error, pattern):
+    with pytest.raises(error, match=pattern):
+        EyeCatchEnv(**kwargs)
+
+
+def test_step_before_reset_is_a_clear_error():
+    env = EyeCatchEnv()
+    with pytest.raises(RuntimeError, match=r"step\(\) called before reset\(\)"):
+        env.step(np.zeros(N_ACT, np.float32))
+
+
+def test_step_after_the_episode_ended_warns_once_and_goes_on():
+    """Gymnasium's own checker warns rather than raises here; so do we (documented in the env)."""
+    env = gym.make("EyeCatchOracle-v0").unwrapped
+    env.reset(seed=0)
+    open_hand = np.zeros(N_ACT, np.float32)
+    open_hand[3] = -1.0
+    for _ in range(200):
+        *_, terminated, _, _ = env.step(open_hand)
+        if terminated:
+            break
+    assert terminated
+    with pytest.warns(UserWarning, match="after the episode ended"):
+        env.step(open_hand)
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        env.step(open_hand)  # only once per episode
+    env.reset(seed=1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        env.step(open_hand)  # a fresh episode: no warning

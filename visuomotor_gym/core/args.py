@@ -42,7 +42,8 @@ def real(
     hi_txt = "inf" if high is None else f"{high:g}"
     allowed = f"{'(' if low_open else '['}{lo_txt}, {hi_txt}{')' if high_open else ']'}"
     if not math.isfinite(x):
-        raise ValueError(f"{arg_name} must be finite, in {allowed}; got {value!r}")
+        where = f", in {allowed}" if (low is not None or high is not None) else ""
+        raise ValueError(f"{arg_name} must be a finite number{where}; got {value!r}")
     if low is not None and (x < low or (low_open and x == low)):
         raise ValueError(f"{arg_name} must be in {allowed}; got {value!r}")
     if high is not None and (x > high or (high_open and x == high)):

@@ -122,6 +122,11 @@ class EyeCatchEnv(VisuomotorEnv):
     floor or far away) or the physics diverges (``info["physics_diverged"]``: MuJoCo's bad-state
     warnings; the last finite observation is returned). Truncated only by the registered
     ``max_episode_steps`` (125 steps = 2.5 s).
+    ``step()`` before the first ``reset()`` raises ``RuntimeError``; ``step()`` after the episode ended
+    warns once (as Gymnasium's checker does) and goes on simulating, unscored, until ``reset()``.
+
+    Every argument is checked at construction (finite, in range, real booleans for flags); the error
+    names the argument, the value and what is allowed.
 
     ## Arguments
 

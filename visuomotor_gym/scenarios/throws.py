@@ -56,11 +56,21 @@ class ThrowDistribution:
     def __post_init__(self) -> None:
         for name, value in self.__dict__.items():
             if isinstance(value, tuple):
-                lo, hi = value
-                if not (np.isfinite(lo) and np.isfinite(hi) and lo <= hi):
-                    raise ValueError(f"ThrowDistribution.{name} must be a (min, max) pair, got {value!r}")
-        if self.flight_time_s[0] <= 0:
-            raise ValueError("ThrowDistribution.flight_time_s must be positive")
+                ok = len(value) == 2 and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)
+                if not (ok and np.isfinite(value[0]) and np.isfinite(value[1]) and value[0] <= value[1]):
+                    raise ValueError(f"ThrowDistribution.{name} must be a finite (min, max) pair with min <= max, "
+                                     f"got {value!r}")
+            elif isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value < 0:
+                raise ValueError(f"ThrowDistribution.{name} must be a finite number >= 0, got {value!r}")
+        positive = ("flight_time_s", "second_stagger_s", "second_arrival_gap_s", "wall_clearance_m")
+        for name in positive:
+            if getattr(self, name)[0] <= 0:
+                raise ValueError(f"ThrowDistribution.{name} must be positive, got {getattr(self, name)!r}")
+        if self.second_max_flight_s <= self.flight_time_s[0]:
+            raise ValueError(
+                f"ThrowDistribution.second_max_flight_s must exceed the shortest flight time "
+                f"{self.flight_time_s[0]} s, got {self.second_max_flight_s!r}"
+            )
 
 
 @dataclass(frozen=True)
