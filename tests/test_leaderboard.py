@@ -316,8 +316,8 @@ def test_superseded_entries_are_kept_but_not_rescored(lb):
             {
                 "superseded": {
                     **already,
-                    KEY: {"reason": "test: the agent changed"},
-                    "nobody__EyeCatch-v0": {"reason": "x"},
+                    KEY: {"reason": "test: the agent changed", "by": "eyecatch__EyeCatch-v0"},
+                    "nobody__EyeCatch-v0": {"reason": "x", "by": KEY},
                 }
             }
         )
@@ -498,7 +498,7 @@ def test_submit_writes_entries_that_pass_and_refuses_to_overwrite(tmp_path, caps
                 "--no-progress",
             ]
         )
-        == 1
+        == 2  # refused before any episode runs
     )
     assert "give the entry its own --name" in capsys.readouterr().err
     assert (
@@ -515,7 +515,7 @@ def test_submit_writes_entries_that_pass_and_refuses_to_overwrite(tmp_path, caps
                 "--no-progress",
             ]
         )
-        == 1
+        == 2
     )
     assert "has no protocol" in capsys.readouterr().err
 
@@ -727,3 +727,83 @@ def test_stochastic_agents_are_rescored_by_replaying_their_seeded_chunk(tmp_path
     common[3] = str(tmp_path / "lb2")
     assert main(["leaderboard", "submit", "--agent", "test-unseeded", *common]) == 1  # submit's own check
     assert "re-scoring seed" in capsys.readouterr().err
+
+
+# ---------------------------------------------------------------- safe policy files and the migration
+
+
+def test_ppo_npz_actor_equals_the_sb3_model_on_many_observations():
+    """The pickle-free actor rebuilt from JSON + arrays gives the SB3 model's actions bit for bit."""
+    import io
+
+    import numpy as np
+    from stable_baselines3 import PPO
+
+    from visuomotor_gym.baselines.ppo.agent import NpzActor, npz_from_model, prove_npz_equals_model, read_npz
+
+    old = COMMITTED / "agents" / "ppo-intercept__EyeCatch-v0.zip"  # our own committed file: trusted here
+    model = PPO.load(io.BytesIO(old.read_bytes()), device="cpu")
+    meta = json.loads(__import__("zipfile").ZipFile(old).read("ppo_meta.json"))
+    data = npz_from_model(model, meta)
+    assert prove_npz_equals_model(data, model, n=3000, seed=1) == 3000
+    committed = (COMMITTED / "agents" / "ppo-intercept-v2__EyeCatch-v0.npz").read_bytes()
+    assert data == committed  # the committed policy file is this conversion, byte for byte
+    actor = NpzActor(*read_npz(data))
+    assert actor(np.zeros(actor.obs_dim, np.float32)).shape == (9,)
+    model.policy.action_net.bias.data += 1e-3  # a different model: the proof must notice
+    with pytest.raises(ValueError, match="differs from the SB3 model"):
+        prove_npz_equals_model(data, model, n=50)
+
+
+def _same(a, b, tol=1e-12):
+    if isinstance(a, dict):
+        return isinstance(b, dict) and set(a) == set(b) and all(_same(a[k], b[k], tol) for k in a)
+    if isinstance(a, list):
+        return isinstance(b, list) and len(a) == len(b) and all(_same(x, y, tol) for x, y in zip(a, b))
+    if isinstance(a, float) and isinstance(b, float):
+        return abs(a - b) <= tol
+    return a == b
+
+
+@pytest.mark.parametrize("old,new", [("ppo-intercept", "ppo-intercept-v2"), ("belief_mpc", "belief_mpc-v2")])
+def test_migrated_entries_have_identical_outcomes(old, new):
+    """The safe-format entries re-enter the superseded ones: every one of the 200 outcomes is identical
+    (caught, diverged, steps, catch and first-saccade times exactly; miss distances within the protocol's
+    distance tolerance: env changes after the old entries moved them by up to 1e-15 m for PPO and 3e-8 m
+    for belief_mpc, whose iLQR amplifies last-bit differences)."""
+    tol = load_protocol(COMMITTED).distance_tolerance_m
+    board = load_leaderboard(COMMITTED)
+    by_key = {e.key: e for e in board.entries}
+    superseded = json.loads((COMMITTED / "superseded.json").read_text())["superseded"]
+    migrated = [e for e in board.entries if e.name == old]
+    assert migrated
+    for e in migrated:
+        twin = by_key[f"{new}__{e.env_id}"]
+        assert superseded[e.key]["by"] == twin.key
+        assert twin.policy["format"] in ("ppo-npz", "belief-mpc-params")
+        for x, y in zip(e.record["episodes"], twin.record["episodes"], strict=True):
+            for k in ("seed", "caught", "diverged", "steps", "catch_time_s", "first_saccade_s"):
+                assert x[k] == y[k], (x["seed"], k)
+            assert _same(x["miss_distance_m"], y["miss_distance_m"], tol), x["seed"]
+        for k in ("caught", "catch_rate", "catch_rate_ci95", "diverged", "reaction_times_s", "time_to_catch_s"):
+            assert twin.results[k] == e.results[k], k
+        for k in ("gaze_realism", "miss_distance_m"):
+            assert _same(twin.results[k], e.results[k], tol), k
+
+
+def test_check_never_unpickles(monkeypatch):
+    """Re-scoring the current PPO entries calls neither pickle nor torch.load."""
+    import pickle
+
+    import torch
+
+    def forbidden(*a, **k):
+        raise AssertionError("the check unpickled something")
+
+    monkeypatch.setattr(pickle, "load", forbidden)
+    monkeypatch.setattr(pickle, "loads", forbidden)
+    monkeypatch.setattr(torch, "load", forbidden)
+    report = check_leaderboard(COMMITTED, base=None, rescore=True, seeds=[0, 1], only={
+        "ppo-intercept-v2__EyeCatch-v0", "ppo-intercept-v2__EyeCatchOracle-v0"}, pages=False)
+    assert report.ok, "\n".join(messages(report))
+    assert report.rescored_episodes == 4
