@@ -95,6 +95,7 @@ def _bad_inputs(tmp_path):
         "submit-workers-0": ([*submit, "--workers", "0"], "--workers must be >= 1"),
         "check-workers-0": (["leaderboard", "check", "--dir", str(lb), "--workers", "0"], "--workers must be >= 1"),
         "check-missing-dir": (["leaderboard", "check", "--dir", str(tmp_path / "nope")], "is not a folder"),
+        "demo-out-in-proc": (["demo", "--out", "/proc/vmgym-demo", "--episodes", "1"], "cannot write there"),
     }
 
 
@@ -102,7 +103,7 @@ CASES = [
     "out-in-proc", "out-under-a-file", "out-onto-a-directory", "ppo-missing-zip", "ppo-corrupt-zip",
     "ppo-zip-without-sb3-data", "ppo-path-with-equals", "ppo-without-path", "unknown-agent", "unknown-env",
     "submit-empty-name", "submit-300-char-name", "submit-name-with-double-underscore", "submit-env-off-protocol",
-    "submit-workers-0", "check-workers-0", "check-missing-dir",
+    "submit-workers-0", "check-workers-0", "check-missing-dir", "demo-out-in-proc",
 ]
 
 

@@ -45,7 +45,14 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     from visuomotor_gym.viz.video import record_episode
 
     out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        probe = out / ".vmgym-write-probe"
+        probe.write_text("")
+        probe.unlink()
+    except OSError as exc:  # before any episode runs
+        print(f"error: --out {out}: cannot write there ({exc.strerror or exc})", file=sys.stderr)
+        return 2
     command = f"vmgym demo --agent {args.agent} --env {args.env} --episodes {args.episodes} --seed {args.seed}"
     result = evaluate(args.agent, args.env, args.episodes, args.seed, workers=1, progress=True)
     results = build_results(result, command)
@@ -107,7 +114,11 @@ def main(argv: list[str] | None = None) -> int:
     if getattr(args, "episodes", 1) < 1:
         print("--episodes must be >= 1", file=sys.stderr)
         return 2
-    return int(args.func(args) or 0)
+    try:
+        return int(args.func(args) or 0)
+    except KeyboardInterrupt:
+        print("interrupted", file=sys.stderr)
+        return 130
 
 
 if __name__ == "__main__":
