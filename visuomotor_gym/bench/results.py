@@ -150,13 +150,13 @@ def _is_int(x) -> bool:
 
 def _semantic_problems(obj: dict) -> list[tuple[str, str]]:
     """Consistency checks a JSON Schema cannot express (each only where the fields are well typed)."""
-    from visuomotor_gym.registration import CATCH_ENV_IDS
+    from visuomotor_gym.registration import ENV_IDS
 
     out = []
     env_id = obj.get("env_id")
-    if isinstance(env_id, str) and env_id not in CATCH_ENV_IDS:
+    if isinstance(env_id, str) and env_id not in ENV_IDS:  # any family (issue 10), not only catch
         out.append(("$.env_id", f"{env_id!r} is not a registered environment id "
-                                 f"(known: {', '.join(CATCH_ENV_IDS)})"))
+                                 f"(known: {', '.join(ENV_IDS)})"))
 
     episodes, caught, seed = obj.get("episodes"), obj.get("caught"), obj.get("seed")
     rate = obj.get("catch_rate")
