@@ -3,6 +3,7 @@
 #   make test   set up, then run the whole test suite
 #   make bench  set up, then run the benchmarks in benchmarks/
 #   make leaderboard-check   set up, then run the leaderboard check CI runs (leaderboard/)
+#   make test-ray   a second venv (.venv-ray) with the distributed extra (Ray), then the Ray-backend tests
 
 PYTHON ?= python3
 VENV ?= .venv
@@ -13,7 +14,10 @@ PIP := $(PY) -m pip
 STAMP := $(VENV)/.installed
 export MUJOCO_GL ?= egl
 
-.PHONY: setup demo test test-fast bench leaderboard-check clean
+RAY_VENV ?= .venv-ray
+RAY_STAMP := $(RAY_VENV)/.installed
+
+.PHONY: setup demo test test-fast test-ray bench leaderboard-check clean
 
 $(STAMP): pyproject.toml Makefile
 	$(PYTHON) -m venv $(VENV)
@@ -33,6 +37,16 @@ test: setup
 test-fast: setup
 	$(PY) -m pytest -n 2 -m "not slow"
 
+# Ray pins its own dependencies; a separate venv (no torch) keeps the main one as users install it.
+$(RAY_STAMP): pyproject.toml Makefile
+	$(PYTHON) -m venv $(RAY_VENV)
+	$(RAY_VENV)/bin/python -m pip install --quiet --upgrade pip
+	$(RAY_VENV)/bin/python -m pip install --quiet -e ".[distributed,dev]"
+	touch $(RAY_STAMP)
+
+test-ray: $(RAY_STAMP)
+	VMGYM_REQUIRE_RAY=1 $(RAY_VENV)/bin/python -m pytest -q -m ray tests/test_ray_backend.py
+
 bench: setup
 	$(PY) benchmarks/env_throughput.py
 
@@ -40,4 +54,4 @@ leaderboard-check: setup
 	$(VENV)/bin/vmgym leaderboard check
 
 clean:
-	rm -rf $(VENV) build dist *.egg-info outputs .pytest_cache
+	rm -rf $(VENV) $(RAY_VENV) build dist *.egg-info outputs .pytest_cache

@@ -29,6 +29,12 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, required=True, help="first seed (>= 0); episode i uses seed + i")
     p.add_argument("--out", required=True, help="results JSON file to write")
     p.add_argument("--workers", type=int, default=1, help="worker processes (default 1: in-process)")
+    p.add_argument("--backend", choices=("local", "ray"), default="local",
+                   help="local: this process or a process pool of --workers (default); ray: Ray tasks on a "
+                        "cluster (pip install 'visuomotor_gym[distributed]'), same per-seed outcomes")
+    p.add_argument("--address", default=None,
+                   help="with --backend ray: the cluster address (auto, ray://host:10001); default: start "
+                        "a local cluster")
     p.add_argument("--traces", default=None, help="also write the per-episode traces to this .npz file")
     p.add_argument("--force", action="store_true", help="overwrite --out / --traces if they exist")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
@@ -40,6 +46,8 @@ def canonical_command(args: argparse.Namespace) -> str:
     """The command that reproduces the numbers (output paths reduced to file names: no personal paths)."""
     parts = ["vmgym", "bench", "--agent", args.agent, "--env", args.env, "--episodes", str(args.episodes),
              "--seed", str(args.seed), "--workers", str(args.workers), "--out", Path(args.out).name]
+    if getattr(args, "backend", "local") != "local":
+        parts[-2:-2] = ["--backend", args.backend]
     if args.traces:
         parts += ["--traces", Path(args.traces).name]
     return shlex.join(parts)
@@ -172,11 +180,19 @@ def main_bench(args: argparse.Namespace) -> int:
         return 1
     try:
         validate_inputs(args.agent, args.env, args.episodes, args.seed, args.workers)
+        if args.address is not None and args.backend != "ray":
+            raise ValueError("--address is only used with --backend ray")
+        if args.backend == "ray":
+            import importlib.util
+
+            if importlib.util.find_spec("ray") is None:
+                raise ValueError("--backend ray needs Ray: pip install 'visuomotor_gym[distributed]'")
     except (ValueError, TypeError, OSError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     result = evaluate(args.agent, args.env, args.episodes, args.seed, workers=args.workers,
-                      keep_traces=traces_path is not None, progress=not args.no_progress)
+                      keep_traces=traces_path is not None, progress=not args.no_progress,
+                      backend=args.backend, address=args.address)
     try:
         results = build_results(result, canonical_command(args))
         print_summary(results)

@@ -204,6 +204,42 @@ def _run_in_pool(agent, env_id, chunks, seeds, workers, progress) -> list[list[E
     return results
 
 
+BACKENDS = ("local", "ray")
+
+
+def _run_on_ray(agent, env_id, chunks, seeds, address, progress) -> list[list[EpisodeTrace]]:
+    """Spread the chunks over Ray tasks (one CPU each) on a local or remote cluster.
+
+    The chunks, their seeds and the one-agent-per-chunk rule are the local pool's, so a deterministic
+    agent gives the same per-seed outcomes. Workers must be able to import ``visuomotor_gym`` (true for
+    a local cluster started from this environment; on a remote cluster install the package there or
+    pass a ``runtime_env`` through ``ray.init`` before calling).
+    """
+    try:
+        import ray
+    except ImportError as exc:
+        raise RuntimeError("backend='ray' needs Ray: pip install 'visuomotor_gym[distributed]'") from exc
+    started_here = not ray.is_initialized()
+    if started_here:
+        ray.init(address=address, log_to_driver=False, include_dashboard=False, configure_logging=False)
+    try:
+        remote_chunk = ray.remote(num_cpus=1)(run_chunk)
+        refs = [remote_chunk.remote(agent, env_id, [seeds[i] for i in chunk]) for chunk in chunks]
+        index = {ref: k for k, ref in enumerate(refs)}
+        results: list = [None] * len(refs)
+        pending = list(refs)
+        while pending:
+            done, pending = ray.wait(pending, num_returns=1)
+            k = index[done[0]]
+            results[k] = ray.get(done[0])  # re-raises a task's exception here
+            if progress is not None:
+                progress.advance(progress.task_ids[0], len(chunks[k]))
+        return results
+    finally:
+        if started_here:
+            ray.shutdown()
+
+
 def evaluate(
     agent: str,
     env_id: str,
@@ -212,6 +248,8 @@ def evaluate(
     workers: int = 1,
     keep_traces: bool = True,
     progress: bool = False,
+    backend: str = "local",
+    address: str | None = None,
 ) -> EvalResult:
     """Play ``agent`` for ``episodes`` episodes of ``env_id`` on seeds ``seed .. seed+episodes-1``.
 
@@ -224,6 +262,10 @@ def evaluate(
         workers: processes to spread chunks of episodes over; 1 runs in this process.
         keep_traces: keep the per-episode traces in the result (the summary is computed either way).
         progress: show a rich progress bar.
+        backend: ``"local"`` (this process, or a process pool of ``workers``) or ``"ray"`` (Ray tasks
+            on the cluster at ``address``; ``None`` starts a local one; ``workers`` is then ignored:
+            Ray schedules one task per chunk on the cluster's CPUs). Per-seed outcomes are identical.
+        address: Ray cluster address (``"auto"``, ``"ray://host:10001"``...), ``backend="ray"`` only.
 
     Raises:
         ValueError / TypeError: unknown env id or agent, agent overrides the agent rejects,
@@ -232,6 +274,10 @@ def evaluate(
     from visuomotor_gym.agents import is_deterministic
 
     env_id = validate_inputs(agent, env_id, episodes, seed, workers)
+    if backend not in BACKENDS:
+        raise ValueError(f"backend={backend!r} is not one of {list(BACKENDS)}")
+    if address is not None and backend != "ray":
+        raise ValueError("address is only used with backend='ray'")
     from visuomotor_gym.metrics import summarize  # imported up front: fail before the rollouts
 
     seeds = episode_seeds(seed, episodes)
@@ -242,7 +288,9 @@ def evaluate(
     if bar is not None:
         bar.start()
     try:
-        if workers == 1:
+        if backend == "ray":
+            parts = _run_on_ray(agent, env_id, chunks, seeds, address, bar)
+        elif workers == 1:
             parts = _run_in_process(agent, env_id, chunks, seeds, bar)
         else:
             parts = _run_in_pool(agent, env_id, chunks, seeds, workers, bar)
