@@ -20,8 +20,9 @@ rest is human data, every constant an :class:`OculomotorParams` field with its s
 * pursuit is driven by **target motion**, which the plant reads from the gaze request stream: the
   angular velocity of the requested direction between consecutive control steps. A static offset
   does not drive pursuit (humans cannot pursue without a moving target); a step of the request
-  larger than the saccade threshold is a position step, not motion; and a step taken while a
-  saccade was in flight, or after which the eye was held at its range, carries no motion signal
+  larger than the saccade threshold is a position step, not motion; and a step to a request that
+  starts a saccade, taken while a saccade was in flight, or after which the eye was held at its
+  range, carries no motion signal
   (saccadic suppression; a carried eye moves an eye-relative request). Without a new sample the
   last one is held;
 * the drive reaches the eye after an **onset latency** (``pursuit_latency_s``, Bahill & McDonald 1983);
@@ -305,7 +306,6 @@ class OculomotorPlant:
         tx, ty, tz = np.asarray(target, dtype=float).tolist()
         n = math.sqrt(tx * tx + ty * ty + tz * tz)
         request = (tx / n, ty / n, tz / n)
-        self._sample_target_motion(request, dt)
         started = deferred = False
         if self.saccade is None:
             amplitude = angle_between(self.gaze, request)
@@ -324,6 +324,10 @@ class OculomotorPlant:
                     started = True
                 else:
                     deferred = True  # waits for the generator; not executed as pursuit
+        # A request that starts a saccade is a position command (it may aim ahead of the target):
+        # like the steps with a saccade in flight, it carries no motion signal.
+        self._suppressed = self._suppressed or started
+        self._sample_target_motion(request, dt)
 
         saccading = self.saccade is not None
         h = dt / n_substeps
