@@ -5,14 +5,19 @@ The agent sees observations only. Each 20 ms control step:
 1. **Perception** (section 3.2): a Kalman filter with a gravity internal model fuses the eye's
    noisy eye-frame samples, each weighted by the vision model's covariance A Sigma^2 A^T (Eq. 1-14);
    an abnormal Mahalanobis innovation resets the prior (bounces).
-2. **Gaze** (section 4.1): the eye is sent to the predicted ball. The first saccade is suppressed until
-   the retinal (eye-frame y-z) position uncertainty from the innovation covariance S (Eq. 11) is below
-   a threshold; then large errors produce catch-up saccades (the plant allows one per 200 ms) and
-   small ones pursuit toward the ball's predicted next position, ``v = (p_target - p) / dt``.
-3. **Head** (section 4.2): at every visuomotor update the head turns by the part of the eye-in-head
-   angle beyond a 20 deg dead zone (Eq. 17-18), as a ~400 ms minimum-jerk submovement; between
-   saccades "the pursuit velocity of the head, which is identical to that of the eye, is then
-   added", so pursuit (also before the first saccade) does not drive the eye into its range limits.
+2. **Gaze** (section 4.1): the eye is sent to the predicted ball. The first saccade is suppressed
+   (gaze held: no saccade, no pursuit) for a human saccadic latency (0.18 s) and then until the
+   estimated retinal (eye-frame Y-Z) error of the ball where the saccade would land is below a
+   criterion (or a deadline passes). Then the request is the ball predicted at the next step: the
+   plant pursues its motion with human latency, gain and acceleration, so the eye falls behind a fast
+   ball and the plant turns the growing error into catch-up saccades, one per >= 200 ms refractory
+   period, each aimed where the ball will be when it lands; pursuit dominates once the ball slows
+   near its apex.
+3. **Head** (section 4.2): at every visuomotor update the head turns, about the axis from its last
+   destination to the eye's gaze destination, by the part of the total angle theta beyond a 20 deg
+   dead zone (Eq. 17-18), as a ~400 ms minimum-jerk submovement; between saccades "the pursuit
+   velocity of the head, which is identical to that of the eye, is then added": the head's plan
+   follows the eye's measured pursuit, so pursuit does not drive the eye into its range limits.
 4. **Hand** (section 4.3): a superposition of ~400 ms minimum-jerk submovements (Eq. 15-16), one per
    visuomotor update (every ~200 ms, re-synchronised to each saccade onset), each aimed from the
    previous destination (not the current position) to the new one, peak speed <= 2 m/s:
