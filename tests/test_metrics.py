@@ -175,30 +175,40 @@ def locked_gaze_after(t_lock: float) -> np.ndarray:
     return gaze
 
 
-def test_gaze_on_the_ball_after_the_first_saccade_gives_foveation_one():
-    # The saccade starts at 0.28 s (row t = 0.30 is in flight) and lands at t = 0.32; gaze is on the ball
-    # from t = 0.30.
-    tr = make_trace(saccades=(0.28,), saccade_rows=1, gaze=locked_gaze_after(0.30))
+def test_gaze_on_the_ball_from_a_human_first_saccade_gives_foveation_one():
+    # A first saccade at 0.20 s (human latency) that lands by 0.24 s: on the ball for the whole window,
+    # which starts at 0.25 s for every agent.
+    tr = make_trace(saccades=(0.20,), saccade_rows=1, gaze=locked_gaze_after(0.22))
     assert M.ball_foveation(tr) == pytest.approx(1.0)
-    # Counting from the release instead would include the rows where the gaze stays on the release point
-    # while the ball flies off: the measure must start at the landing.
+    # Counting from the release would include the rows where the gaze stays on the release point.
     ecc = M.ball_eccentricity_deg(tr)
     assert np.mean(ecc <= 5.0) < 0.95
 
 
+def test_foveation_window_is_the_same_for_every_agent():
+    """A late first saccade no longer moves the window: it costs the rows the ball was off the fovea."""
+    t = np.round(np.arange(0.0, FLIGHT + 1e-9, DT), 10)
+    early = make_trace(saccades=(0.20,), saccade_rows=1, gaze=locked_gaze_after(0.22))
+    late = make_trace(saccades=(0.48,), saccade_rows=1, gaze=locked_gaze_after(0.50))
+    window = t >= 0.25 - 1e-9
+    ecc = M.ball_eccentricity_deg(late)
+    assert M.ball_foveation(late) == pytest.approx(np.mean(ecc[window] <= 5.0))
+    assert M.ball_foveation(late) < M.ball_foveation(early) - 0.1
+
+
 def test_foveation_counts_rows_off_the_ball():
-    gaze = locked_gaze_after(0.30)
+    gaze = locked_gaze_after(0.22)
     t = np.round(np.arange(0.0, FLIGHT + 1e-9, DT), 10)
     off = (t > 0.59) & (t < 0.69)  # 5 rows with the gaze 10 deg below the ball
     az, el = np.degrees(np.arctan2(gaze[off, 1], gaze[off, 0])), np.degrees(np.arcsin(gaze[off, 2]))
     gaze[off] = direction(az, el - 10.0)
-    tr = make_trace(saccades=(0.28,), saccade_rows=1, gaze=gaze)
-    n_counted = int(np.sum(t >= 0.32 - 1e-9))
+    tr = make_trace(saccades=(0.20,), saccade_rows=1, gaze=gaze)
+    n_counted = int(np.sum(t >= 0.25 - 1e-9))
     assert off.sum() == 5
     assert M.ball_foveation(tr) == pytest.approx(1.0 - 5 / n_counted)
 
 
-def test_foveation_without_saccade_counts_from_the_release():
+def test_foveation_without_saccade():
     tr = make_trace(gaze="ball")
     assert M.ball_foveation(tr) == pytest.approx(1.0)
     tr = make_trace()  # gaze left on the release point: the ball leaves the fovea within a few rows

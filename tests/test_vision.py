@@ -45,10 +45,16 @@ def own_basis(u: np.ndarray) -> np.ndarray:
     return np.column_stack([u, e2, e3])
 
 
-def expected_stds(d, ecc, retinal_speed, *, scale=1.0, foveated=True):
-    """Closed-form diagonal of Sigma: (depth, lat, lat, depth rate, lat rate, lat rate)."""
+KNEE = 2.5 * DEG  # rad/s: foveal acuity unchanged by image motion up to 2.5 deg/s (Westheimer & McKee 1975)
+
+
+def expected_stds(d, ecc, retinal_speed, *, scale=1.0, foveated=True, knee=KNEE):
+    """Closed-form diagonal of Sigma: (depth, lat, lat, depth rate, lat rate, lat rate).
+
+    The lateral position std grows with the retinal slip above the knee, x max(1, |slip| / knee)
+    (foveated eye only; ``knee=math.inf``: the paper's static acuity)."""
     k = scale * ((E2 + ecc) / E2 if foveated else 1.0)
-    lat = d * ARCMIN_RAD
+    lat = d * ARCMIN_RAD * (max(1.0, abs(retinal_speed) / knee) if foveated else 1.0)
     lat_rate = d * (0.05 * abs(retinal_speed) + 0.2 * DEG)
     return k * np.array([0.05 * d, lat, lat, 0.1 * d, lat_rate, lat_rate])
 
@@ -164,8 +170,84 @@ def test_velocity_lateral_std_weber_plus_floor(retinal_speed):
     want = d * (0.05 * abs(retinal_speed) + 0.2 * DEG)
     assert sig[4] == pytest.approx(want, rel=1e-12)
     assert sig[5] == pytest.approx(want, rel=1e-12)
-    # position and depth terms do not depend on the retinal speed
-    np.testing.assert_allclose(sig[[0, 1, 2, 3]], fov.standard_deviations(d, 0.0, 0.0, p)[[0, 1, 2, 3]])
+    # the depth terms do not depend on the retinal speed (the lateral position does: see the slip tests)
+    np.testing.assert_allclose(sig[[0, 3]], fov.standard_deviations(d, 0.0, 0.0, p)[[0, 3]])
+
+
+# ------------------------------------------------------------------------------------------------
+# Moving-target localisation: lateral position std x max(1, slip / knee) (issue 11)
+# ------------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("slip_deg_s", [0.0, 1.0, 2.5, 2.6, 5.0, 25.0, 100.0, -40.0])
+@pytest.mark.parametrize("ecc_deg", [0.0, 10.0])
+def test_lateral_position_std_grows_with_retinal_slip(slip_deg_s, ecc_deg):
+    p = VisionParams()
+    assert p.position_slip_knee_deg_s == 2.5
+    d, ecc, slip = 3.0, ecc_deg * DEG, slip_deg_s * DEG
+    sig = fov.standard_deviations(d, ecc, slip, p)
+    growth = max(1.0, abs(slip_deg_s) / 2.5)
+    alpha = E2 / (E2 + ecc)
+    assert sig[1] == pytest.approx(d * ARCMIN_RAD * growth / alpha, rel=1e-12)  # small-angle, Eq. 2
+    assert sig[2] == pytest.approx(sig[1], rel=1e-15)
+    assert fov.slip_factor(slip, p) == pytest.approx(growth, rel=1e-12)
+    # the other terms are the paper's, unchanged
+    static = fov.standard_deviations(d, ecc, slip, VisionParams(position_slip_knee_deg_s=math.inf))
+    np.testing.assert_allclose(sig[[0, 3, 4, 5]], static[[0, 3, 4, 5]], rtol=1e-15)
+    np.testing.assert_allclose(sig, expected_stds(d, ecc, slip), rtol=1e-12)
+    # 20 arcmin at 50 deg/s, the docstring's example
+    assert fov.standard_deviations(1.0, 0.0, 50 * DEG, p)[1] == pytest.approx(20 * ARCMIN_RAD, rel=1e-12)
+
+
+@pytest.mark.parametrize("slip_deg_s", [0.0, 10.0, 300.0])
+def test_paper_vision_and_full_view_have_static_acuity(slip_deg_s):
+    slip = slip_deg_s * DEG
+    paper = VisionParams(position_slip_knee_deg_s=math.inf)
+    full = VisionParams(foveated=False)
+    for params, ecc, fov_ed in ((paper, 5 * DEG, True), (full, 30 * DEG, False)):
+        sig = fov.standard_deviations(2.0, ecc, slip, params)
+        assert sig[1] == pytest.approx(2.0 * ARCMIN_RAD * ((E2 + ecc) / E2 if fov_ed else 1.0), rel=1e-12)
+        np.testing.assert_allclose(sig, expected_stds(2.0, ecc, slip, foveated=fov_ed, knee=math.inf), rtol=1e-12)
+
+
+def test_slip_covariance_and_samples_follow_the_closed_form():
+    p = VisionParams()
+    pos, vel = np.array([2.0, 0.5, -0.3]), np.array([-4.0, 1.0, 2.0])
+    slip = 40 * DEG  # 16 x the knee
+    d = float(np.linalg.norm(pos))
+    ecc = fov.eccentricity(pos)
+    rot = own_basis(pos)
+    want = blockdiag(rot) @ np.diag(expected_stds(d, ecc, slip) ** 2) @ blockdiag(rot).T
+    np.testing.assert_allclose(fov.covariance(pos, slip, p), want, rtol=1e-9, atol=1e-15)
+    x = draw(pos, vel, slip, p, 4000, seed=11)
+    lateral = (x[:, :3] - pos) @ rot[:, 1:]  # across the line of sight
+    assert np.std(lateral, axis=0) == pytest.approx([expected_stds(d, ecc, slip)[1]] * 2, rel=0.06)
+
+
+@pytest.mark.parametrize("knee", [0.0, -1.0, float("nan")])
+def test_slip_knee_must_be_positive(knee):
+    with pytest.raises(ValueError, match="position_slip_knee_deg_s"):
+        VisionParams(position_slip_knee_deg_s=knee)
+
+
+def test_paper_condition_ids_and_agents_use_the_paper_vision():
+    from visuomotor_gym.agents import make_agent
+    from visuomotor_gym.registration import CATCH_ENV_IDS, env_vision_params
+
+    normal = gym.make("EyeCatchPaper-v0").unwrapped.vision_params
+    poor = gym.make("EyeCatchPaperPoorVision-v0").unwrapped.vision_params
+    assert normal == VisionParams(position_slip_knee_deg_s=math.inf)
+    assert poor == VisionParams(position_slip_knee_deg_s=math.inf, noise_scale=10.0)
+    for env_id in CATCH_ENV_IDS:  # the brain's model of its eye is the env's eye
+        env = gym.make(env_id)
+        want = env.unwrapped.vision_params
+        if env.unwrapped.vision == "oracle":
+            want = VisionParams(noise_scale=0.0, foveated=False)
+        assert env_vision_params(env_id) == want, env_id
+        for spec in ("eyecatch", "belief_mpc", "fixed_gaze"):
+            if env_id == "EyeCatchTwoBalls-v0":
+                continue
+            agent = make_agent(spec, env_id, 9)
+            assert getattr(agent, "base", agent).vision == want, (spec, env_id)
+        env.close()
 
 
 def test_noise_scale_multiplies_everything():
@@ -318,7 +400,8 @@ def test_unfoveated_acuity_is_one_everywhere():
     for ecc_deg in (0.0, 5.0, 60.0, 120.0, 180.0):
         assert fov.acuity(ecc_deg * DEG, p) == 1.0
         np.testing.assert_allclose(
-            fov.standard_deviations(3.0, ecc_deg * DEG, 0.2, p), expected_stds(3.0, 0.0, 0.2), rtol=1e-12
+            fov.standard_deviations(3.0, ecc_deg * DEG, 0.2, p), expected_stds(3.0, 0.0, 0.2, foveated=False),
+            rtol=1e-12,
         )
 
 
@@ -574,9 +657,10 @@ def _position_errors(env_id, seeds, gaze_offset):
 
 
 def test_env_position_noise_matches_model():
+    # The paper's static acuity (EyeCatchPaper-v0): the slip term of EyeCatch-v0 is tested below.
     seeds = range(4)
     offset = (0.4, -0.1)  # look ~25 deg away from the ball after the first step
-    ecc_f, d_f, depth_f, lat_f = _position_errors("EyeCatch-v0", seeds, offset)
+    ecc_f, d_f, depth_f, lat_f = _position_errors("EyeCatchPaper-v0", seeds, offset)
     ecc_u, d_u, depth_u, lat_u = _position_errors("EyeCatchFullView-v0", seeds, offset)
     assert len(d_f) > 100 and len(d_u) > 100
 
@@ -600,3 +684,40 @@ def test_env_position_noise_matches_model():
     ang_u = np.sqrt(np.mean((lat_u / d_u) ** 2))
     assert ang_f > 5.0 * ang_u
     assert ang_u == pytest.approx(math.sqrt(2.0) * ARCMIN_RAD, rel=0.25)
+
+
+def test_env_lateral_noise_grows_with_retinal_slip():
+    """EyeCatch-v0 with the eye held: the lateral error, divided by the closed-form std at the true
+    retinal slip (line-of-sight rotation minus the eye's, from ``info``), is a unit normal."""
+    env = gym.make("EyeCatch-v0")
+    s = env.unwrapped.layout.slices
+    z, slips = [], []
+    for seed in range(6):
+        obs, info = env.reset(seed=seed)
+        prev = info
+        for _ in range(100):
+            obs, _, term, trunc, info = env.step(_action())
+            if obs[s["ball_visible"]][0] == 1.0 and not info["in_saccade"]:
+                rot, eye = _eye_frame(env, obs)
+                rel = info["ball_pos"] - eye
+                d = float(np.linalg.norm(rel))
+                u = rel / d
+                # as the env: ball velocity relative to the moving eye, minus the gaze's own rotation
+                rv = info["ball_vel"] - (info["eye_pos"] - prev["eye_pos"]) / env.unwrapped.dt
+                w = np.cross(rel, rv) / d**2 - np.cross(prev["gaze_dir"], info["gaze_dir"]) / env.unwrapped.dt
+                w -= (w @ u) * u
+                slip = float(np.linalg.norm(w))
+                ecc = fov.eccentricity(rot.T @ rel)
+                e = rot @ obs[s["ball_pos"]].astype(float) + eye - info["ball_pos"]
+                lateral = e - (e @ u) * u
+                z.append(np.linalg.norm(lateral) / expected_stds(d, ecc, slip)[1])
+                slips.append(slip)
+            prev = info
+            if term or trunc:
+                break
+    env.close()
+    z, slips = np.array(z), np.array(slips)
+    fast = slips > 10 * KNEE
+    assert len(z) > 200 and fast.sum() > 50  # a held eye sees the ball slip fast
+    assert math.sqrt(np.mean(z**2) / 2.0) == pytest.approx(1.0, abs=0.2)  # 2 lateral axes
+    assert math.sqrt(np.mean(z[fast] ** 2) / 2.0) == pytest.approx(1.0, abs=0.2)

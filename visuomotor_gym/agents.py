@@ -16,6 +16,12 @@ Agent names (``make_agent``):
 * ``ppo:<path>``: a policy trained by ``vmgym train ppo`` (``visuomotor_gym.baselines.ppo``).
 * ``belief_intercept``: no learning, the base of PPO's belief-relative hand action (closed hand at the
   Eyecatch filter's interception point, gaze held still).
+* ``gaze_blind:<agent spec>``: any agent with its gaze and head held (:class:`GazeBlind`): the gaze
+  action is 0 (gaze held fixed in the world, where reset put it: on the thrower) and the head action
+  0 (the reset pose, straight ahead); everything else is the base agent's. The *gaze-blind twin* of
+  DESIGN section 4: the agent's success minus its twin's on the same seeds is the gaze gain.
+* ``fixed_gaze``: ``gaze_blind:eyecatch`` (the Eyecatch filter and hand, gaze and head held);
+  ``fixed_gaze:param=value`` passes overrides to the Eyecatch agent.
 
 Further names register with :func:`register_agent`.
 """
@@ -42,13 +48,24 @@ class Policy(Protocol):
 
 AgentFactory = Callable[..., Policy]
 _REGISTRY: dict[str, tuple[AgentFactory, str, bool]] = {}
+_WRAPPERS: set[str] = set()  # names whose text after ':' is a whole agent spec (``gaze_blind:<spec>``)
 
 
-def register_agent(name: str, factory: AgentFactory, description: str = "", deterministic: bool = True) -> None:
-    """Register ``factory(env_id=..., action_dim=..., seed=..., **overrides) -> Policy`` under ``name``."""
+def register_agent(name: str, factory: AgentFactory, description: str = "", deterministic: bool = True,
+                   wraps: bool = False) -> None:
+    """Register ``factory(env_id=..., action_dim=..., seed=..., **overrides) -> Policy`` under ``name``.
+
+    With ``wraps=True`` the name wraps another agent: ``name:<agent spec>`` calls
+    ``factory(env_id=..., action_dim=..., seed=..., base=<agent spec>)`` and the wrapper is as
+    deterministic as its base.
+    """
     if ":" in name:
         raise ValueError(f"agent names cannot contain ':' (it separates overrides): {name!r}")
     _REGISTRY[name] = (factory, description, deterministic)
+    if wraps:
+        _WRAPPERS.add(name)
+    else:
+        _WRAPPERS.discard(name)
 
 
 def agent_names() -> list[str]:
@@ -61,7 +78,9 @@ def agent_description(name: str) -> str:
 
 def is_deterministic(spec: str) -> bool:
     """Whether the named agent gives the same actions for the same observations (re-scorable)."""
-    name, _ = parse_agent_spec(spec)
+    name, overrides = parse_agent_spec(spec)
+    if name in _WRAPPERS:
+        return is_deterministic(overrides["base"])
     return _REGISTRY[name][2]
 
 
@@ -86,6 +105,11 @@ def parse_agent_spec(spec: str) -> tuple[str, dict[str, Any]]:
     name, colon, rest = spec.partition(":")
     if name not in _REGISTRY:
         raise ValueError(f"unknown agent {name!r}; known agents: {agent_names()}")
+    if name in _WRAPPERS:  # "gaze_blind:eyecatch:alpha=1": the rest is the base agent's whole spec
+        if not rest:
+            raise ValueError(f"{name!r} wraps another agent: write {name}:<agent spec>, e.g. {name}:eyecatch")
+        parse_agent_spec(rest)  # an unknown base agent fails here, naming the known ones
+        return name, {"base": rest}
     overrides: dict[str, Any] = {}
     if name in PATH_AGENTS:
         if colon and not rest.strip():
@@ -141,6 +165,103 @@ class ZeroAgent:
         return np.zeros(self.action_dim, dtype=np.float32), state
 
 
+def _with_env_vision(agent, env_id, overrides):
+    """``agent`` given every vision constant of the registered ``env_id`` (``for_env`` sets the noise
+    scale, foveation and latency only; the paper-condition ids also change ``vision_params``), unless
+    the spec overrides the vision the agent assumes (``eyecatch:vision_noise_scale=5``)."""
+    from visuomotor_gym.registration import env_vision_params
+
+    if not ({"vision_noise_scale", "foveated"} & set(overrides)):
+        match_vision(agent, env_vision_params(env_id))
+    return agent
+
+
+def match_vision(policy, vision) -> None:
+    """Give a model-based agent (its gaze-blind wrapper included) the exact ``VisionParams`` of its eye.
+
+    The Eyecatch and belief-MPC agents weight each sample with the vision model's covariance (a brain
+    adapted to its own eye); ``for_env`` gives them the registered id's noise scale and foveation on
+    top of the default constants. This sets every constant, for envs made with non-default
+    ``vision_params`` (the paper conditions, the sweeps of ``benchmarks/gaze_gain_sweep.py``).
+    Agents without a vision model are left alone.
+    """
+    inner = policy
+    while isinstance(inner, GazeBlind):
+        inner = inner.base
+    for agent in (inner, getattr(inner, "_agent", None)):  # PPO's belief features wrap an Eyecatch agent
+        if agent is None or not hasattr(agent, "vision"):
+            continue
+        agent.vision = vision
+        if hasattr(agent, "noise") and hasattr(agent, "_problems"):  # belief_mpc: its planning noise too
+            from visuomotor_gym.baselines.belief_mpc.belief import ObservationNoise
+
+            p = agent.params
+            agent.noise = ObservationNoise.from_vision(vision, eps_deg=p.fovea_smoothing_deg,
+                                                       angular=p.angular_uncertainty)
+            agent._problems = {}
+
+
+class GazeBlind:
+    """Any agent with its gaze and head held: the *gaze-blind twin* of DESIGN section 4.
+
+    Every action of the base agent passes through unchanged except two blocks, overwritten with 0:
+    the **gaze** change (0 holds gaze fixed in the world, so the eye stays where reset put it, on the
+    thrower's hand, and never saccades; the vestibulo-ocular reflex keeps it there while the torso
+    moves, up to the eye's range) and the **head** target (0 is the reset pose, straight ahead). The
+    fixation (vergence) action is the base agent's: it does not change what is seen.
+
+    The base agent still runs its own filter on the observations, which report the held eye pose, so
+    its estimate stays consistent; only where the eye looks changes. The action layout follows the
+    env's ``action_structure`` (``control="hand"``: 9 values, gaze 4-5, head 7-8; ``control="joint"``:
+    16 values, gaze 11-12, head 14-15).
+    """
+
+    GAZE_HEAD_BLOCKS = {9: ((4, 6), (7, 9)), 16: ((11, 13), (14, 16))}
+
+    def __init__(self, base: Policy, action_dim: int):
+        if action_dim not in self.GAZE_HEAD_BLOCKS:
+            raise ValueError(f"gaze_blind knows the catch action layouts of size 9 and 16, not {action_dim}")
+        self.base = base
+        self.action_dim = action_dim
+        (g0, g1), (h0, h1) = self.GAZE_HEAD_BLOCKS[action_dim]
+        self.held = np.zeros(action_dim, dtype=bool)
+        self.held[g0:g1] = True
+        self.held[h0:h1] = True
+
+    def reset(self) -> None:
+        if hasattr(self.base, "reset"):
+            self.base.reset()
+
+    def predict(self, observation, state=None, episode_start=None, deterministic=True):
+        action, state = self.base.predict(observation, state=state, episode_start=episode_start,
+                                          deterministic=deterministic)
+        action = np.array(action, dtype=np.float32, copy=True)
+        if action.shape[-1] != self.action_dim:
+            raise ValueError(f"base agent gave an action of shape {action.shape}, expected (..., {self.action_dim})")
+        action[..., self.held] = 0.0
+        return action, state
+
+    def __getattr__(self, name):  # the base agent's plotting state (events, filter, ...)
+        if name == "base":
+            raise AttributeError(name)
+        return getattr(self.base, name)
+
+
+def gaze_blind(agent: Policy, action_dim: int = 9) -> GazeBlind:
+    """``agent`` with its gaze and head held (see :class:`GazeBlind`)."""
+    return GazeBlind(agent, action_dim)
+
+
+def _gaze_blind(env_id, action_dim, seed, base=None, **kw):
+    if kw:
+        raise TypeError(f"gaze_blind takes no overrides of its own; put them on the base agent: {sorted(kw)}")
+    return GazeBlind(make_agent(base, env_id, action_dim, seed=seed), action_dim)
+
+
+def _fixed_gaze(env_id, action_dim, seed, **kw):
+    return GazeBlind(_eyecatch(env_id, action_dim, seed, **kw), action_dim)
+
+
 def _oracle(env_id, action_dim, seed, **kw):
     from visuomotor_gym.baselines.oracle import InterceptOracle
 
@@ -157,13 +278,13 @@ def _eyecatch(env_id, action_dim, seed, **kw):
         from visuomotor_gym.baselines.belief_mpc.sequential import SequentialEyecatch
 
         return SequentialEyecatch.for_env(env_id, **kw)
-    return EyecatchAgent.for_env(env_id, **kw)
+    return _with_env_vision(EyecatchAgent.for_env(env_id, **kw), env_id, kw)
 
 
 def _belief_mpc(env_id, action_dim, seed, **kw):
     from visuomotor_gym.baselines.belief_mpc import BeliefMPCAgent
 
-    return BeliefMPCAgent.for_env(env_id, **kw)
+    return _with_env_vision(BeliefMPCAgent.for_env(env_id, **kw), env_id, kw)
 
 
 def _ppo(env_id, action_dim, seed, path=None, **kw):
@@ -202,3 +323,7 @@ register_agent("belief_intercept", _belief_intercept,
 register_agent("ppo", _ppo, "a trained stable-baselines3 PPO/RecurrentPPO policy: ppo:<model.zip or run folder>")
 register_agent("eyecatch", _eyecatch, "Eyecatch heuristic (Yeo et al. 2012): Kalman filter, saccades, submovements")
 register_agent("belief_mpc", _belief_mpc, "belief-space MPC (Eom et al. 2019): Kalman beliefs, iLQR over gaze, head, hand")
+register_agent("gaze_blind", _gaze_blind,
+               "gaze_blind:<agent>: that agent with its gaze and head held (its gaze-blind twin)", wraps=True)
+register_agent("fixed_gaze", _fixed_gaze,
+               "gaze_blind:eyecatch: the Eyecatch filter and hand with gaze and head held (gaze-blind reference)")

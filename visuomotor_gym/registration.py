@@ -6,7 +6,8 @@ this package first, which runs :func:`register_envs`.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import math
+from dataclasses import asdict, dataclass, field
 
 import gymnasium as gym
 
@@ -50,6 +51,11 @@ def vision_rungs(name: str, entry_point: str, *, family: str, max_episode_steps:
     )
 
 
+# The Eyecatch paper's vision model (section 3.1): lateral position noise is static 20/20 acuity whatever
+# the image's speed on the retina. The default since issue 11 degrades it with retinal slip
+# (VisionParams.position_slip_knee_deg_s; docs/reproductions/gaze_default.md).
+PAPER_VISION = {"position_slip_knee_deg_s": math.inf}
+
 # Every registered id, every family, one list.
 ENV_SPECS: tuple[EnvEntry, ...] = (
     *vision_rungs("EyeCatch", CATCH_ENTRY_POINT, family="catch", max_episode_steps=CATCH_MAX_EPISODE_STEPS,
@@ -58,6 +64,13 @@ ENV_SPECS: tuple[EnvEntry, ...] = (
              description="foveated; the ball bounces off an invisible wall mid-flight (Eyecatch 5)"),
     EnvEntry("EyeCatchTwoBalls-v0", CATCH_ENTRY_POINT, {"n_balls": 2}, max_episode_steps=TWO_BALLS_MAX_EPISODE_STEPS,
              description="foveated; two staggered balls from both sides, catch both (Eom 7)"),
+    # The two vision conditions of the Eyecatch paper (section 5: 98 % normal, 81.2 % with the noise x10),
+    # for its reproduction page: the paper's static 20/20 acuity at any retinal speed, no slip term.
+    EnvEntry("EyeCatchPaper-v0", CATCH_ENTRY_POINT, {"vision_params": dict(PAPER_VISION)},
+             description="Eyecatch paper's vision: foveated, static acuity at any retinal speed"),
+    EnvEntry("EyeCatchPaperPoorVision-v0", CATCH_ENTRY_POINT,
+             {"vision_params": dict(PAPER_VISION), "vision_noise_scale": POOR_VISION_SCALE},
+             description="Eyecatch paper's vision with all noise x10 (Eyecatch 5: 81.2 %)"),
 )
 ENV_IDS = tuple(spec.id for spec in ENV_SPECS)
 FAMILIES: dict[str, tuple[str, ...]] = {}
@@ -85,6 +98,29 @@ def env_vision(env_id: str) -> dict:
         "visual_delay_s": float(kw.get("visual_delay_s", 0.0)),
         "gaze_action_range_deg": float(kw.get("gaze_action_range_deg", 60.0)),
     }
+
+
+def vision_params_for(kwargs: dict):
+    """The ``VisionParams`` an ``EyeCatchEnv`` built with ``kwargs`` gives its agent's brain to model.
+
+    As the env builds its own (``vision_params`` fields, times ``vision_noise_scale``; ``full_view``
+    drops foveation), except that ``vision="oracle"`` gives noise scale 0 and no foveation (the true
+    state: nothing to weight).
+    """
+    from visuomotor_gym.vision.foveation import VisionParams
+
+    base = kwargs.get("vision_params") or {}
+    params = base if isinstance(base, VisionParams) else VisionParams(**base)
+    mode = kwargs.get("vision", "foveated")
+    params = params.scaled(0.0 if mode == "oracle" else float(kwargs.get("vision_noise_scale", 1.0)))
+    if mode != "foveated":
+        params = VisionParams(**{**asdict(params), "foveated": False})
+    return params
+
+
+def env_vision_params(env_id: str):
+    """:func:`vision_params_for` the registered kwargs of ``env_id``: every vision constant of its eye."""
+    return vision_params_for(gym.spec(env_id).kwargs or {})
 
 
 def register_envs() -> None:

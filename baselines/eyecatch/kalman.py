@@ -34,7 +34,10 @@ class KalmanParams:
 
     initial_position_var_m2: float = 100.0  # P_0|0: "sufficiently large" (Eyecatch 3.2)
     initial_velocity_var_m2_s2: float = 100.0
-    reset_mahalanobis: float = 40.0  # y^T S^-1 y above this resets P (chi^2, 6 dof: p < 1e-6)
+    reset_mahalanobis: float = 40.0  # y^T S^-1 y above this resets P: the chi^2 (6 dof) tail beyond 40
+    # has p = 4.6e-7, about one false reset in 40,000 throws of 50 samples (the paper gives no value:
+    # our choice of p). The one threshold of the Eyecatch agent (EyecatchParams.reset_mahalanobis); on
+    # 200 EyeCatchBounce-v0 throws it catches 43 % against 38.5 % with 100
     reset_when_position_std_below_m: float = 0.25  # only a confident filter resets (Eyecatch 3.2:
     # the failure the reset cures is "especially when the error covariance is small")
     process_noise_acc_m_s2: float = 0.5  # white acceleration noise. The paper has none; without it

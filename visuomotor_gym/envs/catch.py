@@ -42,7 +42,9 @@ class EyeCatchEnv(VisuomotorEnv):
     thrown from 3-6 m away, **seeing it only through a human-like eye** (Yeo et al., *Eyecatch*,
     SIGGRAPH 2012; Eom et al., TOG 2019). The eye perceives the ball's position and velocity in the
     eye frame with Gaussian noise whose covariance grows with distance and, steeply, with
-    eccentricity from the line of sight (Eyecatch Eq. 1-3); nothing is seen outside the +-60 deg field
+    eccentricity from the line of sight (Eyecatch Eq. 1-3), and whose lateral position part grows with
+    the ball's speed on the retina above 2.5 deg/s (moving-target localisation: an eye that does not
+    pursue the ball localises it poorly); nothing is seen outside the +-60 deg field
     of view or during a saccade. The eye moves under human limits: saccades of main-sequence
     duration (<= 800 deg/s, at most one per 200 ms, ballistic) or pursuit (<= 100 deg/s), with a
     vestibulo-ocular reflex that keeps gaze fixed in the world while the head and torso move. The
@@ -135,7 +137,7 @@ class EyeCatchEnv(VisuomotorEnv):
     | ``render_mode`` | None | ``"rgb_array"`` or ``"human"`` |
     | ``vision`` | ``"foveated"`` | ``"foveated"``, ``"full_view"`` (foveal noise everywhere, no field-of-view limit, no saccadic blindness) or ``"oracle"`` (true ball state) |
     | ``vision_noise_scale`` | 1.0 | multiplies every vision standard deviation (10: poor vision) |
-    | ``vision_params`` | None | ``VisionParams`` or a dict of its fields (acuity, Weber fraction, depth noise, field of view) |
+    | ``vision_params`` | None | ``VisionParams`` or a dict of its fields (acuity, retinal-slip knee, Weber fraction, depth noise, field of view) |
     | ``visual_delay_s`` | 0.0 | visual latency, a multiple of the control period |
     | ``bounce_wall`` | False | an invisible wall deflects the ball mid-flight |
     | ``n_balls`` | 1 | 1, or 2 for two staggered balls (see Two balls) |
@@ -157,7 +159,10 @@ class EyeCatchEnv(VisuomotorEnv):
 
     ## Version History
 
-    * v0: initial release.
+    * v0: initial release. Before the first release (issue 11) the default vision gained the retinal-slip
+      term of moving-target localisation (``VisionParams.position_slip_knee_deg_s`` = 2.5), so that where
+      the eye looks decides the catch; the Eyecatch paper's static acuity is ``EyeCatchPaper-v0`` and
+      ``EyeCatchPaperPoorVision-v0`` (x10).
     """
 
     render_cameras = {

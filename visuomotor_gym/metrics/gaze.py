@@ -99,23 +99,27 @@ def pursuit_share_after_apex(trace, fovea_deg: float = FOVEA_DEG) -> float:
     return float(pursuing[after].mean())
 
 
-def ball_foveation(trace, fovea_deg: float = FOVEA_DEG) -> float:
-    """Fraction of rows, from the landing of the first saccade to the catch/end, with the ball within
-    ``fovea_deg`` of the line of sight (later saccades count as not foveating if the ball is off-axis).
+FOVEATION_START_S = 0.25  # the human first saccade has landed: 180-200 ms saccade latency
+# (../shared/REFERENCES.md: "saccade latency 180-200 ms") plus a ~30-50 ms main-sequence duration
 
-    "Landing" is the first row at or after the first onset row with no saccade in flight. An agent that
-    never saccades is measured from the release instead (pursuit alone may keep the ball foveated; not
-    tracking it at all must not escape the score). NaN only when the first saccade is still in flight at
-    the end. Eyecatch Sec. 1 ("keep your eyes on the ball"), Sec. 3.1 (acuity falls with eccentricity).
+
+def ball_foveation(trace, fovea_deg: float = FOVEA_DEG,
+                   start_s: float = FOVEATION_START_S) -> float:
+    """Fraction of rows from ``start_s`` (0.25 s after the release, the same for every agent) to the
+    catch/end with the ball within ``fovea_deg`` of the line of sight; rows in a saccade count as not
+    foveating when the ball is off-axis.
+
+    The window is fixed, not tied to the agent's own first saccade: an agent whose first saccade comes
+    late, or whose pursuit loses the ball, scores lower (counting from its own landing rewarded a late
+    first saccade). 0.25 s is when a human's first saccade (180-200 ms latency) has landed. NaN when
+    no row falls in the window. Eyecatch Sec. 1 ("keep your eyes on the ball"), Sec. 3.1 (acuity falls
+    with eccentricity).
     """
-    onset_rows = np.flatnonzero(np.asarray(trace.saccade_onset, dtype=bool))
-    start = 0
-    if onset_rows.size:
-        landed = np.flatnonzero(~np.asarray(trace.in_saccade, dtype=bool)[onset_rows[0] :])
-        if landed.size == 0:
-            return float("nan")
-        start = onset_rows[0] + landed[0]
-    return float((ball_eccentricity_deg(trace)[start:] <= fovea_deg).mean())
+    t = np.asarray(trace.t, dtype=float)
+    window = t >= start_s - 1e-9
+    if not window.any():
+        return float("nan")
+    return float((ball_eccentricity_deg(trace)[window] <= fovea_deg).mean())
 
 
 # --- head ----------------------------------------------------------------------------------------

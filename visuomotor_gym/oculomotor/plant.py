@@ -14,8 +14,33 @@ Eom 4.1) have passed since the last saccade onset, a **saccade** starts:
 * minimum-jerk position profile, whose speed is Eyecatch Eq. 15, along the great circle;
 * ballistic: commands are ignored until it ends; optional endpoint noise proportional to A.
 
-Otherwise the eye **pursues**: it turns toward the target at ``A / dt`` (Eyecatch 4.1,
-``v = (p_target - p) / dt``), capped at 100 deg/s (Meyer et al. 1985).
+Otherwise the eye **pursues** like a human eye (Eyecatch 4.1 only caps pursuit at 100 deg/s; the
+rest is human data, every constant an :class:`OculomotorParams` field with its source):
+
+* pursuit is driven by **target motion**, which the plant reads from the gaze request stream: the
+  angular velocity of the requested direction between consecutive control steps. A static offset
+  does not drive pursuit (humans cannot pursue without a moving target); a step of the request
+  larger than the saccade threshold is a position step, not motion; and a step to a request that
+  starts a saccade, taken while a saccade was in flight, or after which the eye was held at its
+  range, carries no motion signal
+  (saccadic suppression; a carried eye moves an eye-relative request). Without a new sample the
+  last one is held;
+* the drive reaches the eye after an **onset latency** (``pursuit_latency_s``, Bahill & McDonald 1983);
+* the eye's pursuit velocity goes to ``G(|v|) v`` for target velocity ``v``, with a **gain** falling
+  from 0.98 at 10 deg/s to 0.75 at 60 deg/s (Schalen 1980), capped at 100 deg/s (Meyer et al. 1985);
+* it gets there at no more than ``pursuit_accel_max_deg_s2`` (Robinson 1965: ~130 ms per velocity
+  transition), integrated at every physics substep;
+* the pursuit velocity persists through saccades (the saccade replaces the eye's motion while in
+  flight; afterwards the eye continues at the pursuit velocity);
+* a request beyond the saccade threshold that cannot be a saccade (refractory period) is **not**
+  carried out as pursuit: it *waits*. The eye keeps pursuing the target motion only, and the saccade
+  starts at the first control step the generator is recharged, toward the request of that step
+  (``PlantStep.saccade_deferred`` flags the waiting steps). So a refused saccade never moves the eye
+  faster than pursuit, and a static target beyond the threshold is reached only by a saccade.
+
+Consequently pursuit lags a fast target and catch-up saccades follow (Schalen 1980: saccades of
+3-10 deg at all target speeds), and a sub-threshold static offset is not corrected (the saccade
+threshold is the smallest correction).
 
 The profile is evaluated at every physics substep inside a control step, so a 40 ms saccade is
 resolved at 500 Hz; ``record=True`` keeps that substep trace for tests and plots.
@@ -44,6 +69,15 @@ class OculomotorParams:
     saccade_peak_deg_s: float = 800.0  # Eyecatch 4.1, Eom 4.1
     saccade_endpoint_noise: float = 0.0  # std of the landing error as a fraction of amplitude
     pursuit_max_deg_s: float = 100.0  # Meyer et al. 1985, Eyecatch 4.1, Eom 4.1
+    pursuit_latency_s: float = 0.15  # onset latency of pursuit: "about 150 msec" (Bahill & McDonald
+    # 1983, Vision Res 23:1573, abstract); counted from the control step whose request first moves
+    pursuit_gain_points: tuple[tuple[float, float], ...] = ((10.0, 0.98), (60.0, 0.75))  # (target
+    # deg/s, eye/target velocity gain): Schalen 1980 (Acta Otolaryngol 90:404, 20 subjects), "0.98-0.75,
+    # gradually diminishing with increasing target velocities of 10-60 deg/s". Linear in between and
+    # constant outside: modelling choice (the abstract gives the ends of the range only)
+    pursuit_accel_max_deg_s2: float = 770.0  # |d(eye velocity)/dt| bound in pursuit: the 100 deg/s cap
+    # reached in the ~130 ms Robinson (1965, J Physiol 180:569) measured for a pursuit velocity
+    # transition (100 / 0.13 = 770). A constant bound is our modelling choice
     eye_azimuth_range_deg: tuple[float, float] = (-44.2, 44.2)  # Eom et al. 2019, 4.1
     eye_elevation_range_deg: tuple[float, float] = (-47.1, 27.7)  # Eom et al. 2019, 4.1
     fixation_range_m: tuple[float, float] = (0.1, 20.0)
@@ -56,6 +90,7 @@ class OculomotorParams:
             "main_sequence_slope_s_per_deg",
             "saccade_peak_deg_s",
             "pursuit_max_deg_s",
+            "pursuit_accel_max_deg_s2",
             "vergence_max_diopter_s",
             "head_max_deg_s",
         )
@@ -69,10 +104,31 @@ class OculomotorParams:
                 raise ValueError(f"OculomotorParams.{name} must be (low, high) with low < high, got {(lo, hi)!r}")
         if self.fixation_range_m[0] <= 0:
             raise ValueError("OculomotorParams.fixation_range_m must be positive")
-        for name in ("saccade_refractory_s", "main_sequence_intercept_s", "saccade_endpoint_noise"):
+        points = self.pursuit_gain_points
+        if not (len(points) >= 1 and all(len(q) == 2 for q in points)
+                and all(math.isfinite(s) and math.isfinite(g) and s >= 0.0 and 0.0 < g <= 1.5 for s, g in points)
+                and all(a[0] < b[0] for a, b in zip(points, points[1:]))):
+            raise ValueError("OculomotorParams.pursuit_gain_points must be (deg/s, gain) pairs with increasing "
+                             f"speeds and gains in (0, 1.5], got {points!r}")
+        for name in ("saccade_refractory_s", "main_sequence_intercept_s", "saccade_endpoint_noise",
+                     "pursuit_latency_s"):
             value = getattr(self, name)
             if not (math.isfinite(value) and value >= 0.0):
                 raise ValueError(f"OculomotorParams.{name} must be finite and >= 0, got {value!r}")
+
+    def pursuit_gain(self, target_speed_deg_s: float) -> float:
+        """Steady-state pursuit gain (eye / target velocity) at a target speed (deg/s)."""
+        points = self.pursuit_gain_points
+        if target_speed_deg_s <= points[0][0]:
+            return points[0][1]
+        for (s0, g0), (s1, g1) in zip(points, points[1:]):
+            if target_speed_deg_s <= s1:
+                return g0 + (g1 - g0) * (target_speed_deg_s - s0) / (s1 - s0)
+        return points[-1][1]
+
+    def pursuit_velocity(self, target_speed_deg_s: float) -> float:
+        """Steady-state pursuit eye speed (deg/s) for a target speed (deg/s): gain, then the cap."""
+        return min(self.pursuit_gain(target_speed_deg_s) * target_speed_deg_s, self.pursuit_max_deg_s)
 
     def saccade_duration(self, amplitude_rad: float) -> float:
         """Main-sequence duration (s) of a saccade, stretched so its peak stays <= the cap."""
@@ -158,6 +214,8 @@ class PlantStep:
     saccade_started: bool  # a saccade began at the start of this step
     saccading: bool  # a saccade was in flight during some part of this step
     in_saccade: bool  # a saccade is still in flight at the end of this step
+    saccade_deferred: bool = False  # the request was beyond the threshold but the generator was not
+    # recharged (refractory period): it waits, and is not carried out as pursuit
 
 
 class OculomotorPlant:
@@ -169,13 +227,23 @@ class OculomotorPlant:
         self.reset(np.array([1.0, 0.0, 0.0]), time=0.0)
 
     def reset(self, gaze: np.ndarray, time: float = 0.0) -> None:
-        """Start at ``gaze`` (unit vector, world) with the saccade generator recharged."""
+        """Start at ``gaze`` (unit vector, world), still, with the saccade generator recharged."""
         self.gaze = np.asarray(gaze, dtype=float) / np.linalg.norm(gaze)
         self.time = float(time)
         self._omega = (None, np.zeros(3), 0.0)  # angular velocity = (cross(a, b) if a else b) * k
         self.last_onset = -math.inf
         self.saccade: Saccade | None = None
         self.saccades: list[Saccade] = []
+        # Pursuit: the eye's pursuit angular velocity (world rotation vector, rad/s), the target-motion
+        # samples read from the request stream as (time, wx, wy, wz) waiting out the onset latency, the
+        # sample now driving the eye, the previous request and whether a saccade flew during the step
+        # after it (its motion is then suppressed).
+        self.pursuit_omega = (0.0, 0.0, 0.0)
+        self._drive_queue: list[tuple[float, float, float, float]] = []
+        self._drive = (0.0, 0.0, 0.0)
+        self._last_sample = (0.0, 0.0, 0.0)
+        self._prev_request: tuple[float, float, float] | None = None
+        self._suppressed = False
         self.trace_t: list[float] = []
         self.trace_gaze: list[np.ndarray] = []
         if self.record:
@@ -184,7 +252,7 @@ class OculomotorPlant:
 
     @property
     def angular_velocity(self) -> np.ndarray:
-        """Angular velocity of the gaze (world, rad/s) over the last step (computed when asked)."""
+        """Angular velocity of the gaze (world, rad/s) at the end of the last step (computed when asked)."""
         a, b, k = self._omega
         return (cross(a, b) if a is not None else b) * k
 
@@ -192,6 +260,35 @@ class OculomotorPlant:
     def ready_for_saccade(self) -> bool:
         """Whether a saccade could start now (none in flight, refractory period over)."""
         return self.saccade is None and self.time - self.last_onset >= self.params.saccade_refractory_s - 1e-9
+
+    def _sample_target_motion(self, target: tuple[float, float, float], dt: float) -> None:
+        """Read the target's angular velocity from the request stream and queue it for the latency."""
+        p = self.params
+        prev = self._prev_request
+        sample = self._last_sample  # held when this step carries no motion signal
+        if prev is not None and not self._suppressed:
+            jump = angle_between(prev, target)
+            if jump <= p.saccade_threshold_deg * DEG:  # a larger step is a position step, not motion
+                (ax, ay, az), (bx, by, bz) = prev, target
+                cx, cy, cz = ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
+                s = math.sqrt(cx * cx + cy * cy + cz * cz)
+                k = jump / dt / s if s > 1e-15 else 0.0
+                sample = (cx * k, cy * k, cz * k)
+        self._last_sample = sample
+        self._prev_request = target
+        self._drive_queue.append((self.time + p.pursuit_latency_s, *sample))
+
+    def _pursuit_goal(self, t: float) -> tuple[float, float, float]:
+        """The eye's pursuit velocity goal at time ``t``: the delayed target motion times the gain."""
+        queue = self._drive_queue
+        while queue and queue[0][0] <= t + 1e-9:  # its latency has passed: it drives the eye now
+            self._drive = queue.pop(0)[1:]
+        wx, wy, wz = self._drive
+        speed = math.sqrt(wx * wx + wy * wy + wz * wz)
+        if speed < 1e-12:
+            return 0.0, 0.0, 0.0
+        k = self.params.pursuit_velocity(speed / DEG) * DEG / speed
+        return wx * k, wy * k, wz * k
 
     def step(
         self,
@@ -206,76 +303,100 @@ class OculomotorPlant:
         """
         p = self.params
         t0 = self.time
-        started = False
-        amplitude = None  # of the requested change; computed once when no saccade is in flight
+        tx, ty, tz = np.asarray(target, dtype=float).tolist()
+        n = math.sqrt(tx * tx + ty * ty + tz * tz)
+        request = (tx / n, ty / n, tz / n)
+        started = deferred = False
         if self.saccade is None:
-            amplitude = angle_between(self.gaze, target)
-            if amplitude > p.saccade_threshold_deg * DEG and self.ready_for_saccade:
-                end = np.asarray(target, dtype=float)
-                if p.saccade_endpoint_noise > 0.0 and rng is not None:
-                    end = _perturb(end, rng.standard_normal(2) * p.saccade_endpoint_noise * amplitude)
-                    amplitude = angle_between(self.gaze, end)
-                tangent = _tangent(self.gaze, end, amplitude)
-                axis = cross(self.gaze, tangent)
-                self.saccade = Saccade(t0, p.saccade_duration(amplitude), self.gaze.copy(), end, amplitude, axis,
-                                       tangent)
-                self.saccades.append(self.saccade)
-                self.last_onset = t0
-                started = True
-
-        t_end = t0 + dt
-        saccading = self.saccade is not None
-        if self.record:
-            sub_t = t0 + dt * np.arange(1, n_substeps + 1) / n_substeps
-        if self.saccade is not None:
-            sac = self.saccade
-            if self.record:
-                u = np.clip((sub_t - sac.onset) / sac.duration, 0.0, 1.0)
-                points = _slerp(sac.start, sac.end, sac.amplitude, minimum_jerk(u))
-            u_end = min(max((t_end - sac.onset) / sac.duration, 0.0), 1.0)
-            gx, gy, gz = sac.direction(minimum_jerk(u_end))
-            speed = sac.amplitude * 30.0 * u_end**2 * (1.0 - u_end) ** 2 / sac.duration  # Eq. 15
-            self._omega = (None, sac.axis, speed)
-            if u_end >= 1.0:
-                self.saccade = None
-        else:  # pursuit (no saccade started, so the gaze and the amplitude are unchanged)
-            travel = min(amplitude, p.pursuit_max_deg_s * DEG * dt)
-            start = self.gaze
-            if amplitude > 1e-12:
-                if self.record:
-                    fractions = np.arange(1, n_substeps + 1) / n_substeps * (travel / amplitude)
-                    points = _slerp(start, target, amplitude, fractions)
-                # _slerp(start, target, amplitude, travel / amplitude) in scalars (same operations)
-                (ax, ay, az), (bx, by, bz) = start.tolist(), np.asarray(target, dtype=float).tolist()
-                sa = math.sin(amplitude)
-                if sa > 1e-9:  # _tangent's general case
-                    ca = math.cos(amplitude)
-                    wx, wy, wz = (bx - ca * ax) / sa, (by - ca * ay) / sa, (bz - ca * az) / sa
+            amplitude = angle_between(self.gaze, request)
+            if amplitude > p.saccade_threshold_deg * DEG:
+                if self.ready_for_saccade:
+                    end = np.array(request)
+                    if p.saccade_endpoint_noise > 0.0 and rng is not None:
+                        end = _perturb(end, rng.standard_normal(2) * p.saccade_endpoint_noise * amplitude)
+                        amplitude = angle_between(self.gaze, end)
+                    tangent = _tangent(self.gaze, end, amplitude)
+                    axis = cross(self.gaze, tangent)
+                    self.saccade = Saccade(t0, p.saccade_duration(amplitude), self.gaze.copy(), end, amplitude,
+                                           axis, tangent)
+                    self.saccades.append(self.saccade)
+                    self.last_onset = t0
+                    started = True
                 else:
-                    wx, wy, wz = _tangent(start, target, amplitude).tolist()
-                t = travel / amplitude * amplitude
-                c, s = math.cos(t), math.sin(t)
-                gx, gy, gz = c * ax + s * wx, c * ay + s * wy, c * az + s * wz
-                self._omega = (start, (wx, wy, wz), travel / dt)
+                    deferred = True  # waits for the generator; not executed as pursuit
+        # A request that starts a saccade is a position command (it may aim ahead of the target):
+        # like the steps with a saccade in flight, it carries no motion signal.
+        self._suppressed = self._suppressed or started
+        self._sample_target_motion(request, dt)
+
+        saccading = self.saccade is not None
+        h = dt / n_substeps
+        a_max = p.pursuit_accel_max_deg_s2 * DEG * h  # largest velocity change per substep
+        gx, gy, gz = self.gaze.tolist()
+        vx, vy, vz = self.pursuit_omega
+        sac = self.saccade
+        points = [] if self.record else None
+        in_saccade_last = False
+        for i in range(1, n_substeps + 1):
+            t = t0 + h * i
+            # Pursuit velocity: toward the delayed, gain-scaled target motion, acceleration-bounded.
+            ux, uy, uz = self._pursuit_goal(t - h)  # the drive at the start of the substep
+            ex, ey, ez = ux - vx, uy - vy, uz - vz
+            e = math.sqrt(ex * ex + ey * ey + ez * ez)
+            if e > a_max:
+                ex, ey, ez = ex * a_max / e, ey * a_max / e, ez * a_max / e
+            vx, vy, vz = vx + ex, vy + ey, vz + ez
+            if sac is not None:  # ballistic: the saccade alone moves the eye until it lands
+                u = min(max((t - sac.onset) / sac.duration, 0.0), 1.0)
+                gx, gy, gz = sac.direction(minimum_jerk(u))
+                in_saccade_last = u < 1.0
+                if u >= 1.0:
+                    sac = None
             else:
-                if self.record:
-                    points = np.broadcast_to(start, (n_substeps, 3)).copy()
-                self._omega = (None, np.zeros(3), 0.0)
-                gx, gy, gz = start.tolist()
-        n = math.sqrt(gx * gx + gy * gy + gz * gz)
-        self.gaze = np.array([gx / n, gy / n, gz / n])
-        self.time = t_end
+                in_saccade_last = False
+                # Rotate the gaze by the pursuit velocity's component across it (Rodrigues).
+                d = vx * gx + vy * gy + vz * gz
+                wx, wy, wz = vx - d * gx, vy - d * gy, vz - d * gz
+                w = math.sqrt(wx * wx + wy * wy + wz * wz)
+                if w > 1e-15:
+                    ang = w * h
+                    c, s = math.cos(ang), math.sin(ang)
+                    kx, ky, kz = wx / w, wy / w, wz / w
+                    cx, cy, cz = ky * gz - kz * gy, kz * gx - kx * gz, kx * gy - ky * gx
+                    gx, gy, gz = c * gx + s * cx, c * gy + s * cy, c * gz + s * cz
+                    m = math.sqrt(gx * gx + gy * gy + gz * gz)
+                    gx, gy, gz = gx / m, gy / m, gz / m
+            if points is not None:
+                points.append(np.array([gx, gy, gz]))
+        if self.saccade is not None:
+            if in_saccade_last:
+                u = min(max((t0 + dt - self.saccade.onset) / self.saccade.duration, 0.0), 1.0)
+                speed = self.saccade.amplitude * 30.0 * u**2 * (1.0 - u) ** 2 / self.saccade.duration  # Eq. 15
+                self._omega = (None, self.saccade.axis, speed)
+            else:
+                self.saccade = None
+        if self.saccade is None:
+            d = vx * gx + vy * gy + vz * gz
+            self._omega = (None, np.array([vx - d * gx, vy - d * gy, vz - d * gz]), 1.0)
+        self.pursuit_omega = (vx, vy, vz)
+        self._suppressed = saccading
+        self.gaze = np.array([gx, gy, gz])
+        self.time = t0 + dt
         if self.record:
-            self.trace_t.extend(sub_t.tolist())
+            self.trace_t.extend((t0 + dt * np.arange(1, n_substeps + 1) / n_substeps).tolist())
             self.trace_gaze.extend(points)
-        return PlantStep(started, saccading, self.saccade is not None)
+        return PlantStep(started, saccading, self.saccade is not None, deferred)
 
     def constrain(self, achieved: np.ndarray) -> None:
         """Replace the gaze with the direction the eye actually reached (it hit its range).
 
-        A saccade in flight keeps its ballistic course; the next substeps may clamp again.
+        A saccade in flight keeps its ballistic course, pursuit its velocity; the next substeps may
+        clamp again.
         """
         self.gaze = np.asarray(achieved, dtype=float)
+        # The request stream moves with the carried eye: no target-motion signal from this step
+        # (modelling choice, as for saccades; otherwise a "hold gaze" request would drive pursuit).
+        self._suppressed = True
         if self.record and self.trace_gaze:
             self.trace_gaze[-1] = self.gaze.copy()
 

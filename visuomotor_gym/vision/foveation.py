@@ -18,6 +18,16 @@ the paper; the defaults below follow the text):
   a small floor so a perfectly pursued target is not known exactly;
 * depth and depth-rate: "much worse" than lateral and proportional to depth (vergence), here
   ``depth_std_fraction * d`` and ``depth_rate_std_fraction * d`` (per second);
+* the lateral position std of a **moving image** grows with its speed on the retina (retinal slip):
+  ``sigma_q * max(1, slip / knee)``, ``knee`` = 2.5 deg/s, the image speed up to which foveal acuity
+  is unchanged by motion (Westheimer & McKee 1975); beyond it the growth in proportion to the slip is
+  our modelling choice (a constant smear time of 6.7 ms), in line with dynamic visual acuity falling
+  steeply with target speed when the eye does not stabilise the image (Ludvigh & Miller 1958; Brown
+  1972: "position and velocity errors [of pursuit] are the main determinants of DVA"). So a pursued
+  ball is localised to ~1 arcmin and one sweeping past a still eye at 50 deg/s to ~20 arcmin. Not
+  in the Eyecatch paper (static 20/20 acuity at any speed: ``position_slip_knee_deg_s=inf``,
+  ``EyeCatchPaper-v0``); added in issue 11 so that where the eye looks decides the catch
+  (``docs/reproductions/gaze_default.md``);
 * everything is divided by the acuity factor ``alpha(theta) = E2 / (E2 + theta)`` (``theta`` the
   eccentricity from the line of sight, ``E2`` = 2 deg: acuity halves 2 deg from the fovea, the
   standard cortical-magnification form, e.g. Levi, Klein & Aitsebaomo 1985);
@@ -49,6 +59,12 @@ class VisionParams:
     depth_rate_std_fraction: float = 0.1  # depth-rate std (m/s) = 0.1/s * depth at the fovea
     fovea_e2_deg: float = 2.0  # alpha(theta) = E2 / (E2 + theta)
     field_of_view_deg: float = 60.0  # half-angle; nothing is seen beyond it (Eom et al. 2019)
+    # Moving-target localisation: lateral position std x max(1, retinal slip / knee). The knee: foveal
+    # Landolt-C and vernier thresholds are unchanged by image motion up to 2.5 deg/s (Westheimer &
+    # McKee 1975, JOSA 65:847). Growth in proportion to the slip above it: modelling choice (a fixed
+    # smear time of 1 arcmin / 2.5 deg/s = 6.7 ms; swept 1-10 deg/s in docs/reproductions/gaze_default.md).
+    # inf: static 20/20 acuity at any retinal speed, the Eyecatch paper's model (EyeCatchPaper-v0).
+    position_slip_knee_deg_s: float = 2.5
     noise_scale: float = 1.0  # multiplies every standard deviation (x10: Eyecatch "poor vision")
     foveated: bool = True  # False: foveal acuity everywhere, no field-of-view limit (FullView)
 
@@ -66,6 +82,10 @@ class VisionParams:
                 raise ValueError(f"VisionParams.{name} must be finite and >= 0, got {value!r}")
         if not (math.isfinite(self.fovea_e2_deg) and self.fovea_e2_deg > 0.0):
             raise ValueError(f"VisionParams.fovea_e2_deg must be > 0, got {self.fovea_e2_deg!r}")
+        if not (self.position_slip_knee_deg_s > 0.0):  # inf allowed: no slip effect
+            raise ValueError(
+                f"VisionParams.position_slip_knee_deg_s must be > 0, got {self.position_slip_knee_deg_s!r}"
+            )
         if not (0.0 < self.field_of_view_deg <= 180.0):
             raise ValueError(
                 f"VisionParams.field_of_view_deg must be in (0, 180], got {self.field_of_view_deg!r}"
@@ -82,6 +102,14 @@ def acuity(eccentricity_rad: float, params: VisionParams) -> float:
         return 1.0
     e2 = params.fovea_e2_deg * DEG
     return e2 / (e2 + eccentricity_rad)
+
+
+def slip_factor(retinal_speed: float, params: VisionParams) -> float:
+    """Growth of the lateral position std with retinal slip (rad/s): max(1, slip / knee); 1 without foveation."""
+    if not params.foveated:
+        return 1.0
+    knee = params.position_slip_knee_deg_s * DEG
+    return max(1.0, abs(retinal_speed) / knee)
 
 
 def line_of_sight_rotation(direction: np.ndarray) -> np.ndarray:
@@ -134,7 +162,7 @@ def standard_deviations(distance: float, eccentricity_rad: float, retinal_speed:
 def _sigmas(distance, eccentricity_rad, retinal_speed, params):
     """``standard_deviations`` as a tuple of floats (the per-step path)."""
     k = distance * params.noise_scale / acuity(eccentricity_rad, params)
-    lateral = k * params.retinal_position_std_arcmin * ARCMIN
+    lateral = k * params.retinal_position_std_arcmin * ARCMIN * slip_factor(retinal_speed, params)
     lateral_rate = k * (
         params.retinal_velocity_weber * abs(retinal_speed) + params.retinal_velocity_floor_deg_s * DEG
     )

@@ -1,0 +1,109 @@
+"""The gaze-blind reference agents: ``gaze_blind:<agent>`` and ``fixed_gaze`` (= ``gaze_blind:eyecatch``).
+
+Oracles: the action layout of the catch env (gaze and head blocks from ``action_structure``), the
+base agent run side by side on the same observations, and the plant's saccade flag.
+"""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import visuomotor_gym  # noqa: F401
+from visuomotor_gym.agents import GazeBlind, agent_names, is_deterministic, make_agent, parse_agent_spec
+
+
+def _blocks(env):
+    """Index masks of the gaze and head blocks, from the env's own action_structure."""
+    held = np.zeros(env.action_space.shape[0], dtype=bool)
+    start = 0
+    for name, size in env.unwrapped.action_structure.items():
+        if name in ("gaze", "head"):
+            held[start : start + size] = True
+        start += size
+    return held
+
+
+def test_names_are_registered_and_parse():
+    assert {"fixed_gaze", "gaze_blind"} <= set(agent_names())
+    assert parse_agent_spec("gaze_blind:eyecatch") == ("gaze_blind", {"base": "eyecatch"})
+    assert parse_agent_spec("gaze_blind:eyecatch:update_period_s=0.3") == (
+        "gaze_blind", {"base": "eyecatch:update_period_s=0.3"})
+    assert is_deterministic("fixed_gaze") and is_deterministic("gaze_blind:belief_mpc")
+    assert not is_deterministic("gaze_blind:random")
+    with pytest.raises(ValueError, match="wraps another agent"):
+        parse_agent_spec("gaze_blind")
+    with pytest.raises(ValueError, match="unknown agent"):
+        parse_agent_spec("gaze_blind:nope")
+
+
+@pytest.mark.parametrize("spec,base_spec", [("fixed_gaze", "eyecatch"), ("gaze_blind:eyecatch", "eyecatch"),
+                                            ("gaze_blind:belief_intercept", "belief_intercept"),
+                                            ("gaze_blind:random", "random")])
+@pytest.mark.parametrize("seed", [0, 3])
+def test_only_gaze_and_head_differ_and_the_eye_never_saccades(spec, base_spec, seed):
+    env = gym.make("EyeCatch-v0")
+    held = _blocks(env)
+    assert held.tolist() == [False] * 4 + [True, True, False, True, True]  # gaze 4-5, head 7-8
+    blind = make_agent(spec, "EyeCatch-v0", 9, seed=seed)
+    base = make_agent(base_spec, "EyeCatch-v0", 9, seed=seed)  # the same agent, fed the same observations
+    assert isinstance(blind, GazeBlind)
+    obs, info = env.reset(seed=seed)
+    blind.reset()
+    if hasattr(base, "reset"):
+        base.reset()
+    steps = differ = 0
+    done = False
+    while not done:
+        a, _ = blind.predict(obs, episode_start=np.array([steps == 0]))
+        b, _ = base.predict(obs, episode_start=np.array([steps == 0]))
+        assert a.shape == (9,) and a.dtype == np.float32
+        np.testing.assert_array_equal(a[held], 0.0)
+        np.testing.assert_allclose(a[~held], np.asarray(b, dtype=np.float32)[~held])
+        differ += bool(np.any(np.asarray(b)[held] != 0.0))
+        obs, _, term, trunc, info = env.step(a)
+        done = term or trunc
+        steps += 1
+        assert not info["saccade_onset"] and not info["in_saccade"]
+    assert steps > 20
+    if base_spec != "belief_intercept":  # belief_intercept already holds its gaze
+        assert differ > 0  # the base agent did want to look around
+
+
+def test_gaze_stays_where_reset_put_it():
+    env = gym.make("EyeCatch-v0")
+    agent = make_agent("fixed_gaze", "EyeCatch-v0", 9)
+    for seed in range(3):
+        obs, info = env.reset(seed=seed)
+        agent.reset()
+        gaze0 = info["gaze_dir"].copy()
+        angles, heads = [], []
+        done = False
+        while not done:
+            a, _ = agent.predict(obs)
+            obs, _, term, trunc, info = env.step(a)
+            done = term or trunc
+            angles.append(np.degrees(np.arccos(np.clip(info["gaze_dir"] @ gaze0, -1, 1))))
+            heads.append(np.abs(info["head_qpos"]).max())
+        assert max(heads) < np.radians(2.0)  # the neck servo holds the reset pose (arm reaction: < 1 deg)
+        assert max(angles) < 2.0  # no pursuit, no saccade: gaze held in the world (VOR)
+
+
+def test_joint_control_layout_and_bad_layout():
+    env = gym.make("EyeCatch-v0", control="joint")
+    held = _blocks(env)
+    assert np.flatnonzero(held).tolist() == [11, 12, 14, 15]
+    blind = GazeBlind(make_agent("random", "EyeCatch-v0", 16, seed=1), 16)
+    a, _ = blind.predict(env.reset(seed=0)[0])
+    assert np.all(a[held] == 0.0) and np.any(a[~held] != 0.0)
+    with pytest.raises(ValueError, match="9 and 16"):
+        GazeBlind(make_agent("random", "EyeCatch-v0", 7), 7)
+
+
+def test_bench_accepts_the_twin():
+    from visuomotor_gym.bench.evaluate import evaluate
+
+    result = evaluate("fixed_gaze", "EyeCatch-v0", episodes=2, seed=0, workers=1)
+    assert result.agent == "fixed_gaze" and result.episodes == 2
+    assert all(not tr.saccade_onset.any() for tr in result.traces)
