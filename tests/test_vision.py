@@ -721,3 +721,59 @@ def test_env_lateral_noise_grows_with_retinal_slip():
     assert len(z) > 200 and fast.sum() > 50  # a held eye sees the ball slip fast
     assert math.sqrt(np.mean(z**2) / 2.0) == pytest.approx(1.0, abs=0.2)  # 2 lateral axes
     assert math.sqrt(np.mean(z[fast] ** 2) / 2.0) == pytest.approx(1.0, abs=0.2)
+
+
+# ----------------------------------------------------------------------------------------------
+# No leak of the ball's true state into the observation (issue 11)
+# ----------------------------------------------------------------------------------------------
+def _non_ball_blocks(layout, obs, exclude=("ball_pos", "ball_vel", "ball_visible", "eye_rot", "eye_in_head")):
+    return {name: obs[s].copy() for name, s in layout.slices.items() if name not in exclude}
+
+
+def test_reset_observation_depends_on_the_throw_only_through_the_visual_sample():
+    """Across throws, every block but the visual sample and the gaze direction (which starts on the
+    thrower's hand by design) is identical at reset: no fixation = true distance, no time, no hand."""
+    env = gym.make("EyeCatch-v0").unwrapped
+    first = None
+    for seed in range(12):
+        obs, info = env.reset(seed=seed)
+        blocks = _non_ball_blocks(env.layout, obs)
+        if first is None:
+            first = blocks
+            continue
+        for name, value in blocks.items():
+            np.testing.assert_array_equal(value, first[name], err_msg=f"{name} differs between throws at reset")
+    distance = np.linalg.norm(info["release_pos"] - info["eye_pos"])
+    assert obs[env.layout.slices["fixation"]][0] != pytest.approx(distance, abs=0.05)
+
+
+def test_fixation_block_follows_the_action_not_the_ball():
+    """With the same actions, two different throws give the same fixation trajectory."""
+    env = gym.make("EyeCatch-v0").unwrapped
+    action = np.zeros(env.action_space.shape, np.float32)
+    action[6] = 0.4  # a fixation request
+    runs = []
+    for seed in (0, 7):
+        env.reset(seed=seed)
+        runs.append([env.step(action)[0][env.layout.slices["fixation"]][0] for _ in range(20)])
+    np.testing.assert_array_equal(runs[0], runs[1])
+
+
+def test_ball_blocks_carry_nothing_during_saccades_or_out_of_view():
+    """Whenever the eye produced no sample (saccade, outside the field of view, before the delay line
+    fills), the ball blocks are exactly zero, whatever the ball does."""
+    env = gym.make("EyeCatchDelayed-v0").unwrapped
+    s = env.layout.slices
+    rng = np.random.default_rng(0)
+    blind_steps = 0
+    for seed in range(3):
+        obs, _ = env.reset(seed=seed)
+        for _ in range(60):
+            action = rng.uniform(-1, 1, env.action_space.shape).astype(np.float32)
+            obs, _, terminated, truncated, info = env.step(action)
+            if obs[s["ball_visible"]][0] == 0.0:
+                blind_steps += 1
+                assert not obs[s["ball_pos"]].any() and not obs[s["ball_vel"]].any()
+            if terminated or truncated:
+                break
+    assert blind_steps > 5  # random gaze makes saccades: the check above ran

@@ -8,6 +8,7 @@ documentation.
 
 from __future__ import annotations
 
+import math
 from dataclasses import asdict
 from typing import Any
 
@@ -116,7 +117,10 @@ class EyeCatchEnv(VisuomotorEnv):
     drawn from ``throw_distribution`` (``visuomotor_gym.scenarios.throws``): release 3-6 m ahead,
     1-2 m high, +-1 m lateral; flight time 0.8-1.4 s; arrival in the catchable region in front of the
     right shoulder. The ball is released at t = 0; gaze starts on the release point with a 2 deg
-    Gaussian jitter. The same seed gives the same throw across the whole ladder.
+    Gaussian jitter (the catcher watches the thrower's hand), and the fixation distance starts at a
+    fixed 1.41 m (what a neutral fixation action holds), never at the ball's true distance. Nothing in
+    the observation but the visual sample depends on the throw. The same seed gives the same throw
+    across the whole ladder.
 
     ## Episode End
 
@@ -162,7 +166,10 @@ class EyeCatchEnv(VisuomotorEnv):
     * v0: initial release. Before the first release (issue 11) the default vision gained the retinal-slip
       term of moving-target localisation (``VisionParams.position_slip_knee_deg_s`` = 2.5), so that where
       the eye looks decides the catch; the Eyecatch paper's static acuity is ``EyeCatchPaper-v0`` and
-      ``EyeCatchPaperPoorVision-v0`` (x10).
+      ``EyeCatchPaperPoorVision-v0`` (x10). The oculomotor plant pursues like a human (150 ms latency,
+      gain 0.98 -> 0.75 with target speed, bounded acceleration; a refused saccade waits instead of
+      being pursued), and the fixation observation no longer starts at the ball's true distance.
+      The leaderboard entries made before are superseded.
     """
 
     render_cameras = {
@@ -250,6 +257,8 @@ class EyeCatchEnv(VisuomotorEnv):
             release_after_catch_s=self.release_after_catch_s, catch_radius=self.catch_radius,
             grasp_closed_fraction=self.grasp_closed_fraction, throw_distribution=self.throw_distribution,
             reward_weights=weights, dt=self.dt, visual_delay_s=self.visual_delay_s,
+            neutral_fixation_m=math.sqrt(self.oculomotor_params.fixation_range_m[0]
+                                         * self.oculomotor_params.fixation_range_m[1]),
         )
         self._assemble(
             body=body,

@@ -92,7 +92,8 @@ class CatchTask:
 
     def __init__(self, model: mujoco.MjModel, body, *, n_balls: int, bounce_wall: bool,
                  release_after_catch_s: float, catch_radius: float, grasp_closed_fraction: float,
-                 throw_distribution, reward_weights: dict, dt: float, visual_delay_s: float) -> None:
+                 throw_distribution, reward_weights: dict, dt: float, visual_delay_s: float,
+                 neutral_fixation_m: float) -> None:
         m = model
         self.model = model
         self.body = body
@@ -106,6 +107,7 @@ class CatchTask:
         self.dt = dt
         self.visual_delay_s = visual_delay_s
         self._physics_dt = float(m.opt.timestep)
+        self.neutral_fixation_m = float(neutral_fixation_m)
         self._seat_x = body.frame.origin_list[0]
         self.balls = [Ball(m, names.BALL_JOINT, names.BALL, names.CATCH_WELD, names.BALL_GEOM)]
         if n_balls == 2:
@@ -157,8 +159,11 @@ class CatchTask:
         return {"missed": bool(info["missed"])}
 
     def initial_fixation(self, distance: float) -> float:
-        """The fixation (vergence) distance at reset, given the initial gaze point's true distance."""
-        return distance
+        """The fixation (vergence) distance at reset: a fixed value, never the true distance of the
+        thrower's hand (that would leak the ball's depth into the ``fixation`` observation). It is the
+        distance a neutral fixation action (0) holds: the log-midpoint of the fixation range,
+        sqrt(0.1 m x 20 m) = 1.41 m (modelling choice)."""
+        return self.neutral_fixation_m
 
     def reset_info(self) -> dict:
         throw = self.throw
