@@ -611,3 +611,22 @@ def test_vor_range_clamp_carries_gaze_with_head(seed, head):
         d_head = (rows[i1][3][0] - rows[i0][3][0]) + (rows[i1][4][0] - rows[i0][4][0])
         assert abs(d_head) > 10 * DEG
         assert d_gaze == pytest.approx(d_head, abs=1.5 * DEG)
+
+
+def test_saccade_history_is_bounded_unless_recording():
+    """An env stepped without end (after termination) must not grow the plant without bound."""
+    from visuomotor_gym.oculomotor.plant import SACCADE_HISTORY
+
+    plant = OculomotorPlant(OculomotorParams())
+    plant.reset(direction_from_angles(0.0, 0.0), time=0.0)
+    rng = np.random.default_rng(0)
+    for k in range(6000):  # a 10 deg jump every 0.3 s: one saccade per 15 steps
+        az = math.radians(10.0 * ((k // 15) % 2))
+        plant.step(direction_from_angles(az, 0.0), 0.02, 10, rng)
+    assert len(plant.saccades) == SACCADE_HISTORY
+    recording = OculomotorPlant(OculomotorParams(), record=True)
+    recording.reset(direction_from_angles(0.0, 0.0), time=0.0)
+    for k in range(6000):
+        az = math.radians(10.0 * ((k // 15) % 2))
+        recording.step(direction_from_angles(az, 0.0), 0.02, 10, rng)
+    assert len(recording.saccades) > SACCADE_HISTORY  # everything kept, with the trace

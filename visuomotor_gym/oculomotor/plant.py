@@ -49,6 +49,7 @@ resolved at 500 Hz; ``record=True`` keeps that substep trace for tests and plots
 from __future__ import annotations
 
 import math
+from collections import deque
 from dataclasses import dataclass
 
 import numpy as np
@@ -56,6 +57,7 @@ import numpy as np
 from visuomotor_gym.geometry import angle_between, cross, unit_from_angles
 
 DEG = math.pi / 180.0
+SACCADE_HISTORY = 256  # saccades kept without record=True: far more than an episode holds (<= 5 per second)
 
 
 @dataclass(frozen=True)
@@ -212,8 +214,8 @@ class PlantStep:
     """What happened during one control step."""
 
     saccade_started: bool  # a saccade began at the start of this step
-    saccading: bool  # a saccade was in flight during some part of this step
-    in_saccade: bool  # a saccade is still in flight at the end of this step
+    saccading: bool  # a saccade was in flight during some part of this step (the plant's
+    # ``saccade`` attribute says whether one is still in flight at the end of it)
     saccade_deferred: bool = False  # the request was beyond the threshold but the generator was not
     # recharged (refractory period): it waits, and is not carried out as pursuit
 
@@ -233,7 +235,9 @@ class OculomotorPlant:
         self._omega = (None, np.zeros(3), 0.0)  # angular velocity = (cross(a, b) if a else b) * k
         self.last_onset = -math.inf
         self.saccade: Saccade | None = None
-        self.saccades: list[Saccade] = []
+        # The last SACCADE_HISTORY saccades (bounded: an env stepped without end must not grow it);
+        # with ``record`` every saccade is kept, as the 500 Hz trace is.
+        self.saccades: deque[Saccade] | list[Saccade] = [] if self.record else deque(maxlen=SACCADE_HISTORY)
         # Pursuit: the eye's pursuit angular velocity (world rotation vector, rad/s), the target-motion
         # samples read from the request stream as (time, wx, wy, wz) waiting out the onset latency, the
         # sample now driving the eye, the previous request and whether a saccade flew during the step
@@ -385,7 +389,7 @@ class OculomotorPlant:
         if self.record:
             self.trace_t.extend((t0 + dt * np.arange(1, n_substeps + 1) / n_substeps).tolist())
             self.trace_gaze.extend(points)
-        return PlantStep(started, saccading, self.saccade is not None, deferred)
+        return PlantStep(started, saccading, deferred)
 
     def constrain(self, achieved: np.ndarray) -> None:
         """Replace the gaze with the direction the eye actually reached (it hit its range).
