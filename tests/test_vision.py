@@ -59,11 +59,18 @@ def expected_stds(d, ecc, retinal_speed, *, scale=1.0, foveated=True, knee=KNEE)
     return k * np.array([0.05 * d, lat, lat, 0.1 * d, lat_rate, lat_rate])
 
 
+def sample(pos, vel, retinal_speed, params, rng):
+    """One perceived (position, velocity) of a point the eye sees (inside the field of view)."""
+    p, v, visible = fov.perceive(list(map(float, pos)), list(map(float, vel)), retinal_speed, params, rng)
+    assert visible, "the test point must be inside the field of view"
+    return np.array(p), np.array(v)
+
+
 def draw(pos, vel, retinal_speed, params, n, seed):
     rng = np.random.default_rng(seed)
     out = np.empty((n, 6))
     for i in range(n):
-        p, v = fov.sample(pos, vel, retinal_speed, params, rng)
+        p, v = sample(pos, vel, retinal_speed, params, rng)
         out[i, :3] = p
         out[i, 3:] = v
     return out
@@ -266,7 +273,7 @@ def test_noise_scale_multiplies_everything():
     # zero noise: the sample is the truth
     rng = np.random.default_rng(0)
     pos, vel = np.array([2.0, 0.3, -0.1]), np.array([-3.0, 0.2, 1.0])
-    p_s, v_s = fov.sample(pos, vel, 0.4, VisionParams(noise_scale=0.0), rng)
+    p_s, v_s = sample(pos, vel, 0.4, VisionParams(noise_scale=0.0), rng)
     np.testing.assert_array_equal(p_s, pos)
     np.testing.assert_array_equal(v_s, vel)
 
@@ -419,7 +426,13 @@ def test_perceive_hides_points_outside_field_of_view():
         truth = 3.0 * unit_at(ecc_deg * DEG, 0.5)
         pos, v, visible = fov.perceive(truth, vel, 0.1, p, np.random.default_rng(1))
         assert visible is True
-        ref_pos, ref_v = fov.sample(truth, vel, 0.1, p, np.random.default_rng(1))
+        # Oracle: truth + A Sigma eps (Eyecatch Eq. 1-3) with the same normal draws.
+        eps = np.random.default_rng(1).standard_normal(6)
+        d = np.linalg.norm(truth)
+        ecc = math.acos(truth[0] / d)
+        sig = fov.standard_deviations(d, ecc, 0.1, p)
+        rot = fov.line_of_sight_rotation(truth / d)
+        ref_pos, ref_v = truth + rot @ (sig[:3] * eps[:3]), np.asarray(vel) + rot @ (sig[3:] * eps[3:])
         np.testing.assert_allclose(pos, ref_pos, rtol=1e-12)
         np.testing.assert_allclose(v, ref_v, rtol=1e-12)
         assert not np.array_equal(pos, truth)  # noisy

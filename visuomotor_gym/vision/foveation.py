@@ -182,18 +182,6 @@ def covariance(position_eye: np.ndarray, retinal_speed: float, params: VisionPar
     return a @ np.diag(sig**2) @ a.T
 
 
-def sample(
-    position_eye: np.ndarray,
-    velocity_eye: np.ndarray,
-    retinal_speed: float,
-    params: VisionParams,
-    rng: np.random.Generator,
-) -> tuple[np.ndarray, np.ndarray]:
-    """Draw one perceived (position, velocity) in the eye frame, ignoring the field of view."""
-    pos, vel = _draw(list(map(float, position_eye)), list(map(float, velocity_eye)), retinal_speed, params, rng)
-    return np.array(pos), np.array(vel)
-
-
 def perceive(position_eye, velocity_eye, retinal_speed: float, params: VisionParams, rng: np.random.Generator):
     """One look at a point: ``(position, velocity, visible)`` in the eye frame, as float lists.
 
@@ -211,17 +199,9 @@ def perceive(position_eye, velocity_eye, retinal_speed: float, params: VisionPar
     return pos, vel, True
 
 
-def _draw(position_eye, velocity_eye, retinal_speed, params, rng):
-    """True state + A Sigma eps with eps ~ N(0, I6) (Eyecatch Eq. 1-3); float lists in and out."""
-    x, y, z = position_eye
-    d = math.sqrt(x * x + y * y + z * z)
-    if d <= 0.0:
-        return list(position_eye), list(velocity_eye)
-    return _draw_at(x, y, z, d, math.acos(max(-1.0, min(1.0, x / d))), velocity_eye, retinal_speed, params, rng)
-
-
 def _draw_at(x, y, z, d, ecc, velocity_eye, retinal_speed, params, rng):
-    """:func:`_draw` for a point at distance ``d`` > 0 and eccentricity ``ecc`` (rad)."""
+    """True state + A Sigma eps with eps ~ N(0, I6) (Eyecatch Eq. 1-3) for a point at distance ``d`` > 0
+    and eccentricity ``ecc`` (rad); float lists in and out."""
     s0, s1, s2, s3, s4, s5 = _sigmas(d, ecc, retinal_speed, params)
     e0, e1, e2, e3, e4, e5 = rng.standard_normal(6).tolist()
     n0, n1, n2, n3, n4, n5 = s0 * e0, s1 * e1, s2 * e2, s3 * e3, s4 * e4, s5 * e5
