@@ -202,3 +202,13 @@ register_agent("belief_intercept", _belief_intercept,
 register_agent("ppo", _ppo, "a trained stable-baselines3 PPO/RecurrentPPO policy: ppo:<model.zip or run folder>")
 register_agent("eyecatch", _eyecatch, "Eyecatch heuristic (Yeo et al. 2012): Kalman filter, saccades, submovements")
 register_agent("belief_mpc", _belief_mpc, "belief-space MPC (Eom et al. 2019): Kalman beliefs, iLQR over gaze, head, hand")
+
+
+def _iwao(env_id, action_dim, seed, **kw):
+    from visuomotor_gym.baselines.iwao import IwaoAgent
+
+    return IwaoAgent.for_env(env_id, **kw)
+
+
+register_agent("iwao", _iwao, "Iwao et al. (seed 003): head/eye pitch Gaussians per gait cycle toward the next "
+               "obstacle, fused percepts, footstep planner (ObstacleWalk); iwao:gaze_blind=true is its gaze-blind twin")

@@ -14,6 +14,8 @@ CATCH_ENTRY_POINT = "visuomotor_gym.envs.catch:EyeCatchEnv"
 CATCH_MAX_EPISODE_STEPS = 125  # 2.5 s at 50 Hz: the longest flight is 1.4 s
 TWO_BALLS_MAX_EPISODE_STEPS = 150  # 3 s: the second ball arrives at most 2.2 s after the first release
 POOR_VISION_SCALE = 10.0  # Eyecatch section 5: every vision noise x10 (81.2 % caught in the paper)
+WALK_ENTRY_POINT = "visuomotor_gym.envs.walk:ObstacleWalkEnv"
+WALK_MAX_EPISODE_STEPS = 2000  # 40 s at 50 Hz: three times the nominal walk (1.3 m/s) of the longest (20 m) course
 VISUAL_DELAY_S = 0.1  # the Delayed rung's latency: ~100 ms of human visual processing (modelling choice)
 
 
@@ -58,6 +60,8 @@ ENV_SPECS: tuple[EnvEntry, ...] = (
              description="foveated; the ball bounces off an invisible wall mid-flight (Eyecatch 5)"),
     EnvEntry("EyeCatchTwoBalls-v0", CATCH_ENTRY_POINT, {"n_balls": 2}, max_episode_steps=TWO_BALLS_MAX_EPISODE_STEPS,
              description="foveated; two staggered balls from both sides, catch both (Eom 7)"),
+    *vision_rungs("ObstacleWalk", WALK_ENTRY_POINT, family="walk", max_episode_steps=WALK_MAX_EPISODE_STEPS,
+                  what="obstacle"),
 )
 ENV_IDS = tuple(spec.id for spec in ENV_SPECS)
 FAMILIES: dict[str, tuple[str, ...]] = {}

@@ -52,6 +52,27 @@ class FreeBodyTarget(VisualTarget):
         return data.qpos[q : q + 3], data.qvel[v : v + 3]
 
 
+class PointTarget(VisualTarget):
+    """A still point of the scene (a corner of an obstacle's top face, a stone's centre): its world
+    position is whatever the task last wrote into ``position`` (a length-3 array), its velocity zero.
+    ``hidden`` (a plain attribute here) hides it, e.g. while its object is parked out of the scene."""
+
+    _ZERO = np.zeros(3)
+
+    def __init__(self, name: str) -> None:
+        self.name = name
+        self.position = np.zeros(3)
+        self.hidden = True
+
+    def place(self, x: float, y: float, z: float) -> None:
+        """Put the point at (x, y, z) (world) and show it."""
+        self.position[:] = (x, y, z)
+        self.hidden = False
+
+    def state(self, data: mujoco.MjData) -> tuple[np.ndarray, np.ndarray]:
+        return self.position, self._ZERO
+
+
 class Retina:
     """Visual samples of targets.
 
