@@ -63,6 +63,11 @@ ENV_SPECS: tuple[EnvEntry, ...] = (
     *vision_rungs("ObstacleWalk", WALK_ENTRY_POINT, family="walk", max_episode_steps=WALK_MAX_EPISODE_STEPS,
                   what="obstacle"),
 )
+# The reach family (seed 002, Faraway, Reed & Wang 2007): ShelfReach-v0 and its vision rungs.
+REACH_ENTRY_POINT = "visuomotor_gym.envs.reach:ShelfReachEnv"
+REACH_MAX_EPISODE_STEPS = 150  # 3 s at 50 Hz: first saccade (~0.2 s), fixation, a ~0.6-1 s reach, slack (modelling choice)
+ENV_SPECS = ENV_SPECS + vision_rungs("ShelfReach", REACH_ENTRY_POINT, family="reach",
+                                     max_episode_steps=REACH_MAX_EPISODE_STEPS, what="object")
 ENV_IDS = tuple(spec.id for spec in ENV_SPECS)
 FAMILIES: dict[str, tuple[str, ...]] = {}
 for _spec in ENV_SPECS:
