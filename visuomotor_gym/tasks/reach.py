@@ -46,9 +46,9 @@ class ShelfLayout:
     # The object: a vertical cylinder (seed 002's subjects moved "a vertical cylinder"); size modelling choice.
     object_radius_m: float = 0.03
     object_half_height_m: float = 0.06
-    # Back panel of each tower, this far behind the far depth (modelling choice: 5 cm of room for the palm,
+    # Back panel of each tower, this far behind the far depth (modelling choice: ~7 cm of room for the palm,
     # which extends 5 cm past the catch site along the forearm).
-    panel_gap_m: float = 0.10
+    panel_gap_m: float = 0.12
 
     def targets(self) -> np.ndarray:
         """(30, 3) object-centre positions, in the order tower, level, depth (near first)."""
