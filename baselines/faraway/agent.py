@@ -49,6 +49,7 @@ _S = _LAYOUT.slices
 # Peak of the Beta(1.63, 1.75) speed density (at its mode 0.457): peak speed = this x length / duration.
 PRIOR_STD_M = 0.5  # weak prior on the object: the shelves' centre +- 0.5 m (modelling choice)
 PRIOR_DISTANCE_M = 0.8  # distance assumed for the first sample's noise: the shelves are 0.5-1.1 m from the eye
+PATH_REPLAN_M = 0.002  # recompute faraway_path when the end estimate moved more than this (cost; modelling choice)
 _BETA_PEAK = float(np.max(np.diff(handpath.beta_progress(np.linspace(0.0, 1.0, 2001))) * 2000.0))
 
 
@@ -127,6 +128,8 @@ class FarawayAgent:
         self.reach_t0 = 0.0
         self.reach_T = self.params.reach_duration_s
         self.home: np.ndarray | None = None
+        self._path: np.ndarray | None = None
+        self._path_end: np.ndarray | None = None
         self.events: list[tuple[float, str]] = []
 
     # --- estimate ---------------------------------------------------------------------------
@@ -226,8 +229,11 @@ class FarawayAgent:
                 target = end
             else:
                 n = 101
-                path = handpath.faraway_path(self.reach_start + SEAT_ORIGIN, end + SEAT_ORIGIN, n)
-                target = np.array([np.interp(tau * (n - 1), np.arange(n), path[:, k]) for k in range(3)]) - SEAT_ORIGIN
+                if self._path_end is None or float(np.linalg.norm(end - self._path_end)) > PATH_REPLAN_M:
+                    self._path = handpath.faraway_path(self.reach_start + SEAT_ORIGIN, end + SEAT_ORIGIN, n) - SEAT_ORIGIN
+                    self._path_end = end
+                path = self._path + np.linspace(0.0, 1.0, n)[:, None] * (end - self._path_end)  # exact end point
+                target = np.array([np.interp(tau * (n - 1), np.arange(n), path[:, k]) for k in range(3)])
             grasp = tau >= p.grasp_at_tau
         return hand_action(target + SEAT_ORIGIN, grasp, gaze, head, fixation, self.gaze_range)
 
