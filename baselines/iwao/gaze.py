@@ -31,8 +31,8 @@ class IwaoGazeParams:
     # The view angle while walking (seed 003 section 4.2.3: 20 deg walking, 30 deg running).
     view_angle_max_deg: float = 20.0
     # beta in theta_V = theta_Vmax - l / beta (metres per degree). The paper gives no value: modelling
-    # choice, the view angle shrinks to 0 for an obstacle 4 m away (foveated) and is 10 deg at 2 m.
-    beta_m_per_deg: float = 0.2
+    # choice, the view angle is 0 (the obstacle foveated) from 2 m away and 10 deg at 1 m.
+    beta_m_per_deg: float = 0.1
     # alpha, the head/eye ratio ("carefulness"). No value in the paper: modelling choice, the head does a
     # third of the downward gaze shift and the eye two thirds.
     alpha: float = 0.5

@@ -53,6 +53,14 @@ class Corner:
         self.n += 1
         self._dirty = True
 
+    def prior(self):
+        """The estimate to linearise the next sample at (refreshed every 4 samples), None before 2."""
+        if self.n < 2:
+            return None
+        if self._est is None or (self._dirty and self.n % 4 == 0):
+            self.estimate()
+        return self._est[0]
+
     def _matrix(self) -> np.ndarray:
         xx, xy, xz, yy, yz, zz = self.info
         return np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
@@ -100,8 +108,6 @@ class ObstacleMemory:
         if d <= 0.0:
             return
         ecc = math.acos(max(-1.0, min(1.0, ex / d)))
-        s_depth, s_lat = _sigmas(d, ecc, 0.0, self.vision)[:2]
-        s_depth, s_lat = max(s_depth, MIN_STD_M), max(s_lat, MIN_STD_M)
         (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = rot_rows
         bx = eye_pos[0] + r00 * ex + r01 * ey + r02 * ez
         by = eye_pos[1] + r10 * ex + r11 * ey + r12 * ez
@@ -114,7 +120,28 @@ class ObstacleMemory:
         pair = self.corners.get(index)
         if pair is None:
             pair = self.corners[index] = (Corner(), Corner())
-        pair[which].add(z, u, s_depth, s_lat)
+        corner = pair[which]
+        eye_w = (z[0] - d * u[0], z[1] - d * u[1], z[2] - d * u[2])  # the eye, path frame
+        # The noise is spread along and across the *true* line of sight at the *true* distance, which the
+        # agent does not know. The perceived point is no guide when the depth noise is as large as the
+        # distance (~40 deg off the fovea): it may come out next to the eye or behind it, its direction
+        # then wrong by a lot. So, as an extended Kalman filter linearises at its prior, the line of sight
+        # and the distance are those of the corner's current estimate; before there is one, of the point
+        # where the perceived ray meets the plane 0.15 m above the floor (mid-range of the obstacles).
+        prior = corner.prior()
+        if prior is not None:
+            lx, ly, lz = prior[0] - eye_w[0], prior[1] - eye_w[1], prior[2] - eye_w[2]
+            d_ref = math.sqrt(lx * lx + ly * ly + lz * lz)
+            u = (lx / d_ref, ly / d_ref, lz / d_ref)
+        else:
+            if u[2] >= -0.02 or u[0] <= 0.0:  # an obstacle's top lies ahead and below the eye
+                return
+            d_ref = (eye_w[2] - 0.15) / -u[2]
+            if d < 0.3 * d_ref:  # too near to trust its direction
+                return
+        d_ref = min(max(d_ref, 0.3), 30.0)
+        s_depth, s_lat = _sigmas(d_ref, ecc, 0.0, self.vision)[:2]
+        corner.add(z, u, max(s_depth, MIN_STD_M), max(s_lat, MIN_STD_M))
 
     def obstacle(self, index: int) -> ObstacleEstimate | None:
         """The box of obstacle ``index`` once both its corners were seen, else None."""
