@@ -10,6 +10,7 @@ sampling time (lists of floats; zeros when not visible).
 
 from __future__ import annotations
 
+import math
 from collections import deque
 
 import mujoco
@@ -97,6 +98,8 @@ class Retina:
         self.params = params
         self.delay_steps = int(delay_steps)
         self.dt = float(dt)
+        # Slightly wider than the field (1e-9 rad): foveation.perceive makes the exact decision.
+        self._cos_fov = math.cos(min(params.field_of_view_deg * foveation.DEG + 1e-9, math.pi))
         self.reset()
 
     def reset(self) -> None:
@@ -128,6 +131,8 @@ class Retina:
         rx, ry, rz = bx - ex, by - ey, bz - ez
         rot = eye.rot_flat
         pos_eye = list(rotate_t(rot, rx, ry, rz))  # R^T (p - r) and R^T v: Eyecatch Eq. 6-7
+        if vp.foveated and pos_eye[0] < self._cos_fov * math.sqrt(rx * rx + ry * ry + rz * rz):
+            return nothing()  # outside the field of view (decided before the costlier retinal slip)
         vel_eye = list(rotate_t(rot, vx, vy, vz))
         retinal_speed = eye.retinal_speed(rx, ry, rz, vx, vy, vz, self.dt)
         return foveation.perceive(pos_eye, vel_eye, retinal_speed, vp, rng)

@@ -122,7 +122,8 @@ class ObstacleWalkTask:
         self.reward_weights = reward_weights
         self.visual_delay_s = visual_delay_s
         n = len(self.pool)
-        self.targets = [PointTarget(f"obstacle_{i:02d}_{c}") for i in range(n) for c in ("near", "far")]
+        self.all_targets = [PointTarget(f"obstacle_{i:02d}_{c}") for i in range(n) for c in ("near", "far")]
+        self.targets = self.all_targets
         self._finish_body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, wn.WALKER_FINISH)
         self._finish_mocap = int(model.body_mocapid[self._finish_body])
         self.course = Course(0.0, np.zeros((0, 6)))
@@ -135,6 +136,7 @@ class ObstacleWalkTask:
         self.misstepped = False
         self.finished = False
         self.n_passed = 0
+        self._slots_set = False
         self._n_events = 0
         self._prev_x = 0.0
         self.seen = [False] * K_SLOTS
@@ -144,8 +146,9 @@ class ObstacleWalkTask:
         m, d = self.model, data
         self.course = course = sample_course(rng, self.dist, len(self.pool))
         self.pool.park_all(m, d)
-        for t in self.targets:
+        for t in self.all_targets:
             t.hidden = True
+        self.targets = self.all_targets[: 2 * len(course.obstacles)]  # what the retina samples
         for i, (x, y, depth, width, height, kind) in enumerate(course.obstacles.tolist()):
             self.pool.place(m, d, i, x, y, depth, width, height, rgba=OBSTACLE_RGBA[int(kind)])
             self.targets[2 * i].place(x - 0.5 * depth, y + 0.5 * width, height)
@@ -189,8 +192,16 @@ class ObstacleWalkTask:
         """Advance the first slot past obstacles the pelvis has left behind (before the retina samples)."""
         obs = self.course.obstacles
         x = float(data.qpos[0])
+        n0 = self.n_passed
         while self.n_passed < len(obs) and obs[self.n_passed, 0] + 0.5 * obs[self.n_passed, 2] < x - PASSED_M:
             self.n_passed += 1
+        if n0 != self.n_passed or not self._slots_set:
+            # Only the slots' obstacles are sampled (the others would not reach the observation; those
+            # passed lie behind the walker, beyond any reach of the eye and the head).
+            for i in range(len(obs)):
+                hidden = not (self.n_passed <= i < self.n_passed + K_SLOTS)
+                self.targets[2 * i].hidden = self.targets[2 * i + 1].hidden = hidden
+            self._slots_set = True
 
     def observe_leading(self, values: list, samples: list) -> None:
         """The :data:`PERCEPT_BLOCKS`: per slot, id, two corners (eye frame) and their seen flags."""
