@@ -327,3 +327,24 @@ register_agent("gaze_blind", _gaze_blind,
                "gaze_blind:<agent>: that agent with its gaze and head held (its gaze-blind twin)", wraps=True)
 register_agent("fixed_gaze", _fixed_gaze,
                "gaze_blind:eyecatch: the Eyecatch filter and hand with gaze and head held (gaze-blind reference)")
+
+
+def _iwao(env_id, action_dim, seed, **kw):
+    from visuomotor_gym.baselines.iwao import IwaoAgent
+
+    return IwaoAgent.for_env(env_id, **kw)
+
+
+register_agent("iwao", _iwao, "Iwao et al. (seed 003): head/eye pitch Gaussians per gait cycle toward the next "
+               "obstacle, fused percepts, footstep planner (ObstacleWalk); iwao:gaze_blind=true is its gaze-blind twin")
+
+
+def _faraway(env_id, action_dim, seed, **kw):
+    from visuomotor_gym.baselines.faraway import FarawayAgent
+
+    return FarawayAgent.for_env(env_id, **kw)
+
+
+# Reach family (issue 14). Its gaze-blind twin is ``faraway:gaze_blind=true`` (gaze, vergence and head held).
+register_agent("faraway", _faraway,
+               "reach family: saccade to the object, then a reach along Faraway et al.'s (2007) Bézier path")

@@ -15,6 +15,8 @@ CATCH_ENTRY_POINT = "visuomotor_gym.envs.catch:EyeCatchEnv"
 CATCH_MAX_EPISODE_STEPS = 125  # 2.5 s at 50 Hz: the longest flight is 1.4 s
 TWO_BALLS_MAX_EPISODE_STEPS = 150  # 3 s: the second ball arrives at most 2.2 s after the first release
 POOR_VISION_SCALE = 10.0  # Eyecatch section 5: every vision noise x10 (81.2 % caught in the paper)
+WALK_ENTRY_POINT = "visuomotor_gym.envs.walk:ObstacleWalkEnv"
+WALK_MAX_EPISODE_STEPS = 2000  # 40 s at 50 Hz: three times the nominal walk (1.3 m/s) of the longest (20 m) course
 VISUAL_DELAY_S = 0.1  # the Delayed rung's latency: ~100 ms of human visual processing (modelling choice)
 
 
@@ -71,7 +73,14 @@ ENV_SPECS: tuple[EnvEntry, ...] = (
     EnvEntry("EyeCatchPaperPoorVision-v0", CATCH_ENTRY_POINT,
              {"vision_params": dict(PAPER_VISION), "vision_noise_scale": POOR_VISION_SCALE},
              description="Eyecatch paper's vision with all noise x10 (Eyecatch 5: 81.2 %)"),
+    *vision_rungs("ObstacleWalk", WALK_ENTRY_POINT, family="walk", max_episode_steps=WALK_MAX_EPISODE_STEPS,
+                  what="obstacle"),
 )
+# The reach family (seed 002, Faraway, Reed & Wang 2007): ShelfReach-v0 and its vision rungs.
+REACH_ENTRY_POINT = "visuomotor_gym.envs.reach:ShelfReachEnv"
+REACH_MAX_EPISODE_STEPS = 150  # 3 s at 50 Hz: first saccade (~0.2 s), fixation, a ~0.6-1 s reach, slack (modelling choice)
+ENV_SPECS = ENV_SPECS + vision_rungs("ShelfReach", REACH_ENTRY_POINT, family="reach",
+                                     max_episode_steps=REACH_MAX_EPISODE_STEPS, what="object")
 ENV_IDS = tuple(spec.id for spec in ENV_SPECS)
 FAMILIES: dict[str, tuple[str, ...]] = {}
 for _spec in ENV_SPECS:

@@ -10,6 +10,7 @@ sampling time (lists of floats; zeros when not visible).
 
 from __future__ import annotations
 
+import math
 from collections import deque
 
 import mujoco
@@ -52,6 +53,27 @@ class FreeBodyTarget(VisualTarget):
         return data.qpos[q : q + 3], data.qvel[v : v + 3]
 
 
+class PointTarget(VisualTarget):
+    """A still point of the scene (a corner of an obstacle's top face, a stone's centre): its world
+    position is whatever the task last wrote into ``position`` (a length-3 array), its velocity zero.
+    ``hidden`` (a plain attribute here) hides it, e.g. while its object is parked out of the scene."""
+
+    _ZERO = np.zeros(3)
+
+    def __init__(self, name: str) -> None:
+        self.name = name
+        self.position = np.zeros(3)
+        self.hidden = True
+
+    def place(self, x: float, y: float, z: float) -> None:
+        """Put the point at (x, y, z) (world) and show it."""
+        self.position[:] = (x, y, z)
+        self.hidden = False
+
+    def state(self, data: mujoco.MjData) -> tuple[np.ndarray, np.ndarray]:
+        return self.position, self._ZERO
+
+
 class Retina:
     """Visual samples of targets.
 
@@ -76,6 +98,8 @@ class Retina:
         self.params = params
         self.delay_steps = int(delay_steps)
         self.dt = float(dt)
+        # Slightly wider than the field (1e-9 rad): foveation.perceive makes the exact decision.
+        self._cos_fov = math.cos(min(params.field_of_view_deg * foveation.DEG + 1e-9, math.pi))
         self.reset()
 
     def reset(self) -> None:
@@ -107,6 +131,8 @@ class Retina:
         rx, ry, rz = bx - ex, by - ey, bz - ez
         rot = eye.rot_flat
         pos_eye = list(rotate_t(rot, rx, ry, rz))  # R^T (p - r) and R^T v: Eyecatch Eq. 6-7
+        if vp.foveated and pos_eye[0] < self._cos_fov * math.sqrt(rx * rx + ry * ry + rz * rz):
+            return nothing()  # outside the field of view (decided before the costlier retinal slip)
         vel_eye = list(rotate_t(rot, vx, vy, vz))
         retinal_speed = eye.retinal_speed(rx, ry, rz, vx, vy, vz, self.dt)
         return foveation.perceive(pos_eye, vel_eye, retinal_speed, vp, rng)

@@ -53,6 +53,16 @@ def episode_success(trace) -> bool:
     return bool(trace.caught if success is None else success)
 
 
+def _family(trace) -> str | None:
+    """The registered family of a trace's env id (None when unknown or absent)."""
+    from visuomotor_gym.registration import family_of
+
+    try:
+        return family_of(str(getattr(trace, "env_id", "")))
+    except ValueError:
+        return None
+
+
 def summarize(traces: Sequence) -> dict:
     """Every benchmark number for a set of episodes, as plain JSON-serialisable Python (None = undefined).
 
@@ -76,6 +86,10 @@ def summarize(traces: Sequence) -> dict:
     catch rate and latency.
     """
     traces = list(traces)
+    if traces and _family(traces[0]) == "reach":  # the reach family's realism and outcomes (issue 14)
+        from visuomotor_gym.metrics.reach_realism import reach_summary
+
+        return to_json_safe(reach_summary(traces))
     n = len(traces)
     caught = sum(bool(tr.caught) for tr in traces)
     diverged = sum(bool(tr.diverged) for tr in traces)

@@ -1,0 +1,245 @@
+"""The ``faraway`` baseline for ShelfReach: look, then reach along Faraway's path.
+
+The agent sees observations only (the object's position only as the eye's samples). Each 20 ms step:
+
+1. **Perception**: every visual sample of the object (eye frame at sampling time; the eye pose of that
+   time is kept for the visual delay) is turned into the seat frame with its covariance from the vision
+   model (Eyecatch Eq. 1-3, :func:`visuomotor_gym.vision.foveation.covariance`) and fused in information
+   form (the object does not move). Peripheral samples know the direction well and the depth badly; a
+   fixated one knows both.
+2. **Gaze**: the first saccade goes ``saccade_latency_s`` after the start (~200 ms, REFERENCES.md:
+   Prablanc et al. 1979, the saccade within ~250 ms; saccade latency 180-200 ms) to the estimated
+   object, or, while the object has not been seen, to the next tower of the known layout (search).
+   Then the eye is sent to the estimate every step (the plant turns small errors into pursuit, large
+   ones into corrective saccades). The head turns by the part of the gaze angle beyond a 20 deg dead
+   zone (Eyecatch Sec. 4.2). Vergence follows the estimate's distance.
+3. **Hand**: ``hand_delay_s`` (100 ms, Prablanc et al. 1979: the hand ~100 ms after the saccade) after the
+   saccade to the object, the hand starts along :func:`visuomotor_gym.handpath.faraway_path` from where it
+   is to the estimated object; the end point follows the estimate as it sharpens (on-line correction,
+   re-evaluated every step). The reach lasts ``reach_duration_s`` (0.6 s, so that gaze, which lands
+   ~0.05-0.1 s after the saccade onset, leads the hand's arrival by ~0.5-0.6 s: Land, Mennie & Rusted
+   1999, gaze reaches an object ~0.56 s before the hand acts on it), longer when the peak speed would
+   exceed ``max_peak_speed_m_s``. The fingers close from ``grasp_at_tau`` of the reach on.
+
+``gaze_blind=True`` is the gaze-blind twin (DESIGN.md Sec. 2): the same agent with gaze, vergence and
+head held (zero actions), reaching to whatever its peripheral samples tell it, when they tell it anything.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from dataclasses import dataclass, fields, replace
+
+import numpy as np
+
+from visuomotor_gym import handpath
+from visuomotor_gym.core.frames import SEAT_ORIGIN
+from visuomotor_gym.envs.actions import NECK_RANGE_DEG, hand_action
+from visuomotor_gym.envs.reach import reach_observation
+from visuomotor_gym.core.observation import ObservationLayout
+from visuomotor_gym.registration import env_vision
+from visuomotor_gym.tasks.reach import SHELF_LAYOUT
+from visuomotor_gym.vision import foveation
+from visuomotor_gym.vision.foveation import VisionParams
+
+DEG = math.pi / 180.0
+_LAYOUT = ObservationLayout(reach_observation())
+_S = _LAYOUT.slices
+# Peak of the Beta(1.63, 1.75) speed density (at its mode 0.457): peak speed = this x length / duration.
+PRIOR_STD_M = 0.5  # weak prior on the object: the shelves' centre +- 0.5 m (modelling choice)
+PRIOR_DISTANCE_M = 0.8  # distance assumed for the first sample's noise: the shelves are 0.5-1.1 m from the eye
+PATH_REPLAN_M = 0.002  # recompute faraway_path when the end estimate moved more than this (cost; modelling choice)
+_BETA_PEAK = float(np.max(np.diff(handpath.beta_progress(np.linspace(0.0, 1.0, 2001))) * 2000.0))
+
+
+@dataclass(frozen=True)
+class FarawayParams:
+    """Every constant of the baseline, with its source; override by name (``faraway:name=value``)."""
+
+    # Vision assumed by the brain (set from the env id by ``for_env``).
+    vision_noise_scale: float = 1.0
+    foveated: bool = True
+    visual_delay_s: float = 0.0
+    gaze_action_range_deg: float = 60.0
+    # Timing (REFERENCES.md, Reaching).
+    saccade_latency_s: float = 0.2  # first saccade: 180-200 ms latency; Prablanc et al. 1979: within ~250 ms
+    hand_delay_s: float = 0.1  # Prablanc et al. 1979: the hand ~100 ms after the saccade
+    reach_duration_s: float = 0.6  # gaze leads the hand by ~0.56 s (Land et al. 1999); modelling choice
+    max_peak_speed_m_s: float = 1.8  # below the hand controller's 2 m/s cap (Eyecatch 4.3); modelling choice
+    grasp_at_tau: float = 0.8  # close the fingers over the last fifth of the reach (modelling choice)
+    search_dwell_s: float = 0.3  # look at a tower this long before searching the next (modelling choice)
+    head_dead_zone_deg: float = 20.0  # Eyecatch Sec. 4.2 Eq. 17
+    # The gaze-blind twin: gaze, vergence and head held.
+    gaze_blind: bool = False
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            v = getattr(self, f.name)
+            if f.name in ("foveated", "gaze_blind"):
+                if not isinstance(v, bool):
+                    raise ValueError(f"FarawayParams.{f.name} must be true or false, got {v!r}")
+            elif isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v < 0:
+                raise ValueError(f"FarawayParams.{f.name} must be a finite number >= 0, got {v!r}")
+        if not 0.0 < self.grasp_at_tau <= 1.0:
+            raise ValueError(f"FarawayParams.grasp_at_tau must be in (0, 1], got {self.grasp_at_tau!r}")
+        if self.reach_duration_s <= 0 or self.max_peak_speed_m_s <= 0:
+            raise ValueError("FarawayParams.reach_duration_s and max_peak_speed_m_s must be > 0")
+
+
+class FarawayAgent:
+    """Saccade to the object, then a reach along Faraway's predicted path (SB3 ``predict`` interface)."""
+
+    def __init__(self, params: FarawayParams | None = None, dt: float = 0.02):
+        self.params = params or FarawayParams()
+        p = self.params
+        self.dt = float(dt)
+        self.vision = VisionParams(noise_scale=max(p.vision_noise_scale, 1e-6), foveated=p.foveated)
+        self.delay_steps = int(round(p.visual_delay_s / self.dt))
+        self.gaze_range = p.gaze_action_range_deg * DEG
+        # Search points: the towers' centres (the layout is known, as a person knows the shelves in front).
+        targets = SHELF_LAYOUT.targets() - SEAT_ORIGIN
+        self.search_points = [targets[t * 10 : t * 10 + 10].mean(axis=0) for t in range(3)]
+        self.prior_mean = targets.mean(axis=0)
+        self.reset()
+
+    @classmethod
+    def for_env(cls, env_id: str, **overrides) -> FarawayAgent:
+        """An agent whose assumed vision matches the registered env (noise, foveation, latency)."""
+        base = FarawayParams(**env_vision(env_id))
+        unknown = sorted(set(overrides) - {f.name for f in fields(FarawayParams)})
+        if unknown:
+            raise TypeError(f"unknown faraway parameter(s) {unknown}; known: {[f.name for f in fields(FarawayParams)]}")
+        return cls(replace(base, **overrides))
+
+    def reset(self) -> None:
+        """Forget the episode (called by the evaluator, and on ``episode_start``)."""
+        self.started = False
+        # The object estimate (seat frame): a precision-weighted mean started from a weak prior on the
+        # shelves' centre (the layout is known), PRIOR_STD_M in every direction.
+        self.weight_sum = 1.0 / PRIOR_STD_M**2
+        self.point_sum = self.weight_sum * self.prior_mean
+        self.samples = 0
+        self.poses: deque = deque(maxlen=self.delay_steps + 1)
+        self.saccade_time: float | None = None  # when the first saccade to the object was commanded
+        self.search_index = 1  # the gaze starts on tower 0
+        self.search_since = 0.0
+        self.reach_start: np.ndarray | None = None
+        self.reach_t0 = 0.0
+        self.reach_T = self.params.reach_duration_s
+        self.home: np.ndarray | None = None
+        self._path: np.ndarray | None = None
+        self._path_end: np.ndarray | None = None
+        self.events: list[tuple[float, str]] = []
+
+    # --- estimate ---------------------------------------------------------------------------
+    @property
+    def has_estimate(self) -> bool:
+        return self.samples > 0
+
+    def estimate(self) -> np.ndarray:
+        """Seat-frame estimate of the object centre: the precision-weighted mean of the samples and the prior."""
+        return self.point_sum / self.weight_sum
+
+    def estimate_std(self) -> float:
+        """Standard deviation (m) of the estimate along the worst (depth) direction."""
+        return float(1.0 / math.sqrt(self.weight_sum))
+
+    def _fuse(self, pos_eye: np.ndarray, rot: np.ndarray, eye: np.ndarray) -> None:
+        """Add one sample, weighted by its depth precision (Eyecatch Eq. 2 at its eccentricity).
+
+        Depth noise dominates (5 % of the distance at the fovea vs 1 arcmin laterally), so each sample is
+        weighted isotropically by 1 / depth variance: the weighted mean of the sample points is unbiased
+        (the eye-to-world map is linear) and, unlike a full-covariance fusion, it does not collapse onto the
+        eye where the samples' nearly parallel lines of sight meet. The noise grows with the *true*
+        distance, which a sample does not know (a far-peripheral one may put the object at the eye), so it
+        is taken at the current estimate's distance (before the first sample: ``PRIOR_DISTANCE_M``)."""
+        ref = float(np.linalg.norm(self.estimate() - eye)) if self.has_estimate else PRIOR_DISTANCE_M
+        v = self.vision
+        ecc = foveation.eccentricity(pos_eye)
+        depth_std = max(ref, 0.1) * v.depth_std_fraction * v.noise_scale / foveation.acuity(ecc, v)
+        w = 1.0 / max(depth_std, 1e-6) ** 2
+        self.weight_sum += w
+        self.point_sum += w * (eye + rot @ pos_eye)
+        self.samples += 1
+
+    # --- policy -------------------------------------------------------------------------------
+    def predict(self, observation, state=None, episode_start=None, deterministic=True):
+        obs = np.asarray(observation, dtype=float)
+        if episode_start is not None and bool(np.asarray(episode_start).reshape(-1)[0]) and self.started:
+            self.reset()
+        if obs.shape != (_LAYOUT.size,):
+            raise ValueError(f"FarawayAgent expects the flat ShelfReach observation of size {_LAYOUT.size} "
+                             f"(hand_action='target'), got shape {obs.shape}")
+        return self._act(obs), state
+
+    def _act(self, obs: np.ndarray) -> np.ndarray:
+        p = self.params
+        t = float(obs[_S["time"]][0])
+        rot = obs[_S["eye_rot"]].reshape(3, 3)
+        eye = obs[_S["eye_pos"]].copy()  # seat frame
+        hand = obs[_S["hand_pos"]].copy()
+        if not self.started:
+            self.started = True
+            self.home = hand.copy()
+        self.poses.append((rot.copy(), eye.copy()))
+        if obs[_S["object_visible"]][0] > 0.5 and len(self.poses) == self.delay_steps + 1:
+            r0, e0 = self.poses[0]  # the eye pose when the sample was taken
+            self._fuse(obs[_S["object_pos"]].copy(), r0, e0)
+
+        # --- gaze ---------------------------------------------------------------------------
+        gaze = (0.0, 0.0)
+        head = (0.0, 0.0)
+        fixation = None
+        look_at = None
+        if t >= p.saccade_latency_s - 1e-9:
+            if self.has_estimate:
+                look_at = self.estimate()
+                if self.saccade_time is None:
+                    self.saccade_time = t
+                    self.events.append((t, "saccade"))
+            else:
+                if t - self.search_since >= p.search_dwell_s and self.search_index < len(self.search_points):
+                    self.search_since = t
+                    self.search_index += 1
+                look_at = self.search_points[min(self.search_index, len(self.search_points)) - 1]
+        if look_at is not None and not p.gaze_blind:
+            d_eye = rot.T @ (look_at - eye)
+            gaze = (math.atan2(d_eye[1], d_eye[0]), math.atan2(d_eye[2], math.hypot(d_eye[0], d_eye[1])))
+            d = look_at - eye  # seat frame = world axes
+            az, el = math.atan2(d[1], d[0]), math.atan2(d[2], math.hypot(d[0], d[1]))
+            head = (self._beyond_dead_zone(az, 0), self._beyond_dead_zone(el, 1))
+            fixation = float(np.linalg.norm(d))
+        elif p.gaze_blind and self.has_estimate and self.saccade_time is None and t >= p.saccade_latency_s - 1e-9:
+            self.saccade_time = t  # the time the looking agent would have looked: the twin's hand starts alike
+
+        # --- hand ---------------------------------------------------------------------------
+        target = self.home
+        grasp = False
+        if self.saccade_time is not None and t >= self.saccade_time + p.hand_delay_s - 1e-9 and self.has_estimate:
+            end = self.estimate()
+            if self.reach_start is None:
+                self.reach_start = hand.copy()
+                self.reach_t0 = t
+                length = float(np.linalg.norm(end - hand))
+                self.reach_T = max(p.reach_duration_s, _BETA_PEAK * length / p.max_peak_speed_m_s)
+                self.events.append((t, "reach"))
+            tau = min((t + self.dt - self.reach_t0) / self.reach_T, 1.0)  # where the hand should be next step
+            if float(np.linalg.norm(end - self.reach_start)) < 1e-3 or tau >= 1.0:
+                target = end
+            else:
+                n = 101
+                if self._path_end is None or float(np.linalg.norm(end - self._path_end)) > PATH_REPLAN_M:
+                    self._path = handpath.faraway_path(self.reach_start + SEAT_ORIGIN, end + SEAT_ORIGIN, n) - SEAT_ORIGIN
+                    self._path_end = end
+                path = self._path + np.linspace(0.0, 1.0, n)[:, None] * (end - self._path_end)  # exact end point
+                target = np.array([np.interp(tau * (n - 1), np.arange(n), path[:, k]) for k in range(3)])
+            grasp = tau >= p.grasp_at_tau
+        return hand_action(target + SEAT_ORIGIN, grasp, gaze, head, fixation, self.gaze_range)
+
+    def _beyond_dead_zone(self, angle: float, k: int) -> float:
+        """Head angle (rad) that leaves at most the dead zone to the eye (Eyecatch Eq. 17), within the neck's range."""
+        dz = self.params.head_dead_zone_deg * DEG
+        h = 0.0 if abs(angle) <= dz else angle - math.copysign(dz, angle)
+        lo, hi = NECK_RANGE_DEG[k]
+        return min(max(h, lo * DEG), hi * DEG)

@@ -1,0 +1,165 @@
+"""The iwao agent's memory of the obstacles: each seen corner fused over time in the path frame.
+
+A corner is a still point, so every visual sample is one more measurement of the same point: the
+agent adds its information ``C^-1`` (the inverse of the vision model's covariance, Eyecatch Eq. 1-3,
+along and across the line of sight) to that corner's running sum (a static Kalman filter in
+information form). Samples are placed in the *path frame* (x along the path from the start, y left,
+z up) with the agent's own proprioception: the eye pose in the pelvis frame and the odometry block.
+The covariance is evaluated at the perceived point (the agent does not know the truth). Nothing is
+assumed about the obstacles except that they are boxes whose two seen corners span the footprint.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from visuomotor_gym.vision.foveation import VisionParams, _sigmas
+
+MIN_STD_M = 1e-4  # a floor for the noiseless oracle rung (its information would be infinite)
+
+
+class Corner:
+    """Information-form estimate of one still point."""
+
+    __slots__ = ("info", "vec", "n", "_est", "_dirty")
+
+    def __init__(self) -> None:
+        self.info = [0.0] * 6  # xx, xy, xz, yy, yz, zz
+        self.vec = [0.0, 0.0, 0.0]
+        self.n = 0
+        self._est = None
+        self._dirty = True
+
+    def add(self, z: tuple[float, float, float], u: tuple[float, float, float], s_depth: float, s_lat: float) -> None:
+        """A sample ``z`` with std ``s_depth`` along the unit line of sight ``u`` and ``s_lat`` across it."""
+        a = 1.0 / (s_lat * s_lat)
+        b = 1.0 / (s_depth * s_depth) - a
+        ux, uy, uz = u
+        I = self.info
+        I[0] += a + b * ux * ux
+        I[1] += b * ux * uy
+        I[2] += b * ux * uz
+        I[3] += a + b * uy * uy
+        I[4] += b * uy * uz
+        I[5] += a + b * uz * uz
+        uz_dot = ux * z[0] + uy * z[1] + uz * z[2]
+        v = self.vec
+        v[0] += a * z[0] + b * ux * uz_dot
+        v[1] += a * z[1] + b * uy * uz_dot
+        v[2] += a * z[2] + b * uz * uz_dot
+        self.n += 1
+        self._dirty = True
+
+    def prior(self):
+        """The estimate to linearise the next sample at (refreshed every 4 samples), None before 2."""
+        if self.n < 2:
+            return None
+        if self._est is None or (self._dirty and self.n % 4 == 0):
+            self.estimate()
+        return self._est[0]
+
+    def _matrix(self) -> np.ndarray:
+        xx, xy, xz, yy, yz, zz = self.info
+        return np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
+
+    def estimate(self) -> tuple[np.ndarray, np.ndarray]:
+        """(position, standard deviations along x, y, z) of the fused estimate."""
+        if self._dirty:
+            cov = np.linalg.inv(self._matrix())
+            self._est = (cov @ np.array(self.vec), np.sqrt(np.maximum(np.diag(cov), 0.0)))
+            self._dirty = False
+        return self._est
+
+
+@dataclass
+class ObstacleEstimate:
+    """A box from its two fused corners (path frame): footprint, height and their uncertainties."""
+
+    index: int
+    x0: float
+    x1: float
+    y0: float
+    y1: float
+    height: float
+    sx: float  # std of the x extents
+    sy: float
+    sz: float
+
+
+class ObstacleMemory:
+    """Fused corners of every obstacle seen so far, by course index."""
+
+    def __init__(self, vision: VisionParams) -> None:
+        self.vision = vision
+        self.corners: dict[int, tuple[Corner, Corner]] = {}
+
+    def reset(self) -> None:
+        self.corners = {}
+
+    def add(self, index: int, which: int, p_eye, eye_pos, rot_rows, odo) -> None:
+        """One sample of corner ``which`` (0 near-left, 1 far-right) of obstacle ``index``: ``p_eye`` in
+        the eye frame, ``eye_pos`` and ``rot_rows`` (3x3, columns = eye axes) in the pelvis frame,
+        ``odo`` = (x, y, yaw, pelvis height) placing the pelvis frame in the path frame."""
+        ex, ey, ez = p_eye
+        d = math.sqrt(ex * ex + ey * ey + ez * ez)
+        if d <= 0.0:
+            return
+        ecc = math.acos(max(-1.0, min(1.0, ex / d)))
+        (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = rot_rows
+        bx = eye_pos[0] + r00 * ex + r01 * ey + r02 * ez
+        by = eye_pos[1] + r10 * ex + r11 * ey + r12 * ez
+        bz = eye_pos[2] + r20 * ex + r21 * ey + r22 * ez
+        lx, ly, lz = bx - eye_pos[0], by - eye_pos[1], bz - eye_pos[2]
+        ox, oy, yaw, pz = odo
+        c, s = math.cos(yaw), math.sin(yaw)
+        z = (ox + c * bx - s * by, oy + s * bx + c * by, pz + bz)
+        u = ((c * lx - s * ly) / d, (s * lx + c * ly) / d, lz / d)
+        pair = self.corners.get(index)
+        if pair is None:
+            pair = self.corners[index] = (Corner(), Corner())
+        corner = pair[which]
+        eye_w = (z[0] - d * u[0], z[1] - d * u[1], z[2] - d * u[2])  # the eye, path frame
+        # The noise is spread along and across the *true* line of sight at the *true* distance, which the
+        # agent does not know. The perceived point is no guide when the depth noise is as large as the
+        # distance (~40 deg off the fovea): it may come out next to the eye or behind it, its direction
+        # then wrong by a lot. So, as an extended Kalman filter linearises at its prior, the line of sight
+        # and the distance are those of the corner's current estimate; before there is one, of the point
+        # where the perceived ray meets the plane 0.15 m above the floor (mid-range of the obstacles).
+        prior = corner.prior()
+        if prior is not None:
+            lx, ly, lz = prior[0] - eye_w[0], prior[1] - eye_w[1], prior[2] - eye_w[2]
+            d_ref = math.sqrt(lx * lx + ly * ly + lz * lz)
+            u = (lx / d_ref, ly / d_ref, lz / d_ref)
+        else:
+            if u[2] >= -0.02 or u[0] <= 0.0:  # an obstacle's top lies ahead and below the eye
+                return
+            d_ref = (eye_w[2] - 0.15) / -u[2]
+            if d < 0.3 * d_ref:  # too near to trust its direction
+                return
+        d_ref = min(max(d_ref, 0.3), 30.0)
+        s_depth, s_lat = _sigmas(d_ref, ecc, 0.0, self.vision)[:2]
+        corner.add(z, u, max(s_depth, MIN_STD_M), max(s_lat, MIN_STD_M))
+
+    def obstacle(self, index: int) -> ObstacleEstimate | None:
+        """The box of obstacle ``index`` once both its corners were seen, else None."""
+        pair = self.corners.get(index)
+        if pair is None or pair[0].n == 0 or pair[1].n == 0:
+            return None
+        (p0, s0), (p1, s1) = pair[0].estimate(), pair[1].estimate()
+        w0, w1 = 1.0 / max(s0[2], 1e-6) ** 2, 1.0 / max(s1[2], 1e-6) ** 2
+        height = (w0 * p0[2] + w1 * p1[2]) / (w0 + w1)
+        return ObstacleEstimate(
+            index, min(p0[0], p1[0]), max(p0[0], p1[0]), min(p0[1], p1[1]), max(p0[1], p1[1]),
+            max(height, 0.0), float(max(s0[0], s1[0])), float(max(s0[1], s1[1])), float(math.sqrt(1.0 / (w0 + w1))),
+        )
+
+    def known(self) -> list[ObstacleEstimate]:
+        out = []
+        for i in sorted(self.corners):
+            est = self.obstacle(i)
+            if est is not None:
+                out.append(est)
+        return out

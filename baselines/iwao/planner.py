@@ -1,0 +1,152 @@
+"""The iwao agent's footstep planner: at each footstep read (mid-stance), choose the next foothold of the
+swinging foot from the obstacles it has perceived (:mod:`.perception`), stepping over what is low and
+short enough and around what is not (mats, long boxes).
+
+A grid search over (length, lateral offset) with one step of look-ahead: a candidate foothold must keep
+its foot out of every obstacle's *keep-out zone* (the footprint grown by the estimate's uncertainty and
+by gaps that the swing needs in front of the toe and behind the heel, growing with the obstacle's height)
+and leave at least one such foothold for the other foot next; among those, the cheapest in deviation from
+the nominal step and from the lateral corridor (the path's centre line, or beside an obstacle that has to
+be walked around). The toe clearance of the swing is the highest obstacle under it plus a margin.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from visuomotor_gym.body.walker import GaitParams
+
+# Foot box around the foothold (envs_assets/common/walker_body.xml: heel 6 cm behind the ankle, toe 20 cm
+# ahead, 9 cm wide).
+HEEL_M, TOE_M, HALF_WIDTH_M = 0.06, 0.20, 0.045
+
+
+@dataclass(frozen=True)
+class PlannerParams:
+    """Margins of the planner (metres). All modelling choices, tuned on ``ObstacleWalkOracle-v0`` so the
+    oracle trips on none of 200 courses (docs/reproductions/iwao.md)."""
+
+    # Free gap between the foot box and an obstacle, plus so much per metre of obstacle height: in front
+    # of the toe (the stance shin leans forward over it at push-off) and behind the heel (the landing).
+    gap_front_m: float = 0.06
+    gap_front_per_height: float = 0.8
+    gap_back_m: float = 0.04
+    gap_back_per_height: float = 0.5
+    lateral_margin_m: float = 0.04
+    sigmas: float = 2.0  # obstacle extents grown by this many estimate standard deviations
+    clearance_margin_m: float = 0.06  # toe clearance above the highest obstacle under the swing
+    tall_m: float = 0.15  # over an obstacle taller than this ...
+    max_stride_over_tall_m: float = 0.85  # ... no step longer than this
+    max_step_over_m: float = 0.85  # a keep-out zone longer than this is walked around
+    corridor_margin_m: float = 0.08  # the feet pass this far beside an obstacle walked around
+    look_ahead_m: float = 3.5  # obstacles this far ahead of the last foothold shape the corridor
+    w_length: float = 1.0
+    w_corridor: float = 2.0
+    w_lateral: float = 0.3
+
+
+class FootstepPlanner:
+    def __init__(self, gait: GaitParams | None = None, params: PlannerParams | None = None) -> None:
+        self.g = gait or GaitParams()
+        self.p = params or PlannerParams()
+        g = self.g
+        self.lengths = np.arange(0.30, g.step_range_m[1] + 1e-9, 0.05)
+        self.laterals = np.arange(g.lateral_range_m[0], g.lateral_range_m[1] + 1e-9, 0.05)
+        self.lengths2 = np.arange(0.35, g.step_range_m[1] + 1e-9, 0.1)
+        self.laterals2 = np.arange(-0.3, 0.3 + 1e-9, 0.1)
+
+    def _next_v(self, v_prev, lateral, side: int):
+        """Lateral position of a foothold of ``side`` (0 left) from the previous one (the gait's rule)."""
+        sign = 1.0 if side == 0 else -1.0
+        return v_prev + sign * np.maximum(self.g.step_width_m + sign * lateral, self.g.min_step_width_m)
+
+    def _zones(self, obstacles):
+        """(x0, x1, y0, y1, height) of every keep-out zone as arrays (before the foot box is added)."""
+        p = self.p
+        arr = np.array([(o.x0 - p.sigmas * o.sx, o.x1 + p.sigmas * o.sx, o.y0 - p.sigmas * o.sy - p.lateral_margin_m,
+                         o.y1 + p.sigmas * o.sy + p.lateral_margin_m, o.height + p.sigmas * o.sz)
+                        for o in obstacles], dtype=float).reshape(-1, 5)
+        front = p.gap_front_m + p.gap_front_per_height * arr[:, 4]  # obstacle ahead of the foot
+        back = p.gap_back_m + p.gap_back_per_height * arr[:, 4]  # obstacle behind the foot
+        return arr, (front, back)
+
+    def _clear(self, u, v, arr, gap):
+        """Boolean array: foothold (u, v) (any broadcastable shape) keeps out of every zone."""
+        if len(arr) == 0:
+            return np.ones(np.broadcast(u, v).shape, dtype=bool)
+        u = u[..., None]
+        v = v[..., None]
+        front, back = gap
+        x_hit = (u + TOE_M + front > arr[:, 0]) & (u - HEEL_M - back < arr[:, 1])
+        y_hit = (v + HALF_WIDTH_M > arr[:, 2]) & (v - HALF_WIDTH_M < arr[:, 3])
+        return ~np.any(x_hit & y_hit, axis=-1)
+
+    def _stride_ok(self, u_prev, u, length, arr):
+        """No long stride over a tall obstacle (the stance leg's knee reaches over it at push-off)."""
+        p = self.p
+        if len(arr) == 0:
+            return np.ones(np.broadcast(u_prev, u, length).shape, dtype=bool)
+        tall = arr[:, 4] > p.tall_m
+        over = tall & (arr[:, 0] > np.asarray(u_prev)[..., None]) & (arr[:, 1] < np.asarray(u)[..., None])
+        return ~(np.any(over, axis=-1) & (length > p.max_stride_over_tall_m))
+
+    def corridor(self, u_last: float, y_now: float, obstacles, arr, gap) -> float:
+        """The pelvis's lateral target: 0 (the path's centre line) unless an obstacle ahead is too long
+        to step over; then beside it, on the side nearer the pelvis's lateral position ``y_now``."""
+        p = self.p
+        for o, zone, gf, gb in zip(obstacles, arr, gap[0], gap[1]):
+            if zone[1] < u_last - 0.3 or zone[0] > u_last + p.look_ahead_m:
+                continue
+            if (zone[1] - zone[0]) + TOE_M + HEEL_M + gf + gb <= p.max_step_over_m:
+                continue
+            half = HALF_WIDTH_M + 0.5 * self.g.step_width_m + p.corridor_margin_m
+            left, right = zone[3] + half, zone[2] - half
+            if right < 0.0 < left:  # the centre line runs into it: pass on the nearer side
+                return float(left if abs(left - y_now) < abs(right - y_now) else right)
+        return 0.0
+
+    def plan(self, footholds, obstacles) -> tuple[float, float, float]:
+        """(length, lateral, clearance) of the next footstep. ``footholds``: the last three latched ones
+        as (u, v, side) in the path frame, oldest first (the new foothold's foot swings from the oldest);
+        ``obstacles``: :class:`~.perception.ObstacleEstimate` list."""
+        g, p = self.g, self.p
+        (u_a, v_a, _), (u_b, v_b, side_b) = footholds[-2], footholds[-1]
+        u_from, v_from = u_a, v_a  # the new foothold's foot swings from the one before the last
+        side = 1 - int(side_b)
+        arr, gap = self._zones(obstacles)
+        y_goal = self.corridor(u_b, 0.5 * (v_a + v_b), obstacles, arr, gap)
+        L, A = np.meshgrid(self.lengths, self.laterals, indexing="ij")
+        U = u_b + L
+        V = self._next_v(v_b, A, side)
+        ok = self._clear(U, V, arr, gap) & self._stride_ok(u_b, U, L, arr)
+        # One step of look-ahead: the other foot must find a clear foothold after this one.
+        L2, A2 = np.meshgrid(self.lengths2, self.laterals2, indexing="ij")
+        U2 = U[..., None, None] + L2
+        V2 = self._next_v(V[..., None, None], A2, 1 - side)
+        ok2 = self._clear(U2, V2, arr, gap) & self._stride_ok(U[..., None, None], U2, L2, arr)
+        cost2 = np.where(ok2, g.nominal_step_m - L2, np.inf)
+        cost2 = np.abs(cost2) * p.w_length + p.w_corridor * np.abs(0.5 * (V[..., None, None] + V2) - y_goal)
+        best2 = cost2.reshape(*U.shape, -1).min(axis=-1)
+        cost = (p.w_length * np.abs(L - g.nominal_step_m) + p.w_corridor * np.abs(0.5 * (V + v_b) - y_goal)
+                + p.w_lateral * np.abs(A) + best2)
+        cost = np.where(ok & np.isfinite(best2), cost, np.inf)
+        if not np.isfinite(cost).any():  # nothing is clear: the footholds that are clear now, else nominal
+            cost = np.where(ok, p.w_length * np.abs(L - g.nominal_step_m), np.inf)
+            if not np.isfinite(cost).any():
+                cost = np.abs(L - g.nominal_step_m) + np.abs(A)
+        i, j = np.unravel_index(int(np.argmin(cost)), cost.shape)
+        length, lateral = float(L[i, j]), float(A[i, j])
+        u_to, v_to = float(U[i, j]), float(V[i, j])
+        return length, lateral, self.clearance(u_from, v_from, u_to, v_to, arr)
+
+    def clearance(self, u0: float, v0: float, u1: float, v1: float, arr) -> float:
+        """Toe clearance of a swing from (u0, v0) to (u1, v1): the highest zone under it plus a margin."""
+        g, p = self.g, self.p
+        lo, hi = min(v0, v1) - HALF_WIDTH_M, max(v0, v1) + HALF_WIDTH_M
+        c = g.nominal_clearance_m
+        for x0, x1, y0, y1, h in arr:
+            if x1 > u0 - HEEL_M and x0 < u1 + TOE_M and y1 > lo and y0 < hi:
+                c = max(c, h + p.clearance_margin_m)
+        return float(min(c, g.clearance_range_m[1]))

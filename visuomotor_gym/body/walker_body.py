@@ -1,0 +1,120 @@
+"""The walker as a :class:`~visuomotor_gym.core.parts.Body`: the footstep action block, proprioception
+and the pelvis frame over the scripted gait of :mod:`visuomotor_gym.body.walker`.
+
+Action block ``footstep`` (3 values in [-1, 1], mapped linearly onto the gait's ranges of
+:class:`~visuomotor_gym.body.walker.GaitParams`): step length (0.25-0.95 m), lateral offset from the
+nominal step width (-0.3-0.3 m, + = left) and toe clearance (0.02-0.45 m). The command is handed to
+the gait every control step and *read at each mid-stance* for the next step of the foot in stance
+(:meth:`WalkerGait.set_next_footstep`); an action of 0 asks for a 0.60 m step, straight, with 0.235 m
+clearance (the middle of each range; modelling choice: linear maps, as the other bodies' actions).
+
+Observations are expressed in the pelvis frame (:class:`~visuomotor_gym.core.frames.RootFrame`:
+origin at the pelvis, x along its heading, z up).
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+
+from visuomotor_gym.body import walker_names as wn
+from visuomotor_gym.body.walker import GaitParams, WalkerGait
+from visuomotor_gym.core.frames import RootFrame
+from visuomotor_gym.core.observation import Block
+
+N_FOOTHOLDS_OBSERVED = 3  # the last three latched footholds (modelling choice: the landed one and the two planned)
+
+WALKER_BLOCKS = (
+    Block("gait_phase", 3, "0..1, 0..1, s",
+          "step phase (0 at a heel strike), stride phase (0 at a left heel strike), time until the next "
+          "mid-stance, when the footstep action is read"),
+    Block("pelvis", 4, "m, m/s",
+          "pelvis height above the floor; pelvis velocity (forward, left, up) in the pelvis frame"),
+    Block("feet_pos", 6, "m", "left and right sole centres, pelvis frame"),
+    Block("footholds", 3 * N_FOOTHOLDS_OBSERVED, "m, m, 0/1",
+          "the last three latched footholds, oldest first: (x, y) in the pelvis frame and the foot "
+          "(0 left, 1 right); the newest is where the next footstep's length and offset count from"),
+    Block("leg_qpos", 10, "rad", "left then right leg joints: hip roll, hip pitch, knee, ankle pitch, ankle roll"),
+)
+
+
+class WalkerBody:
+    """Footstep actions, proprioception and events of the walker (``envs_assets/walker.xml``)."""
+
+    observation_blocks = WALKER_BLOCKS
+    trace_step_fields = ("pelvis_pos", "feet_pos")
+    action_structure = {"footstep": 3}
+    n_action = 3
+
+    def __init__(self, model: mujoco.MjModel, params: GaitParams | None = None) -> None:
+        self.model = model
+        self.gait = WalkerGait(model, params)
+        self.p = self.gait.p
+        self.frame = RootFrame(self.gait.pelvis_body)
+        (l0, l1), (a0, a1), (c0, c1) = self.p.step_range_m, self.p.lateral_range_m, self.p.clearance_range_m
+        self._maps = ((0.5 * (l0 + l1), 0.5 * (l1 - l0)), (0.5 * (a0 + a1), 0.5 * (a1 - a0)),
+                      (0.5 * (c0 + c1), 0.5 * (c1 - c0)))
+        leg = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, n) for n in wn.WALKER_LEG_JOINTS[0] + wn.WALKER_LEG_JOINTS[1]]
+        self._leg_qpos = [int(model.jnt_qposadr[j]) for j in leg]
+        self._root_dof = [int(model.jnt_dofadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, n)])
+                          for n in wn.WALKER_ROOT_JOINTS[:3]]
+        self.start_xy = (0.0, 0.0)
+        self.start_yaw = 0.0
+
+    def footstep_from_action(self, a0: float, a1: float, a2: float) -> tuple[float, float, float]:
+        """(length, lateral, clearance) in metres for a footstep action in [-1, 1]^3."""
+        (lc, lh), (ac, ah), (cc, ch) = self._maps
+        return lc + a0 * lh, ac + a1 * ah, cc + a2 * ch
+
+    @staticmethod
+    def action_from_footstep(length: float, lateral: float, clearance: float, p: GaitParams | None = None):
+        """The inverse of :meth:`footstep_from_action` (for agents), clipped to [-1, 1]."""
+        p = p or GaitParams()
+        out = []
+        for value, (lo, hi) in ((length, p.step_range_m), (lateral, p.lateral_range_m),
+                                (clearance, p.clearance_range_m)):
+            out.append(min(max((2.0 * value - lo - hi) / (hi - lo), -1.0), 1.0))
+        return out
+
+    # --- episode ------------------------------------------------------------------------------
+    def reset_pose(self, data: mujoco.MjData) -> None:
+        """Walking at the nominal speed, left heel striking at the path's start."""
+        x, y = self.start_xy
+        self.gait.reset(self.model, data, x, y, self.start_yaw)
+
+    def start(self, data: mujoco.MjData) -> None:
+        self.frame.update(data)
+
+    # --- control ------------------------------------------------------------------------------
+    def command(self, data: mujoco.MjData, a: np.ndarray, al: list, dt: float) -> None:
+        self.gait.set_next_footstep(*self.footstep_from_action(al[0], al[1], al[2]))
+        self.gait.advance(data, dt)
+
+    # --- state --------------------------------------------------------------------------------
+    def observe(self, values: list, data: mujoco.MjData) -> None:
+        """Append the :data:`WALKER_BLOCKS` (``frame`` must be current: the env updates it before the
+        observation, since it moves with the pelvis)."""
+        d, g, f = data, self.gait, self.frame
+        latch = g.next_latch_time - g.time
+        values += (g.step_phase(), g.stride_phase(), latch)
+        qv = d.qvel
+        vx, vy, vz = (float(qv[i]) for i in self._root_dof)
+        c, s = f._cos, f._sin
+        values += (f.origin_list[2], c * vx + s * vy, -s * vx + c * vy, vz)
+        for x, y, z in d.site_xpos[g.sole_sites].tolist():
+            values += f.to_local(x, y, z)
+        n = g.next_footstep_index
+        for j in range(n - N_FOOTHOLDS_OBSERVED, n):
+            x, y = g.foothold_world(j)
+            lx, ly, _ = f.to_local(x, y, 0.0)
+            values += (lx, ly, float(g.side_of(j)))
+        values += d.qpos[self._leg_qpos].tolist()
+
+    def info(self, data: mujoco.MjData) -> dict:
+        return {
+            "pelvis_pos": data.xpos[self.gait.pelvis_body].copy(),
+            "feet_pos": data.site_xpos[self.gait.sole_sites].copy(),
+            "step_phase": self.gait.step_phase(),
+            "stride_phase": self.gait.stride_phase(),
+        }
+

@@ -1,0 +1,271 @@
+"""ShelfReach: reach an object on one of 30 shelf targets while seeing it only through a foveated eye.
+
+``ShelfReachEnv`` composes the embodiment core (:mod:`visuomotor_gym.core`), the seated body in its
+reaching form (:mod:`visuomotor_gym.body.reach_body`) and the shelf-reach task
+(:mod:`visuomotor_gym.tasks.reach`); this module holds its public signature, argument checks and
+documentation.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict
+from typing import Any
+
+from visuomotor_gym.body import names, reach_names
+from visuomotor_gym.body.reach_body import (
+    BEZIER_OFFSET_RANGE,
+    HAND_ACTIONS,
+    REACH_DURATION_RANGE_S,
+    REACH_PROGRESS_BLOCK,
+    ReachSeatedBody,
+)
+from visuomotor_gym.body.seated import CONTROL_MODES, SEATED_BLOCKS
+from visuomotor_gym.control.hand import HandControlParams
+from visuomotor_gym.core import args
+from visuomotor_gym.core.env import OBS_MODES, VisuomotorEnv
+from visuomotor_gym.core.eye import EYE_BLOCKS, Eye
+from visuomotor_gym.core.head import HEAD_BLOCKS, Head
+from visuomotor_gym.core.observation import ObservationLayout
+from visuomotor_gym.core.retina import VISION_MODES, Retina
+from visuomotor_gym.oculomotor.plant import DEG, OculomotorParams
+from visuomotor_gym.tasks.reach import (
+    OBJECT_PERCEPT_BLOCKS,
+    REWARD_TERMS,
+    SHAPED_WEIGHTS,
+    SPARSE_WEIGHTS,
+    TIME_BLOCK,
+    ReachTask,
+)
+from visuomotor_gym.vision.foveation import VisionParams
+
+__all__ = ["ShelfReachEnv", "reach_observation"]
+
+REWARD_MODES = ("sparse", "shaped")
+RENDER_CAMERAS = ("both", "scene", "eye", "over_shoulder", "top")
+MAX_VISION_NOISE_SCALE = 1000.0  # as EyeCatchEnv (modelling choice)
+MAX_VISUAL_DELAY_S = 2.0  # as EyeCatchEnv (modelling choice)
+
+
+def reach_observation(hand_action: str = "target"):
+    """The observation blocks of ShelfReach, in order."""
+    extra = (REACH_PROGRESS_BLOCK,) if hand_action == "bezier" else ()
+    return OBJECT_PERCEPT_BLOCKS + EYE_BLOCKS + HEAD_BLOCKS + SEATED_BLOCKS + extra + (TIME_BLOCK,)
+
+
+class ShelfReachEnv(VisuomotorEnv):
+    """
+    ## Description
+
+    The seated upper body of the catch family (3-DOF torso, 7-DOF right arm, 2-DOF neck, cyclopean
+    eye) must reach, with its right hand, an object standing on one of **30 shelf targets: three
+    towers (in front, 45 deg to the right, 90 deg to the right) x five heights x two depths**, the
+    layout of Faraway, Reed & Wang (2007, seed 002), whose Bézier model of human hand paths is the
+    realism reference of this family (``visuomotor_gym.handpath``). The object is seen **only through
+    the eye**: its position reaches the agent as samples of the foveated noise model (Eyecatch Eq. 1-3;
+    depth noise 5 % of the distance at the fovea, growing with eccentricity), nothing outside the
+    +-60 deg field of view or during a saccade. The gaze starts on the front tower, so an accurate
+    reach needs a saccade (and for the right-hand tower a head turn) to the object first.
+
+    Physics 500 Hz, control 50 Hz. The observability ladder (Oracle, FullView, foveated, Delayed,
+    PoorVision) is keyword arguments of this class (``visuomotor_gym.registration``).
+
+    ## Action Space
+
+    One ``Box(-1, 1, (9,), float32)`` with ``hand_action="target"`` (default; ``(16,)`` with
+    ``control="joint"``, ``(17,)`` with ``hand_action="bezier"``). ``env.unwrapped.action_structure``
+    gives the blocks. Finite values outside [-1, 1] are clipped; NaN, inf and wrong shapes raise.
+
+    ACTION_TABLE
+
+    ## Observation Space
+
+    ``Box(-inf, inf, (OBS_SIZE,), float32)`` (one more with ``hand_action="bezier"``), or with
+    ``obs_mode="dict"`` a ``Dict`` of the same blocks; ``env.unwrapped.observation_structure`` maps
+    names to sizes. The object blocks are what the eye perceived (true position only with
+    ``vision="oracle"``); everything else is proprioception.
+
+    OBSERVATION_TABLE
+
+    With ``hand_action="bezier"``, ``reach_progress`` (1 value: relative time of the reach in
+    progress, 0 when none) comes before ``time``.
+
+    ## Rewards
+
+    A sum of named terms, each in ``info["reward_terms"]``. ``reward="sparse"`` (default): ``reach`` =
+    +1 on the step of success. ``reward="shaped"`` adds ``panel_hit`` (-0.2 once), ``approach`` (-0.01 x
+    hand-object distance in m), ``foveation`` (+0.005 x exp(-(eccentricity/5 deg)^2) when the object is
+    seen) and ``effort`` (-0.001 x mean squared action). ``reward_weights`` overrides any weight by name.
+
+    ## Starting State
+
+    The body sits upright with the hand at its home posture, in front of the belly near the midline
+    (~(0.32, -0.05, 0.74) m: the seated analogue of seed 002's home shelf). The target is drawn
+    uniformly from the 30, with a +-1 cm jitter on its board; the gaze starts on the front tower's middle
+    level between its two depths, with a 2 deg Gaussian jitter. The same seed gives the same target on
+    every rung of the ladder. ``info`` at reset: ``target_index`` (0-29: tower-major, then level, then
+    depth), ``tower``, ``level``, ``depth``, ``object_pos``, ``hand_home``.
+
+    ## Episode End
+
+    Terminated on **success** (``info["is_success"]``, ``info["reached"]``): the object's centre within
+    ``reach_radius`` of the catch site with the fingers closed beyond ``grasp_closed_fraction`` and the
+    hand slower than ``arrival_speed_m_s``; on a **panel touch** (``info["panel_hit"]``: any contact between
+    the body and a tower's back panel, checked every physics substep); or on a physics divergence.
+    Truncated by the registered ``max_episode_steps`` (150 steps = 3 s). The boards under the objects are
+    seen but not touched (see ``envs_assets/README.md``, ShelfReach).
+
+    ## Arguments
+
+    | argument | default | meaning |
+    |---|---|---|
+    | ``render_mode`` | None | ``"rgb_array"`` or ``"human"`` |
+    | ``vision`` | ``"foveated"`` | ``"foveated"``, ``"full_view"`` or ``"oracle"`` (true object position) |
+    | ``vision_noise_scale`` | 1.0 | multiplies every vision standard deviation |
+    | ``vision_params`` | None | ``VisionParams`` or a dict of its fields |
+    | ``visual_delay_s`` | 0.0 | visual latency, a multiple of the control period |
+    | ``control`` | ``"hand"`` | ``"hand"`` (Cartesian) or ``"joint"`` |
+    | ``hand_action`` | ``"target"`` | ``"target"`` (a hand target each step) or ``"bezier"`` (reaches as cubic Bézier curves: end point, two interior control-point offsets, duration; needs ``control="hand"``) |
+    | ``obs_mode`` | ``"flat"`` | ``"flat"`` or ``"dict"`` |
+    | ``reward`` | ``"sparse"`` | ``"sparse"`` or ``"shaped"`` |
+    | ``reward_weights`` | None | dict overriding term weights |
+    | ``oculomotor_params`` | None | ``OculomotorParams`` or dict |
+    | ``hand_params`` | None | ``HandControlParams`` or dict (2 m/s cap, DLS damping) |
+    | ``control_dt`` | 0.02 | control period (s); a whole multiple of the 2 ms physics step |
+    | ``reach_radius`` | 0.06 | success radius (m) around the catch site (the catch family's catch volume) |
+    | ``grasp_closed_fraction`` | 0.6 | finger closure above which the hand counts as closed |
+    | ``arrival_speed_m_s`` | 0.5 | the hand must be slower than this (m/s) to count as arrived (modelling choice: arriving, not sweeping past) |
+    | ``gaze_action_range_deg`` | 60.0 | gaze change at action +-1 |
+    | ``render_camera`` | ``"both"`` | ``"both"`` (scene beside eye view), ``"scene"``, ``"eye"``, ``"over_shoulder"``, ``"top"`` |
+    | ``width``, ``height`` | 480, 360 | size of each rendered camera image |
+    | ``record_plant`` | False | keep the 500 Hz gaze trace |
+
+    ## Version History
+
+    * v0: initial release.
+    """
+
+    render_cameras = {
+        "both": (reach_names.SCENE_CAMERA, names.EYE_CAMERA),
+        "scene": (reach_names.SCENE_CAMERA,),
+        "eye": (names.EYE_CAMERA,),
+        "over_shoulder": (reach_names.OVER_SHOULDER_CAMERA,),
+        "top": (reach_names.TOP_CAMERA,),
+    }
+    eye_camera = names.EYE_CAMERA
+
+    def __init__(
+        self,
+        render_mode: str | None = None,
+        *,
+        vision: str = "foveated",
+        vision_noise_scale: float = 1.0,
+        vision_params: VisionParams | dict | None = None,
+        visual_delay_s: float = 0.0,
+        control: str = "hand",
+        hand_action: str = "target",
+        obs_mode: str = "flat",
+        reward: str = "sparse",
+        reward_weights: dict[str, float] | None = None,
+        oculomotor_params: OculomotorParams | dict | None = None,
+        hand_params: HandControlParams | dict | None = None,
+        control_dt: float = 0.02,
+        reach_radius: float = 0.06,
+        grasp_closed_fraction: float = 0.6,
+        arrival_speed_m_s: float = 0.5,
+        gaze_action_range_deg: float = 60.0,
+        render_camera: str = "both",
+        width: int = 480,
+        height: int = 360,
+        record_plant: bool = False,
+        **unknown: Any,
+    ):
+        self._reject_unknown(unknown)
+        if render_mode is not None:
+            args.choice(render_mode, self.metadata["render_modes"], "render_mode")
+        self.render_mode = render_mode
+        self.vision = args.choice(vision, VISION_MODES, "vision")
+        self.control = args.choice(control, CONTROL_MODES, "control")
+        self.hand_action = args.choice(hand_action, HAND_ACTIONS, "hand_action")
+        if self.hand_action == "bezier" and self.control != "hand":
+            raise ValueError("hand_action='bezier' needs control='hand'")
+        args.choice(obs_mode, OBS_MODES, "obs_mode")
+        self.render_camera = args.choice(render_camera, RENDER_CAMERAS, "render_camera")
+        scale = args.real(vision_noise_scale, "vision_noise_scale", low=0.0, high=MAX_VISION_NOISE_SCALE)
+        self.vision_params = args.coerce(VisionParams, vision_params, "vision_params").scaled(scale)
+        if vision == "full_view":
+            self.vision_params = VisionParams(**{**asdict(self.vision_params), "foveated": False})
+        self.oculomotor_params = args.coerce(OculomotorParams, oculomotor_params, "oculomotor_params")
+        self.hand_params = args.coerce(HandControlParams, hand_params, "hand_params")
+        self.reach_radius = args.real(reach_radius, "reach_radius", low=0.0, high=0.5, low_open=True)
+        self.grasp_closed_fraction = args.real(grasp_closed_fraction, "grasp_closed_fraction", low=0.0, high=1.0,
+                                               low_open=True)
+        self.arrival_speed_m_s = args.real(arrival_speed_m_s, "arrival_speed_m_s", low=0.0, high=100.0, low_open=True)
+        self.gaze_action_range = args.real(gaze_action_range_deg, "gaze_action_range_deg", low=0.0, high=180.0,
+                                           low_open=True) * DEG
+        weights = dict(SPARSE_WEIGHTS if args.choice(reward, REWARD_MODES, "reward") == "sparse" else SHAPED_WEIGHTS)
+        if reward_weights is not None and not isinstance(reward_weights, dict):
+            raise TypeError(f"reward_weights must be a dict of term -> weight, got {type(reward_weights).__name__}")
+        for name, value in (reward_weights or {}).items():
+            if name not in REWARD_TERMS:
+                raise ValueError(f"reward_weights: unknown term {name!r}; known terms: {list(REWARD_TERMS)}")
+            weights[name] = args.real(value, f"reward_weights[{name!r}]")
+        self.reward_mode = reward
+        self.reward_weights = weights
+        self.record_plant = args.flag(record_plant, "record_plant")
+        control_dt = args.real(control_dt, "control_dt", low=0.0, high=1.0, low_open=True)
+        visual_delay_s = args.real(visual_delay_s, "visual_delay_s", low=0.0, high=MAX_VISUAL_DELAY_S)
+
+        self._load_physics(reach_names.SCENE, control_dt)
+        self.visual_delay_s = float(visual_delay_s)
+        self.delay_steps = args.whole_multiple(visual_delay_s, self.dt, "visual_delay_s")
+        body = ReachSeatedBody(self.model, self.control, self.hand_params, self.dt, hand_action=self.hand_action)
+        task = ReachTask(
+            self.model, body, reach_radius=self.reach_radius, grasp_closed_fraction=self.grasp_closed_fraction,
+            arrival_speed_m_s=self.arrival_speed_m_s, reward_weights=weights, dt=self.dt,
+            visual_delay_s=self.visual_delay_s,
+        )
+        self._assemble(
+            body=body,
+            eye=Eye(self.model, self.oculomotor_params, self.gaze_action_range, record=self.record_plant),
+            head=Head(self.model, self.oculomotor_params),
+            retina=Retina(self.vision, self.vision_params, self.delay_steps, self.dt),
+            task=task,
+            obs_mode=obs_mode,
+            width=width,
+            height=height,
+        )
+        self.hand = body.hand
+
+    @property
+    def target_index(self) -> int:
+        """This episode's target (0-29)."""
+        return self.task.target_index
+
+
+def _action_table() -> str:
+    from visuomotor_gym.body.seated import HAND_WORKSPACE
+
+    (x0, x1), (y0, y1), (z0, z1) = HAND_WORKSPACE.tolist()
+    lo, hi = REACH_DURATION_RANGE_S
+    rows = [
+        "| index (target) | index (joint) | index (bezier) | meaning |",
+        "|---|---|---|---|",
+        f"| 0-2 | - | 0-2 | hand target (catch-site centre; with bezier: the reach's end point), seat frame, mapped from [-1, 1] to x in [{x0}, {x1}], y in [{y0}, {y1}], z in [{z0}, {z1}] m |",
+        "| - | 0-9 | - | torso (3) and arm (7) joint setpoints, mapped onto each joint's range |",
+        f"| - | - | 3-5, 6-8 | interior control-point offsets Y1, Y2 per metre of reach, body frame (lateral right, forward, up), [-1, 1] onto [-{BEZIER_OFFSET_RANGE}, {BEZIER_OFFSET_RANGE}] (seed 002's axis parameterisation; 0 = straight) |",
+        f"| - | - | 9 | reach duration, [-1, 1] onto [{lo}, {hi}] s |",
+        "| - | - | 10 | reach start: > 0 starts a reach from the hand reference when none is in progress |",
+        "| 3 | 10 | 11 | grasp: -1 open ... 1 closed |",
+        "| 4-5 | 11-12 | 12-13 | requested gaze change (azimuth, elevation) of the current eye frame, times ``gaze_action_range_deg`` |",
+        "| 6 | 13 | 14 | fixation (vergence) distance, log-mapped onto [0.1, 20] m |",
+        "| 7-8 | 14-15 | 15-16 | head target: neck yaw in [-80, 80] deg and pitch in [-50, 40] deg |",
+    ]
+    return "\n    ".join(rows)
+
+
+if ShelfReachEnv.__doc__:
+    _layout = ObservationLayout(reach_observation())
+    ShelfReachEnv.__doc__ = (ShelfReachEnv.__doc__
+                             .replace("OBSERVATION_TABLE", "\n    ".join(_layout.markdown_table().splitlines()))
+                             .replace("ACTION_TABLE", _action_table())
+                             .replace("OBS_SIZE", str(_layout.size)))

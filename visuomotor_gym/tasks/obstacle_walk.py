@@ -1,0 +1,270 @@
+"""The obstacle-walk task (issue 12; Iwao et al., seed 003): walk a straight 15-20 m path across bars,
+boxes and flat mats seen only through the foveated eye; a leg striking an obstacle is a trip (the end),
+a foot landing on one a misstep (no success).
+
+**Course** (:func:`sample_course`, drawn first from the env's ``np_random`` so every rung of the ladder
+gets the same course for a seed): the path runs along +x from the walker's first heel strike at the
+origin to a finish line 15-20 m ahead. Obstacles follow one another along it with free gaps of
+1.6-3.0 m; each is a bar (5 cm deep, 0.8-1.2 m wide: stepped over), a box (20-40 cm deep, 40-80 cm
+wide: stepped over or around) or a flat mat (70 x 70 cm, 1 cm: Iwao's cloth, stepped around; landing on
+it is a misstep), 5-30 cm high except the mats (issue 12). Kinds, sizes and lateral offsets are uniform
+draws (modelling choice).
+
+**What the eye sees of an obstacle**: two corners of its top face, the near-left and the far-right
+(:class:`~visuomotor_gym.core.retina.PointTarget`), each sampled by the retina like any target
+(eccentricity-dependent noise, field of view, saccadic suppression, visual delay). For the axis-aligned
+boxes of v0 the two corners fix the footprint and the height. The observation holds the percepts of
+the ``K_SLOTS`` = 4 next obstacles of the course (slot ``k`` = course obstacle ``n + k``, ``n`` the
+number of obstacles the pelvis has passed by more than ``PASSED_M``): with free gaps >= 1.6 m four slots
+reach >= 6 m ahead, more than the 2 steps (~1.3 m) that walkers need to see (Matthis & Fajen 2014) and
+the 1-2 m of travel fixations (Patla & Vickers 1997). An obstacle not seen this step reads as zeros.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from visuomotor_gym.body import walker_names as wn
+from visuomotor_gym.core.observation import Block
+from visuomotor_gym.core.retina import PointTarget
+
+K_SLOTS = 4
+PASSED_M = 0.5  # an obstacle whose far edge is this far behind the pelvis leaves the slots (modelling choice)
+KINDS = ("bar", "box", "mat")
+BAR, BOX, MAT = 0, 1, 2
+REWARD_TERMS = ("finish", "trip", "misstep", "progress")
+DEFAULT_REWARD_WEIGHTS = {"finish": 1.0, "trip": -1.0, "misstep": -1.0, "progress": 0.0}
+OBSTACLE_RGBA = {BAR: (0.80, 0.25, 0.20, 1.0), BOX: (0.85, 0.55, 0.15, 1.0), MAT: (0.08, 0.08, 0.08, 1.0)}
+
+
+@dataclass(frozen=True)
+class CourseDistribution:
+    """The course sampler's ranges (metres; uniform draws). Sources in the module docstring."""
+
+    length_m: tuple[float, float] = (15.0, 20.0)  # issue 12: a 15-20 m path
+    first_m: tuple[float, float] = (3.0, 4.5)  # near edge of the first obstacle (>= 2 s of approach at 1.3 m/s)
+    gap_m: tuple[float, float] = (1.6, 3.0)  # free gap between consecutive obstacles (modelling choice)
+    finish_clear_m: float = 1.5  # no obstacle within this distance of the finish (modelling choice)
+    kind_p: tuple[float, float, float] = (0.4, 0.35, 0.25)  # bar, box, mat (modelling choice)
+    height_m: tuple[float, float] = (0.05, 0.30)  # issue 12: bars and boxes 5-30 cm high
+    bar_depth_m: float = 0.05
+    bar_width_m: tuple[float, float] = (0.8, 1.2)
+    box_depth_m: tuple[float, float] = (0.2, 0.4)
+    box_width_m: tuple[float, float] = (0.4, 0.8)
+    mat_size_m: float = 0.7  # Iwao et al.: a 70 cm square black cloth
+    mat_height_m: float = 0.01
+    offset_m: tuple[float, float] = (-0.15, 0.15)  # bars and boxes: centre beside the path's centre line
+    mat_offset_m: tuple[float, float] = (-0.3, 0.3)
+
+
+@dataclass(frozen=True)
+class Course:
+    length: float
+    obstacles: np.ndarray  # (N, 6): centre x, centre y, depth (along x), width, height, kind
+
+
+def sample_course(rng: np.random.Generator, dist: CourseDistribution, max_obstacles: int) -> Course:
+    """One course: obstacles in path order, free gaps between them, none near the finish."""
+    length = float(rng.uniform(*dist.length_m))
+    rows = []
+    near = float(rng.uniform(*dist.first_m))
+    while len(rows) < max_obstacles:
+        kind = int(rng.choice(3, p=np.asarray(dist.kind_p) / sum(dist.kind_p)))
+        if kind == BAR:
+            depth, width, height = dist.bar_depth_m, float(rng.uniform(*dist.bar_width_m)), float(rng.uniform(*dist.height_m))
+            y = float(rng.uniform(*dist.offset_m))
+        elif kind == BOX:
+            depth, width = float(rng.uniform(*dist.box_depth_m)), float(rng.uniform(*dist.box_width_m))
+            height, y = float(rng.uniform(*dist.height_m)), float(rng.uniform(*dist.offset_m))
+        else:
+            depth = width = dist.mat_size_m
+            height, y = dist.mat_height_m, float(rng.uniform(*dist.mat_offset_m))
+        if near + depth > length - dist.finish_clear_m:
+            break
+        rows.append((near + 0.5 * depth, y, depth, width, height, kind))
+        near += depth + float(rng.uniform(*dist.gap_m))
+    return Course(length, np.array(rows, dtype=float).reshape(-1, 6))
+
+
+def obstacle_blocks(k: int) -> Block:
+    return Block(f"obstacle_{k}", 9, "-, m, 0/1",
+                 f"slot {k}: course index of the obstacle ({k} after the last one passed); perceived near-left "
+                 "then far-right corner of its top face, eye frame (zeros when not seen); seen flags of the two corners")
+
+
+PERCEPT_BLOCKS = tuple(obstacle_blocks(k) for k in range(K_SLOTS))
+TRAILING_BLOCKS = (
+    Block("odometry", 3, "m, m, rad", "pelvis x, y and heading relative to the start (path integration)"),
+    Block("to_finish", 1, "m", "distance from the pelvis to the finish line along the path"),
+    Block("time", 1, "s", "time since the start"),
+)
+
+
+class ObstacleWalkTask:
+    """Course, visual targets, events, rewards and info of ObstacleWalk. ``body`` is a
+    :class:`~visuomotor_gym.body.walker_body.WalkerBody`."""
+
+    leading_blocks = PERCEPT_BLOCKS
+    trailing_blocks = TRAILING_BLOCKS
+    trace_step_fields = ("step_phase",)
+    trace_flag_fields = ("obstacle_seen",)
+
+    def __init__(self, model: mujoco.MjModel, body, *, course_distribution: CourseDistribution,
+                 reward_weights: dict, visual_delay_s: float) -> None:
+        self.model = model
+        self.body = body
+        self.gait = body.gait
+        self.pool = body.gait.pool
+        self.dist = course_distribution
+        self.reward_weights = reward_weights
+        self.visual_delay_s = visual_delay_s
+        n = len(self.pool)
+        self.all_targets = [PointTarget(f"obstacle_{i:02d}_{c}") for i in range(n) for c in ("near", "far")]
+        self.targets = self.all_targets
+        self._finish_body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, wn.WALKER_FINISH)
+        self._finish_mocap = int(model.body_mocapid[self._finish_body])
+        self.course = Course(0.0, np.zeros((0, 6)))
+        self.reset_state()
+
+    # --- episode ------------------------------------------------------------------------------
+    def reset_state(self) -> None:
+        self.success = False
+        self.tripped = False
+        self.misstepped = False
+        self.finished = False
+        self.n_passed = 0
+        self._slots_set = False
+        self._n_events = 0
+        self._prev_x = 0.0
+        self.seen = [False] * K_SLOTS
+
+    def reset_episode(self, data: mujoco.MjData, rng: np.random.Generator) -> None:
+        """Draw the course, place the obstacles and the finish line (the walker is already at the start)."""
+        m, d = self.model, data
+        self.course = course = sample_course(rng, self.dist, len(self.pool))
+        self.pool.park_all(m, d)
+        for t in self.all_targets:
+            t.hidden = True
+        self.targets = self.all_targets[: 2 * len(course.obstacles)]  # what the retina samples
+        for i, (x, y, depth, width, height, kind) in enumerate(course.obstacles.tolist()):
+            self.pool.place(m, d, i, x, y, depth, width, height, rgba=OBSTACLE_RGBA[int(kind)])
+            self.targets[2 * i].place(x - 0.5 * depth, y + 0.5 * width, height)
+            self.targets[2 * i + 1].place(x + 0.5 * depth, y - 0.5 * width, height)
+        d.mocap_pos[self._finish_mocap] = (course.length, 0.0, 0.0)
+        self._prev_x = float(d.qpos[0])
+
+    def initial_gaze(self) -> tuple[np.ndarray, tuple[float, float]]:
+        """Gaze starts level, straight ahead along the path (at the finish line, at eye height)."""
+        return np.array([self.course.length, 0.0, 1.6]), (0.0, 0.0)
+
+    def initial_fixation(self, distance: float) -> float:
+        return distance
+
+    def reset_info(self) -> dict:
+        return {"course_length": self.course.length, "obstacles": self.course.obstacles.copy()}
+
+    # --- what the evaluator records ----------------------------------------------------------
+    def trace_episode_fields(self) -> dict:
+        return {"course_length": float(self.course.length), "obstacles": self.course.obstacles.copy()}
+
+    @staticmethod
+    def trace_final_fields(info: dict) -> dict:
+        return {"tripped": bool(info["tripped"]), "misstepped": bool(info["misstepped"]),
+                "finished": bool(info["finished"])}
+
+    # --- physics ------------------------------------------------------------------------------
+    def before_physics(self, data: mujoco.MjData) -> None:
+        return None
+
+    def needs_substep_checks(self, data: mujoco.MjData) -> bool:
+        """Contact checks every substep only while an obstacle is within reach of a leg."""
+        return self.pool.near(float(data.qpos[0]), float(data.qpos[1]), self.gait.CONTACT_RADIUS_M)
+
+    def check_substep(self, data: mujoco.MjData) -> bool:
+        """Classify leg-obstacle contacts (:meth:`WalkerGait.check_contacts`): True on a new event."""
+        return self.gait.check_contacts(data)
+
+    # --- observation --------------------------------------------------------------------------
+    def update_slots(self, data: mujoco.MjData) -> None:
+        """Advance the first slot past obstacles the pelvis has left behind (before the retina samples)."""
+        obs = self.course.obstacles
+        x = float(data.qpos[0])
+        n0 = self.n_passed
+        while self.n_passed < len(obs) and obs[self.n_passed, 0] + 0.5 * obs[self.n_passed, 2] < x - PASSED_M:
+            self.n_passed += 1
+        if n0 != self.n_passed or not self._slots_set:
+            # Only the slots' obstacles are sampled (the others would not reach the observation; those
+            # passed lie behind the walker, beyond any reach of the eye and the head).
+            for i in range(len(obs)):
+                hidden = not (self.n_passed <= i < self.n_passed + K_SLOTS)
+                self.targets[2 * i].hidden = self.targets[2 * i + 1].hidden = hidden
+            self._slots_set = True
+
+    def observe_leading(self, values: list, samples: list) -> None:
+        """The :data:`PERCEPT_BLOCKS`: per slot, id, two corners (eye frame) and their seen flags."""
+        n_targets = len(samples) // 2
+        for k in range(K_SLOTS):
+            i = self.n_passed + k
+            values.append(float(i))
+            if i < n_targets:
+                (p0, _, v0), (p1, _, v1) = samples[2 * i], samples[2 * i + 1]
+            else:
+                p0 = p1 = [0.0, 0.0, 0.0]
+                v0 = v1 = False
+            values += p0
+            values += p1
+            values += (1.0 if v0 else 0.0, 1.0 if v1 else 0.0)
+            self.seen[k] = v0 or v1
+
+    def observe_trailing(self, values: list, samples: list, data: mujoco.MjData) -> None:
+        d = data
+        sx, sy = self.body.start_xy
+        x, y = float(d.qpos[0]), float(d.qpos[1])
+        values += (x - sx, y - sy, float(d.qpos[3]) - self.body.start_yaw,
+                   self.course.length - (x - sx), float(d.time))
+
+    # --- outcome ------------------------------------------------------------------------------
+    def evaluate(self, data: mujoco.MjData, fired: bool, a: np.ndarray, eye) -> tuple[float, dict, bool, dict]:
+        d = data
+        g = self.gait
+        new_trip = g.tripped and not self.tripped
+        new_missteps = sum(e.kind == "misstep" for e in g.events[self._n_events:])
+        self._n_events = len(g.events)
+        self.tripped = g.tripped
+        self.misstepped = g.misstepped
+        x = float(d.qpos[0])
+        arrived = not self.finished and x - self.body.start_xy[0] >= self.course.length
+        self.finished = self.finished or arrived
+        self.success = self.finished and not self.tripped and not self.misstepped
+        values = {"finish": 1.0 if (arrived and self.success) else 0.0, "trip": 1.0 if new_trip else 0.0,
+                  "misstep": float(new_missteps), "progress": x - self._prev_x}
+        self._prev_x = x
+        terms = {k: w * values[k] for k, w in self.reward_weights.items() if w != 0.0}
+        terminated = self.tripped or self.finished
+        return float(sum(terms.values())), terms, terminated, self.info(d)
+
+    def info(self, data: mujoco.MjData, *, diverged: bool = False) -> dict:
+        """Step information (the course is true state: for scoring only, never for a policy)."""
+        return {
+            "tripped": self.tripped,
+            "misstepped": self.misstepped,
+            "finished": self.finished,
+            "events": len(self.gait.events),
+            "obstacles_passed": self.n_passed,
+            "obstacle_seen": False if diverged else any(self.seen),
+            "step_phase": self.gait.step_phase(),
+        }
+
+
+def top_corners(obstacles: np.ndarray) -> np.ndarray:
+    """(N, 2, 3) near-left and far-right top corners of course obstacles (the points the eye sees)."""
+    x, y, depth, width, height = (obstacles[:, i] for i in range(5))
+    near = np.stack([x - 0.5 * depth, y + 0.5 * width, height], axis=1)
+    far = np.stack([x + 0.5 * depth, y - 0.5 * width, height], axis=1)
+    return np.stack([near, far], axis=1)
+
+
+__all__ = ["Course", "CourseDistribution", "K_SLOTS", "KINDS", "ObstacleWalkTask", "sample_course", "top_corners"]

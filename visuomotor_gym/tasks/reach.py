@@ -1,0 +1,242 @@
+"""The shelf-reach task (seed 002, Faraway, Reed & Wang 2007): an object stands on one of 30 shelf
+targets (3 towers x 5 heights x 2 depths); the seated body must reach it with the right hand, seeing
+it only through the eye.
+
+The object is a :class:`~visuomotor_gym.core.retina.VisualTarget`: its position reaches the agent only
+as the retina's samples (foveated noise, field of view, saccadic suppression, delay), so an accurate
+reach needs it fixated (the depth noise is 5 % of the distance at the fovea and grows ~1 + theta/2 deg
+away from it). Success: the object's centre inside the catch volume (``reach_radius``, 6 cm, as in the
+catch family) with the fingers closed and the hand nearly still (``arrival_speed_m_s``), before the
+time limit, without touching a tower's back panel (MuJoCo contact). Episodes end on success, on a
+touch, or by the registered step limit.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from visuomotor_gym.body import reach_names
+from visuomotor_gym.body.reach_body import home_hand_position
+from visuomotor_gym.core.observation import Block
+from visuomotor_gym.core.retina import VisualTarget
+from visuomotor_gym.vision import foveation
+
+DEG = math.pi / 180.0
+
+
+@dataclass(frozen=True)
+class ShelfLayout:
+    """The 30 targets, world frame (x forward, y left, z up; the seat axis is x = y = 0). ``envs_assets/reach.xml``
+    is built from these numbers (a test compares them)."""
+
+    # Seed 002 Sec. 2: towers "in front of the subject, to the right-hand side and 45 deg to the right"
+    # (sourced); azimuth measured about the body's vertical (seat) axis, negative = to the right.
+    tower_azimuth_deg: tuple[float, float, float] = (0.0, -45.0, -90.0)
+    # Horizontal distance of the object centres from the seat axis, near and far (modelling choice: the
+    # seated arm reaches both with the torso's help; the median reach, 0.53 m, is near seed 002's 56.7 cm).
+    depth_m: tuple[float, float] = (0.50, 0.65)
+    # Object-centre heights: 5 levels from seat height (0.55 m) to 0.18 m above the seated eye (1.13 m),
+    # the seated analogue of seed 002's "five levels ranging from eye to ankle level" (modelling choice).
+    level0_z_m: float = 0.55
+    level_step_m: float = 0.19
+    # The object: a vertical cylinder (seed 002's subjects moved "a vertical cylinder"); size modelling choice.
+    object_radius_m: float = 0.03
+    object_half_height_m: float = 0.06
+    # Back panel of each tower, this far behind the far depth (modelling choice: ~7 cm of room for the palm,
+    # which extends 5 cm past the catch site along the forearm).
+    panel_gap_m: float = 0.12
+
+    def targets(self) -> np.ndarray:
+        """(30, 3) object-centre positions, in the order tower, level, depth (near first)."""
+        out = []
+        for az in self.tower_azimuth_deg:
+            c, s = math.cos(az * DEG), math.sin(az * DEG)
+            for k in range(reach_names.LEVELS):
+                for r in self.depth_m:
+                    out.append((r * c, r * s, self.level0_z_m + k * self.level_step_m))
+        return np.array(out)
+
+    @staticmethod
+    def describe(index: int) -> tuple[int, int, int]:
+        """(tower, level, depth) of a target index."""
+        tower, rest = divmod(int(index), reach_names.LEVELS * 2)
+        level, depth = divmod(rest, 2)
+        return tower, level, depth
+
+
+SHELF_LAYOUT = ShelfLayout()
+N_TARGETS = 30
+TARGET_JITTER_M = 0.01  # uniform +-1 cm in x and y on the board (modelling choice: "small jitter")
+GAZE_JITTER_DEG = 2.0  # Gaussian jitter of the initial gaze (as the catch family's start, modelling choice)
+
+OBJECT_PERCEPT_BLOCKS = (
+    Block("object_pos", 3, "m", "perceived object position, eye frame at the sample (zeros when not visible)"),
+    Block("object_visible", 1, "0/1", "1 if this step produced a visual sample of the object"),
+    Block("object_age", 1, "s", "age of the visual sample (the visual latency; 0 without delay)"),
+)
+TIME_BLOCK = Block("time", 1, "s", "time since the episode started")
+REWARD_TERMS = ("reach", "panel_hit", "approach", "foveation", "effort")
+SPARSE_WEIGHTS = {"reach": 1.0}
+SHAPED_WEIGHTS = {"reach": 1.0, "panel_hit": -0.2, "approach": -0.01, "foveation": 0.005, "effort": -0.001}
+FOVEATION_WIDTH_DEG = 5.0  # as the catch family's shaping term
+
+
+class ShelfObject(VisualTarget):
+    """The object on its shelf: a mocap body (still; velocity zero)."""
+
+    name = "object"
+
+    def __init__(self, model: mujoco.MjModel) -> None:
+        body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, reach_names.OBJECT)
+        self.mocap = int(model.body_mocapid[body])
+        self._zero = np.zeros(3)
+
+    def state(self, data: mujoco.MjData) -> tuple[np.ndarray, np.ndarray]:
+        return data.mocap_pos[self.mocap], self._zero
+
+    def place(self, data: mujoco.MjData, position) -> None:
+        data.mocap_pos[self.mocap] = position
+
+
+class ReachTask:
+    """Targets, contacts, success and rewards of the shelf-reach task (``body``: a reach body)."""
+
+    trace_step_fields = ()
+    trace_flag_fields = ("object_visible",)
+
+    def __init__(self, model: mujoco.MjModel, body, *, reach_radius: float, grasp_closed_fraction: float,
+                 arrival_speed_m_s: float, reward_weights: dict, dt: float, visual_delay_s: float) -> None:
+        self.model = model
+        self.body = body
+        self.reach_radius = reach_radius
+        self.grasp_closed_fraction = grasp_closed_fraction
+        self.arrival_speed = arrival_speed_m_s
+        self.reward_weights = reward_weights
+        self.dt = dt
+        self.visual_delay_s = visual_delay_s
+        self.object = ShelfObject(model)
+        self.targets = [self.object]
+        self.positions = SHELF_LAYOUT.targets()
+        self.home = home_hand_position(model)
+        self._panels = {mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, n) for n in reach_names.PANELS}
+        # The initial gaze point: the front tower's middle level, between its depths (modelling choice).
+        self._gaze_point = np.array([np.mean(SHELF_LAYOUT.depth_m), 0.0, SHELF_LAYOUT.level0_z_m + 2 * SHELF_LAYOUT.level_step_m])
+        self.leading_blocks = OBJECT_PERCEPT_BLOCKS
+        self.trailing_blocks = (TIME_BLOCK,)
+        self.reset_state()
+
+    # --- episode ------------------------------------------------------------------------------
+    def reset_state(self) -> None:
+        self.success = False
+        self.hit = False
+        self.hit_geoms: tuple[str, str] | None = None
+        self.visible = False
+        self._hand_prev = None
+
+    def reset_episode(self, data: mujoco.MjData, rng: np.random.Generator) -> None:
+        """Draw the target (index, jitter) and the initial gaze jitter, in that order, from ``rng``."""
+        self.target_index = int(rng.integers(N_TARGETS))
+        jitter = rng.uniform(-TARGET_JITTER_M, TARGET_JITTER_M, 2)
+        self.gaze_offset = rng.normal(0.0, GAZE_JITTER_DEG * DEG, 2)
+        pos = self.positions[self.target_index].copy()
+        pos[:2] += jitter
+        self.object_pos = pos
+        self.object.place(data, pos)
+
+    def initial_gaze(self) -> tuple[np.ndarray, tuple[float, float]]:
+        return self._gaze_point, (float(self.gaze_offset[0]), float(self.gaze_offset[1]))
+
+    def initial_fixation(self, distance: float) -> float:
+        return distance
+
+    def reset_info(self) -> dict:
+        tower, level, depth = ShelfLayout.describe(self.target_index)
+        return {"target_index": self.target_index, "tower": tower, "level": level, "depth": depth,
+                "object_pos": self.object_pos.copy(), "hand_home": self.home.copy()}
+
+    # --- what the evaluator records ----------------------------------------------------------
+    def trace_episode_fields(self) -> dict:
+        return {"object_pos": self.object_pos.copy(), "target_index": self.target_index,
+                "hand_home": self.home.copy()}
+
+    @staticmethod
+    def trace_final_fields(info: dict) -> dict:
+        return {"panel_hit": bool(info["panel_hit"])}
+
+    # --- physics ------------------------------------------------------------------------------
+    def before_physics(self, data: mujoco.MjData) -> None:
+        self._hand_prev = self.body.hand_pos(data).copy()
+
+    def needs_substep_checks(self, data: mujoco.MjData) -> bool:
+        """Touches are checked after every physics substep (a brush may last less than a control step)."""
+        return not (self.hit or self.success)
+
+    def check_substep(self, data: mujoco.MjData) -> bool:
+        """True on the first contact between the body and a back panel (the only contacts the scene has)."""
+        if self.hit:
+            return True
+        d = data
+        for i in range(d.ncon):
+            c = d.contact[i]
+            if c.geom1 in self._panels or c.geom2 in self._panels:
+                self.hit = True
+                m = self.model
+                self.hit_geoms = (mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_GEOM, c.geom1),
+                                  mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_GEOM, c.geom2))
+                return True
+        return False
+
+    # --- observation --------------------------------------------------------------------------
+    def observe_leading(self, values: list, samples: list) -> None:
+        pos, _vel, visible = samples[0]
+        self.visible = visible
+        values += pos
+        values += (1.0 if visible else 0.0, self.visual_delay_s)
+
+    def observe_trailing(self, values: list, samples: list, data: mujoco.MjData) -> None:
+        values.append(data.time)
+
+    # --- outcome ------------------------------------------------------------------------------
+    def _reached(self, d: mujoco.MjData) -> bool:
+        hand = self.body.hand_pos(d)
+        if float(np.linalg.norm(hand - self.object_pos)) > self.reach_radius:
+            return False
+        if not self.body.grasp_closed(d, self.grasp_closed_fraction):
+            return False
+        prev = hand if self._hand_prev is None else self._hand_prev
+        return float(np.linalg.norm(hand - prev)) / self.dt <= self.arrival_speed
+
+    def evaluate(self, data: mujoco.MjData, fired: bool, a: np.ndarray, eye) -> tuple[float, dict, bool, dict]:
+        d = data
+        hit = bool(fired or self.hit)
+        reached = (not hit) and self._reached(d)
+        self.success = reached
+        w = self.reward_weights
+        terms = {}
+        if w.get("reach"):
+            terms["reach"] = w["reach"] * float(reached)
+        if w.get("panel_hit"):
+            terms["panel_hit"] = w["panel_hit"] * float(hit)
+        if w.get("approach"):
+            terms["approach"] = w["approach"] * float(np.linalg.norm(self.body.hand_pos(d) - self.object_pos))
+        if w.get("foveation"):
+            ecc = foveation.eccentricity(eye.to_eye(self.object_pos, np.zeros(3))[0]) if self.visible else None
+            terms["foveation"] = 0.0 if ecc is None else w["foveation"] * math.exp(-(ecc / (FOVEATION_WIDTH_DEG * DEG)) ** 2)
+        if w.get("effort"):
+            terms["effort"] = w["effort"] * float(a @ a) / a.size
+        reward = float(sum(terms.values()))
+        return reward, terms, reached or hit, self.info(d, reached=reached, hit=hit)
+
+    def info(self, data: mujoco.MjData, *, reached: bool = False, hit: bool = False, diverged: bool = False) -> dict:
+        """Task information; the object's true position is for scoring only, never for a policy."""
+        return {
+            "reached": reached,
+            "panel_hit": hit,
+            "object_visible": False if diverged else bool(self.visible),
+            "object_pos": self.object_pos.copy(),
+            "hand_object_distance": float(np.linalg.norm(self.body.hand_pos(data) - self.object_pos)),
+        }
