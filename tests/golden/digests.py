@@ -22,6 +22,9 @@ import numpy as np
 
 GOLDEN_FILE = Path(__file__).with_name("digests.json")
 SEEDS = (0, 1, 2)
+# Families whose episodes are pinned. A family joins once its env and baseline are settled (a digest
+# of a behaviour still being tuned proves nothing).
+GOLDEN_FAMILIES = ("catch",)
 MAX_STEPS = 150
 
 
@@ -94,7 +97,8 @@ def compute() -> dict[str, str]:
     from visuomotor_gym.registration import ENV_SPECS, family_of
 
     out: dict[str, str] = {}
-    for spec in ENV_SPECS:
+    specs = [spec for spec in ENV_SPECS if family_of(spec.id) in GOLDEN_FAMILIES]
+    for spec in specs:
         for obs_mode in ("flat", "dict"):
             env = gym.make(spec.id, obs_mode=obs_mode)
             for seed in SEEDS:
@@ -115,7 +119,7 @@ def compute() -> dict[str, str]:
     # Each family's own baseline on each of its ids (catch: the Eyecatch agent, walk: iwao, reach: faraway).
     family_agent = {"catch": "eyecatch", "walk": "iwao", "reach": "faraway"}
     agent_cases = [("oracle", "EyeCatchOracle-v0")] + [
-        (family_agent[family_of(spec.id)], spec.id) for spec in ENV_SPECS if family_of(spec.id) in family_agent
+        (family_agent[family_of(spec.id)], spec.id) for spec in specs
     ]
     for agent, env_id in agent_cases:
         env = gym.make(env_id)
