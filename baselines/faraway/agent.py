@@ -50,7 +50,8 @@ _S = _LAYOUT.slices
 PRIOR_STD_M = 0.5  # weak prior on the object: the shelves' centre +- 0.5 m (modelling choice)
 SAMPLE_DISTANCE_RANGE_M = (0.2, 1.6)  # samples outside are rejected: the shelves are 0.5-1.1 m from the eye (modelling choice)
 PRIOR_DISTANCE_M = 0.8  # distance assumed for the first sample's noise: the shelves are 0.5-1.1 m from the eye
-PATH_REPLAN_M = 0.002  # recompute faraway_path when the end estimate moved more than this (cost; modelling choice)
+PATH_REPLAN_M = 0.01  # recompute faraway_path when the end estimate moved more than this; in between the path is
+# shifted linearly in relative time onto the new end (cost: ~3 ms a call on a loaded core; modelling choice)
 _BETA_PEAK = float(np.max(np.diff(handpath.beta_progress(np.linspace(0.0, 1.0, 2001))) * 2000.0))
 
 
