@@ -16,13 +16,12 @@ import pytest
 from gymnasium.utils.env_checker import check_env as gym_check_env
 from gymnasium.utils.env_checker import data_equivalence
 
-import visuomotor_gym
 from visuomotor_gym import handpath
 from visuomotor_gym.body import reach_names
 from visuomotor_gym.body.reach_body import BEZIER_OFFSET_RANGE, bezier_point
+from visuomotor_gym.core.observation import ObservationLayout
 from visuomotor_gym.envs.actions import hand_target_action
 from visuomotor_gym.envs.reach import ShelfReachEnv, reach_observation
-from visuomotor_gym.core.observation import ObservationLayout
 from visuomotor_gym.registration import FAMILIES, family_of
 from visuomotor_gym.tasks.reach import SHELF_LAYOUT, ShelfLayout
 
@@ -139,8 +138,8 @@ def _rollout(env, seed, actions):
     obs, info = env.reset(seed=seed)
     out.append((obs.copy(), info["target_index"]))
     for a in actions:
-        obs, r, te, tr, info = env.step(a)
-        out.append((obs.copy(), r, te, tr, info["hand_pos"].copy()))
+        obs, rew, te, tr, info = env.step(a)
+        out.append((obs.copy(), rew, te, tr, info["hand_pos"].copy()))
         if te or tr:
             break
     return out

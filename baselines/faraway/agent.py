@@ -35,9 +35,9 @@ import numpy as np
 
 from visuomotor_gym import handpath
 from visuomotor_gym.core.frames import SEAT_ORIGIN
+from visuomotor_gym.core.observation import ObservationLayout
 from visuomotor_gym.envs.actions import NECK_RANGE_DEG, hand_action
 from visuomotor_gym.envs.reach import reach_observation
-from visuomotor_gym.core.observation import ObservationLayout
 from visuomotor_gym.registration import env_vision
 from visuomotor_gym.tasks.reach import SHELF_LAYOUT
 from visuomotor_gym.vision import foveation
@@ -97,7 +97,7 @@ class FarawayAgent:
         p = self.params
         self.dt = float(dt)
         self.vision = VisionParams(noise_scale=max(p.vision_noise_scale, 1e-6), foveated=p.foveated)
-        self.delay_steps = int(round(p.visual_delay_s / self.dt))
+        self.delay_steps = round(p.visual_delay_s / self.dt)
         self.gaze_range = p.gaze_action_range_deg * DEG
         # Search points: the towers' centres (the layout is known, as a person knows the shelves in front).
         targets = SHELF_LAYOUT.targets() - SEAT_ORIGIN
