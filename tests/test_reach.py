@@ -184,7 +184,7 @@ def test_every_rung_runs_finite(env_id):
     obs, info = env.reset(seed=1)
     assert env.observation_space.contains(obs)
     for a in _actions(env.action_space.shape[0], 2, 40):
-        obs, r, te, tr, info = env.step(a)
+        obs, _r, te, tr, info = env.step(a)
         assert np.all(np.isfinite(obs)) and not info["physics_diverged"]
         assert set(info["reward_terms"]) <= {"reach", "panel_hit", "approach", "foveation", "effort"}
         if te or tr:
