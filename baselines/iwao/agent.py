@@ -63,7 +63,7 @@ class IwaoAgent:
         self.gait = gait or GaitParams()
         self.planner = FootstepPlanner(self.gait, planner)
         self.vision = VisionParams(noise_scale=p.vision_noise_scale, foveated=p.foveated)
-        self.delay_steps = int(round(p.visual_delay_s / p.control_dt))
+        self.delay_steps = round(p.visual_delay_s / p.control_dt)
         self.gaze_range = p.gaze_action_range_deg * DEG
         self.memory = ObstacleMemory(self.vision)
         self.reset()
@@ -131,7 +131,7 @@ class IwaoAgent:
             near, far = ol[b + 7], ol[b + 8]
             if near == 0.0 and far == 0.0:
                 continue
-            index = int(round(ol[b]))
+            index = round(ol[b])
             if near > 0.0:
                 self.memory.add(index, 0, ol[b + 1:b + 4], eye_pos, rot_rows, odo)
             if far > 0.0:

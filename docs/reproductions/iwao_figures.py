@@ -15,12 +15,12 @@ import gymnasium as gym
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
 
-import visuomotor_gym  # noqa: E402,F401
-from visuomotor_gym.agents import make_agent  # noqa: E402
-from visuomotor_gym.bench.trace import run_episode  # noqa: E402
+import visuomotor_gym  # noqa: F401
+from visuomotor_gym.agents import make_agent
+from visuomotor_gym.bench.trace import run_episode
 
 HERE = Path(__file__).resolve().parent
 IMAGES = HERE / "images"
