@@ -3,7 +3,8 @@
 #   make test   set up, then run the whole test suite
 #   make bench  set up, then run the benchmarks in benchmarks/
 #   make leaderboard-check   set up, then run the leaderboard check CI runs (leaderboard/)
-#   make test-ray   a second venv (.venv-ray) with the distributed extra (Ray), then the Ray-backend tests
+#   make test-ray   a second venv (.venv-ray) with Ray and RLlib (which pins its own gymnasium), then the
+#                   Ray-backend and RLlib tests
 
 PYTHON ?= python3
 VENV ?= .venv
@@ -41,11 +42,12 @@ test-fast: setup
 $(RAY_STAMP): pyproject.toml Makefile
 	$(PYTHON) -m venv $(RAY_VENV)
 	$(RAY_VENV)/bin/python -m pip install --quiet --upgrade pip
-	$(RAY_VENV)/bin/python -m pip install --quiet -e ".[distributed,dev]"
+	$(RAY_VENV)/bin/python -m pip install --quiet "$(TORCH_SPEC)"
+	$(RAY_VENV)/bin/python -m pip install --quiet -e ".[distributed,dev]" "ray[rllib]"
 	touch $(RAY_STAMP)
 
 test-ray: $(RAY_STAMP)
-	VMGYM_REQUIRE_RAY=1 $(RAY_VENV)/bin/python -m pytest -q -m ray tests/test_ray_backend.py
+	VMGYM_REQUIRE_RAY=1 $(RAY_VENV)/bin/python -m pytest -q -m ray tests/test_ray_backend.py tests/test_rllib.py
 
 bench: setup
 	$(PY) benchmarks/env_throughput.py

@@ -28,9 +28,12 @@ from visuomotor_gym.envs.catch import RENDER_CAMERAS, EyeCatchEnv
 from visuomotor_gym.envs.observation import ObservationLayout
 from visuomotor_gym.tasks.catch_rewards import REWARD_TERMS, SHAPED_WEIGHTS
 
-ENV_IDS = [s.id for s in visuomotor_gym.ENV_SPECS]
-SPECS = {s.id: s for s in visuomotor_gym.ENV_SPECS}
-BOUNCE_IDS = [s.id for s in visuomotor_gym.ENV_SPECS if s.kwargs.get("bounce_wall")]
+# The catch family (EyeCatchEnv); the walk and reach families have their own suites
+# (tests/test_obstacle_walk.py, tests/test_reach.py).
+CATCH_SPECS = [s for s in visuomotor_gym.ENV_SPECS if s.family == "catch"]
+ENV_IDS = [s.id for s in CATCH_SPECS]
+SPECS = {s.id: s for s in CATCH_SPECS}
+BOUNCE_IDS = [s.id for s in CATCH_SPECS if s.kwargs.get("bounce_wall")]
 
 # Warnings that check_env may legitimately raise for these envs; anything else fails the test.
 ALLOWED_CHECK_ENV_WARNINGS = (

@@ -35,9 +35,9 @@ import numpy as np
 
 from visuomotor_gym import handpath
 from visuomotor_gym.core.frames import SEAT_ORIGIN
+from visuomotor_gym.core.observation import ObservationLayout
 from visuomotor_gym.envs.actions import NECK_RANGE_DEG, hand_action
 from visuomotor_gym.envs.reach import reach_observation
-from visuomotor_gym.core.observation import ObservationLayout
 from visuomotor_gym.registration import env_vision
 from visuomotor_gym.tasks.reach import SHELF_LAYOUT
 from visuomotor_gym.vision import foveation
@@ -48,8 +48,10 @@ _LAYOUT = ObservationLayout(reach_observation())
 _S = _LAYOUT.slices
 # Peak of the Beta(1.63, 1.75) speed density (at its mode 0.457): peak speed = this x length / duration.
 PRIOR_STD_M = 0.5  # weak prior on the object: the shelves' centre +- 0.5 m (modelling choice)
+SAMPLE_DISTANCE_RANGE_M = (0.2, 1.6)  # samples outside are rejected: the shelves are 0.5-1.1 m from the eye (modelling choice)
 PRIOR_DISTANCE_M = 0.8  # distance assumed for the first sample's noise: the shelves are 0.5-1.1 m from the eye
-PATH_REPLAN_M = 0.002  # recompute faraway_path when the end estimate moved more than this (cost; modelling choice)
+PATH_REPLAN_M = 0.01  # recompute faraway_path when the end estimate moved more than this; in between the path is
+# shifted linearly in relative time onto the new end (cost: ~3 ms a call on a loaded core; modelling choice)
 _BETA_PEAK = float(np.max(np.diff(handpath.beta_progress(np.linspace(0.0, 1.0, 2001))) * 2000.0))
 
 
@@ -95,7 +97,7 @@ class FarawayAgent:
         p = self.params
         self.dt = float(dt)
         self.vision = VisionParams(noise_scale=max(p.vision_noise_scale, 1e-6), foveated=p.foveated)
-        self.delay_steps = int(round(p.visual_delay_s / self.dt))
+        self.delay_steps = round(p.visual_delay_s / self.dt)
         self.gaze_range = p.gaze_action_range_deg * DEG
         # Search points: the towers' centres (the layout is known, as a person knows the shelves in front).
         targets = SHELF_LAYOUT.targets() - SEAT_ORIGIN
@@ -154,6 +156,9 @@ class FarawayAgent:
         eye where the samples' nearly parallel lines of sight meet. The noise grows with the *true*
         distance, which a sample does not know (a far-peripheral one may put the object at the eye), so it
         is taken at the current estimate's distance (before the first sample: ``PRIOR_DISTANCE_M``)."""
+        dist = float(np.linalg.norm(pos_eye))
+        if pos_eye[0] <= 0.0 or not SAMPLE_DISTANCE_RANGE_M[0] <= dist <= SAMPLE_DISTANCE_RANGE_M[1]:
+            return  # behind the eye or off the shelves' range: a far-peripheral depth error, not the object
         ref = float(np.linalg.norm(self.estimate() - eye)) if self.has_estimate else PRIOR_DISTANCE_M
         v = self.vision
         ecc = foveation.eccentricity(pos_eye)

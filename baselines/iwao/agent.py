@@ -63,7 +63,7 @@ class IwaoAgent:
         self.gait = gait or GaitParams()
         self.planner = FootstepPlanner(self.gait, planner)
         self.vision = VisionParams(noise_scale=p.vision_noise_scale, foveated=p.foveated)
-        self.delay_steps = int(round(p.visual_delay_s / p.control_dt))
+        self.delay_steps = round(p.visual_delay_s / p.control_dt)
         self.gaze_range = p.gaze_action_range_deg * DEG
         self.memory = ObstacleMemory(self.vision)
         self.reset()
@@ -102,37 +102,40 @@ class IwaoAgent:
         return self._act(obs), state
 
     def _act(self, obs: np.ndarray) -> np.ndarray:
-        eye_pos = obs[_S["eye_pos"]].tolist()
-        rot = obs[_S["eye_rot"]].reshape(3, 3)
-        odo = obs[_S["odometry"]].tolist()
-        pelvis_z = float(obs[_S["pelvis"]][0])
-        pose = (eye_pos, rot.tolist(), (odo[0], odo[1], odo[2], pelvis_z))
+        ol = obs.tolist()
+        e0, r0, o0, p0 = _S["eye_pos"].start, _S["eye_rot"].start, _S["odometry"].start, _S["pelvis"].start
+        eye_pos = ol[e0:e0 + 3]
+        rot = [ol[r0:r0 + 3], ol[r0 + 3:r0 + 6], ol[r0 + 6:r0 + 9]]
+        odo = ol[o0:o0 + 3]
+        pose = (eye_pos, rot, (odo[0], odo[1], odo[2], ol[p0]))
         self.poses.append(pose)
         if len(self.poses) > self.delay_steps + 1:
             self.poses.pop(0)
         seen_pose = self.poses[0] if len(self.poses) > self.delay_steps else pose
-        self._perceive(obs, seen_pose)
+        self._perceive(ol, seen_pose)
 
-        phase, _, latch_in = obs[_S["gait_phase"]].tolist()
+        g0 = _S["gait_phase"].start
+        phase, latch_in = ol[g0], ol[g0 + 2]
         if latch_in <= self.params.control_dt + 1e-6:  # this step's command is read at mid-stance
             self.footstep = self._plan(obs, odo)
         action = np.zeros(8, dtype=np.float32)
         action[0:3] = self.footstep
         if not self.params.gaze_blind:
-            action[3:8] = self._look(obs, phase, pose, rot)
+            action[3:8] = self._look(obs, phase, pose)
         return action
 
-    def _perceive(self, obs: np.ndarray, pose) -> None:
+    def _perceive(self, ol: list, pose) -> None:
         eye_pos, rot_rows, odo = pose
         for k in range(K_SLOTS):
-            block = obs[_S[f"obstacle_{k}"]]
-            if block[7] == 0.0 and block[8] == 0.0:
+            b = _S[f"obstacle_{k}"].start
+            near, far = ol[b + 7], ol[b + 8]
+            if near == 0.0 and far == 0.0:
                 continue
-            index = int(round(block[0]))
-            if block[7] > 0.0:
-                self.memory.add(index, 0, block[1:4].tolist(), eye_pos, rot_rows, odo)
-            if block[8] > 0.0:
-                self.memory.add(index, 1, block[4:7].tolist(), eye_pos, rot_rows, odo)
+            index = round(ol[b])
+            if near > 0.0:
+                self.memory.add(index, 0, ol[b + 1:b + 4], eye_pos, rot_rows, odo)
+            if far > 0.0:
+                self.memory.add(index, 1, ol[b + 4:b + 7], eye_pos, rot_rows, odo)
 
     def _footholds(self, obs: np.ndarray, odo) -> list[tuple[float, float, float]]:
         f = obs[_S["footholds"]].reshape(3, 3)
@@ -159,11 +162,11 @@ class IwaoAgent:
         eye_x = odo[0] + pose[0][0]
         return (eye_x + self.params.travel_look_ahead_m, odo[1], 0.0), -1
 
-    def _look(self, obs: np.ndarray, phase: float, pose, rot: np.ndarray) -> np.ndarray:
+    def _look(self, obs: np.ndarray, phase: float, pose) -> list:
         gp = self.gaze_params
         T = self.gait.step_s
         t = phase * T
-        eye_pos, _, odo = pose
+        eye_pos, rot, odo = pose
         ex, ey, ez = odo[0] + eye_pos[0], odo[1] + eye_pos[1], odo[3] + eye_pos[2]
         new_cycle = self.cycle_start_phase is None or phase < self.cycle_start_phase
         self.cycle_start_phase = phase
@@ -178,14 +181,15 @@ class IwaoAgent:
         pitch = head + eye  # downward gaze below the horizontal
         az = math.atan2(self.target[1] - ey, max(self.target[0] - ex, 0.3))
         cp = math.cos(pitch)
-        want = np.array([cp * math.cos(az), cp * math.sin(az), -math.sin(pitch)])  # pelvis-frame axes
-        e = rot.T @ want  # in the eye frame
-        d_az = math.atan2(e[1], e[0])
-        d_el = math.atan2(e[2], math.hypot(e[0], e[1]))
-        out = np.zeros(5, dtype=np.float32)
-        out[0] = np.clip(d_az / self.gaze_range, -1.0, 1.0)
-        out[1] = np.clip(d_el / self.gaze_range, -1.0, 1.0)
-        out[2] = 0.0  # fixation distance: unused in v0
-        out[3] = 0.0  # head yaw straight
-        out[4] = np.clip(-head / (NECK_PITCH_DOWN_DEG * DEG), -1.0, 0.0)
-        return out
+        wx, wy, wz = cp * math.cos(az), cp * math.sin(az), -math.sin(pitch)  # pelvis-frame axes
+        (a00, a01, a02), (a10, a11, a12), (a20, a21, a22) = rot
+        e0 = a00 * wx + a10 * wy + a20 * wz  # R^T w: in the eye frame
+        e1 = a01 * wx + a11 * wy + a21 * wz
+        e2 = a02 * wx + a12 * wy + a22 * wz
+        d_az = math.atan2(e1, e0)
+        d_el = math.atan2(e2, math.hypot(e0, e1))
+        r = self.gaze_range
+        return [min(max(d_az / r, -1.0), 1.0), min(max(d_el / r, -1.0), 1.0),
+                0.0,  # fixation distance: unused in v0
+                0.0,  # head yaw straight
+                min(max(-head / (NECK_PITCH_DOWN_DEG * DEG), -1.0), 0.0)]

@@ -38,7 +38,7 @@ class IwaoGazeParams:
     alpha: float = 0.5
     # sigma_H = sigma_E as fractions of the cycle. No value in the paper: modelling choice, T_F / 6 (the
     # Gaussian is ~1 % of its peak at the cycle's ends, so each cycle starts and ends near level).
-    sigma_fraction: float = 1.0 / 6.0
+    sigma_fraction: float = 1.0 / 3.0
     # t_E: the paper neglects the eye's lag for Eq. 8-10; so do we.
     eye_lag_s: float = 0.0
     # theta_B: the walker's trunk does not pitch (torso rigid on the pelvis, which keeps level).

@@ -24,7 +24,7 @@ MIN_STD_M = 1e-4  # a floor for the noiseless oracle rung (its information would
 class Corner:
     """Information-form estimate of one still point."""
 
-    __slots__ = ("info", "vec", "n", "_est", "_dirty")
+    __slots__ = ("_dirty", "_est", "info", "n", "vec")
 
     def __init__(self) -> None:
         self.info = [0.0] * 6  # xx, xy, xz, yy, yz, zz

@@ -22,7 +22,6 @@ give Faraway's mean path. Between reaches the reference holds the last reach's e
 
 from __future__ import annotations
 
-
 import mujoco
 import numpy as np
 

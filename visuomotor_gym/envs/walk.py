@@ -33,7 +33,7 @@ from visuomotor_gym.tasks.obstacle_walk import (
 )
 from visuomotor_gym.vision.foveation import VisionParams
 
-__all__ = ["OBSTACLE_VIEW_ANGLE_DEG", "ObstacleWalkEnv", "WALK_LAYOUT", "WALK_VISION"]
+__all__ = ["OBSTACLE_VIEW_ANGLE_DEG", "WALK_LAYOUT", "WALK_VISION", "ObstacleWalkEnv"]
 
 RENDER_CAMERAS = ("both", "side", "follow", "scene", "eye")
 MAX_VISION_NOISE_SCALE = 1000.0  # modelling choice: far beyond blindness (x10 is Eyecatch's poor vision)

@@ -90,6 +90,10 @@ def summarize(traces: Sequence) -> dict:
         from visuomotor_gym.metrics.reach_realism import reach_summary
 
         return to_json_safe(reach_summary(traces))
+    if traces and _family(traces[0]) == "walk":  # the walk family's realism and outcomes (issue 12)
+        from visuomotor_gym.metrics.walk_realism import walk_summary
+
+        return to_json_safe(walk_summary(traces))
     n = len(traces)
     caught = sum(bool(tr.caught) for tr in traces)
     diverged = sum(bool(tr.diverged) for tr in traces)

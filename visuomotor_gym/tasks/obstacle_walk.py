@@ -267,4 +267,4 @@ def top_corners(obstacles: np.ndarray) -> np.ndarray:
     return np.stack([near, far], axis=1)
 
 
-__all__ = ["Course", "CourseDistribution", "K_SLOTS", "KINDS", "ObstacleWalkTask", "sample_course", "top_corners"]
+__all__ = ["KINDS", "K_SLOTS", "Course", "CourseDistribution", "ObstacleWalkTask", "sample_course", "top_corners"]

@@ -1,0 +1,215 @@
+"""ObstacleWalk-v0 (issue 12): API checkers, determinism, pickling, bad input, no leak of the obstacles'
+true state, every rung from the registry, the iwao baseline against its gaze-blind twin, walking realism."""
+
+from __future__ import annotations
+
+import pickle
+from types import SimpleNamespace
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import visuomotor_gym  # noqa: F401  (registers the ids)
+from visuomotor_gym.agents import make_agent
+from visuomotor_gym.envs.walk import WALK_LAYOUT, ObstacleWalkEnv
+from visuomotor_gym.registration import ENV_SPECS, FAMILIES
+from visuomotor_gym.tasks.obstacle_walk import K_SLOTS, CourseDistribution, sample_course
+
+WALK_IDS = FAMILIES["walk"]
+
+
+def rollout(env, seed, actions):
+    obs, info = env.reset(seed=seed)
+    out = [obs.copy()]
+    for a in actions:
+        obs, r, term, trunc, info = env.step(a)
+        out.append(np.append(obs, r))
+        if term or trunc:
+            break
+    return out
+
+
+def test_the_five_rungs_are_registered_in_the_walk_family():
+    assert set(WALK_IDS) == {"ObstacleWalkOracle-v0", "ObstacleWalkFullView-v0", "ObstacleWalk-v0",
+                             "ObstacleWalkDelayed-v0", "ObstacleWalkPoorVision-v0"}
+    assert all(s.max_episode_steps == 2000 for s in ENV_SPECS if s.family == "walk")
+
+
+@pytest.mark.parametrize("env_id", WALK_IDS)
+def test_every_rung_runs_from_the_registry_on_the_same_course(env_id):
+    env = gym.make(env_id)
+    obs, info = env.reset(seed=7)
+    assert obs.shape == (WALK_LAYOUT.size,) and env.observation_space.contains(obs)
+    ref = ObstacleWalkEnv()
+    _, ref_info = ref.reset(seed=7)
+    np.testing.assert_array_equal(info["obstacles"], ref_info["obstacles"])  # same course on every rung
+    for _ in range(5):
+        obs, r, term, trunc, info = env.step(env.action_space.sample())
+        assert env.observation_space.contains(obs) and np.isfinite(obs).all()
+
+
+def test_gymnasium_and_sb3_checkers():
+    from gymnasium.utils.env_checker import check_env as gym_check
+    from stable_baselines3.common.env_checker import check_env as sb3_check
+
+    gym_check(ObstacleWalkEnv(), skip_render_check=True)
+    sb3_check(ObstacleWalkEnv(), warn=True)
+    gym_check(ObstacleWalkEnv(obs_mode="dict"), skip_render_check=True)
+
+
+def test_layout_docstring_and_spaces_agree():
+    env = ObstacleWalkEnv()
+    assert env.observation_structure == WALK_LAYOUT.structure
+    assert env.action_structure == {"footstep": 3, "gaze": 2, "fixation": 1, "head": 2}
+    assert "| 0-8 | obstacle_0 | 9 |" in ObstacleWalkEnv.__doc__
+    assert f"({WALK_LAYOUT.size},)" in ObstacleWalkEnv.__doc__
+
+
+def test_same_seed_same_episode_and_pickling_mid_episode():
+    rng = np.random.default_rng(0)
+    actions = rng.uniform(-1, 1, (60, 8)).astype(np.float32)
+    a = rollout(ObstacleWalkEnv(), 3, actions)
+    b = rollout(ObstacleWalkEnv(), 3, actions)
+    assert len(a) == len(b) and all(np.array_equal(x, y) for x, y in zip(a, b))
+    env = ObstacleWalkEnv()
+    env.reset(seed=3)
+    for act in actions[:20]:
+        env.step(act)
+    clone = pickle.loads(pickle.dumps(env))
+    for act in actions[20:40]:
+        o1, r1, t1, _, _ = env.step(act)
+        o2, r2, t2, _, _ = clone.step(act)
+        assert np.array_equal(o1, o2) and r1 == r2 and t1 == t2
+
+
+def test_bad_input_gives_clear_errors():
+    env = ObstacleWalkEnv()
+    env.reset(seed=0)
+    bad = np.zeros(8, np.float32)
+    bad[2] = np.nan
+    with pytest.raises(ValueError, match="NaN or inf"):
+        env.step(bad)
+    with pytest.raises(ValueError, match="shape"):
+        env.step(np.zeros(9, np.float32))
+    with pytest.raises(TypeError, match="unknown argument"):
+        ObstacleWalkEnv(n_balls=2)
+    with pytest.raises(ValueError, match="unknown term"):
+        ObstacleWalkEnv(reward_weights={"catch": 1.0})
+    with pytest.raises(TypeError, match="unknown field"):
+        ObstacleWalkEnv(vision_params={"fov": 30})
+    with pytest.raises(ValueError, match="vision"):
+        ObstacleWalkEnv(vision="xray")
+    with pytest.raises(RuntimeError, match="before reset"):
+        ObstacleWalkEnv().step(np.zeros(8, np.float32))
+
+
+def _look_up(n):
+    a = np.zeros((n, 8), np.float32)
+    a[:, 4] = 0.5  # gaze up (elevation, 30 deg a step until the eye's range)
+    a[:, 7] = 1.0  # head up (neck pitch +40 deg)
+    return a
+
+
+def _move_obstacles(env):
+    """Change the true course after reset (other places, heights): what a leak would reveal."""
+    task = env.task
+    for i, (x, y, depth, width, height, kind) in enumerate(task.course.obstacles.tolist()):
+        x, height = x + 0.7, min(height + 0.1, 0.4)
+        env.gait.pool.place(env.model, env.data, i, x, y, depth, width, height)
+        task.targets[2 * i].place(x - 0.5 * depth, y + 0.5 * width, height)
+        task.targets[2 * i + 1].place(x + 0.5 * depth, y - 0.5 * width, height)
+        task.course.obstacles[i, [0, 4]] = (x, height)
+
+
+@pytest.mark.parametrize("vision", ["foveated", "oracle"])
+def test_no_observation_leak_of_the_obstacles_true_state(vision):
+    """Looking up at the sky, the foveated walker's observations do not depend on where the obstacles
+    are or how high (the same episode with a moved course gives identical observations). The oracle rung
+    (true corners) is the positive control: there the same change shows."""
+    actions = _look_up(40)
+    a, b = ObstacleWalkEnv(vision=vision), ObstacleWalkEnv(vision=vision)
+    a.reset(seed=5)
+    b.reset(seed=5)
+    _move_obstacles(b)
+    differ = False
+    for act in actions:
+        oa, *_ = a.step(act)
+        ob, *_ = b.step(act)
+        differ |= not np.array_equal(oa, ob)
+    if vision == "foveated":
+        assert not differ
+        seen = [oa[WALK_LAYOUT.slices[f"obstacle_{k}"]][7:9] for k in range(K_SLOTS)]
+        assert not np.any(seen)
+    else:
+        assert differ
+
+
+def test_course_sampler_follows_its_distribution():
+    dist = CourseDistribution()
+    for seed in range(50):
+        course = sample_course(np.random.default_rng(seed), dist, 16)
+        ob = course.obstacles
+        assert 15.0 <= course.length <= 20.0 and len(ob) >= 3
+        near, far = ob[:, 0] - ob[:, 2] / 2, ob[:, 0] + ob[:, 2] / 2
+        assert near[0] >= 3.0 and far[-1] <= course.length - dist.finish_clear_m
+        assert np.all(near[1:] - far[:-1] >= 1.6 - 1e-9)
+        tall = ob[:, 5] != 2
+        assert np.all((ob[tall, 4] >= 0.05) & (ob[tall, 4] <= 0.30)) and np.all(ob[~tall, 4] == 0.01)
+
+
+def test_a_trip_ends_the_episode_and_scores_nothing():
+    env = ObstacleWalkEnv()
+    env.reset(seed=0)
+    a = np.zeros(8, np.float32)
+    a[0], a[2] = 0.1, -1.0  # 0.65 m steps, 2 cm clearance: walks into the first bar
+    for _ in range(1000):
+        obs, r, term, trunc, info = env.step(a)
+        if term:
+            break
+    assert info["tripped"] and term and not info["is_success"]
+    assert info["reward_terms"]["trip"] == -1.0 and r == pytest.approx(-1.0)
+
+
+def _successes(agent, seeds):
+    env = gym.make("ObstacleWalk-v0")
+    policy = make_agent(agent, "ObstacleWalk-v0", 8)
+    wins = 0
+    for seed in seeds:
+        obs, _ = env.reset(seed=seed)
+        policy.reset()
+        while True:
+            obs, _, term, trunc, info = env.step(policy.predict(obs)[0])
+            if term or trunc:
+                break
+        wins += bool(info["is_success"])
+    return wins
+
+
+@pytest.mark.slow
+def test_iwao_crosses_more_courses_than_its_gaze_blind_twin():
+    seeds = range(100, 108)
+    looking, blind = _successes("iwao", seeds), _successes("iwao:gaze_blind=true", seeds)
+    assert looking >= 7 and blind <= 5 and looking - blind >= 3, (looking, blind)
+
+
+def test_walk_realism_measures_on_a_synthetic_trace():
+    from visuomotor_gym.metrics.walk_realism import episode_measures, walk_gaze_realism
+
+    t = np.arange(0, 6.0, 0.02)
+    pelvis = np.stack([1.3 * t, 0 * t, 0.9 + 0 * t], axis=1)
+    eye = pelvis + [0.1, 0.0, 0.7]
+    obstacle = np.array([[5.0, 0.0, 0.05, 1.0, 0.2, 0.0]])
+    # Gaze on the obstacle's top during the first 20 % of its approach, then on the floor 1.5 m ahead.
+    target = np.where((pelvis[:, 0] < 0.4)[:, None], [5.0, 0.0, 0.2], eye * [1, 1, 0] + [1.5, 0.0, 0.0])
+    gaze = (target - eye) / np.linalg.norm(target - eye, axis=1, keepdims=True)
+    trace = SimpleNamespace(eye_pos=eye, gaze_dir=gaze, pelvis_pos=pelvis, obstacles=obstacle, diverged=False)
+    m = episode_measures(trace)
+    # Approach: pelvis x in [0, 4.375). On the obstacle: x < 0.4 (fixated), and while the travel gaze (1.5 m
+    # ahead on the floor, so 1.31 m ahead at the top's height) sweeps over its 0.05 + 2 x 0.10 m: 0.25 m more.
+    assert m["obstacle_fixation_share"] == pytest.approx((0.4 + 0.25) / 4.375, abs=0.01)
+    assert m["fixation_while_crossing"] == 0.0
+    assert m["travel_fixation_distance_m"] == pytest.approx(1.5, abs=0.01)
+    assert 45.0 < m["gaze_below_horizon_deg"] < 50.0  # arctan(1.6 / 1.5) = 46.8 deg
+    score = walk_gaze_realism([trace])
+    assert 0.0 < score["score"] <= 1.0 and score["components"]["fixation_while_crossing"]["score"] == 1.0

@@ -1,0 +1,387 @@
+"""ShelfReach-v0 (issue 14): scene and layout, Gymnasium/SB3 checkers, determinism, pickling, bad input,
+no leak of the object's true position, every rung of the ladder, the Bézier hand action, the faraway
+baseline against its gaze-blind twin, and the reach-family realism measures."""
+
+from __future__ import annotations
+
+import math
+import pickle
+import re
+import warnings
+
+import gymnasium as gym
+import mujoco
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env as gym_check_env
+from gymnasium.utils.env_checker import data_equivalence
+
+from visuomotor_gym import handpath
+from visuomotor_gym.body import reach_names
+from visuomotor_gym.body.reach_body import BEZIER_OFFSET_RANGE, bezier_point
+from visuomotor_gym.core.observation import ObservationLayout
+from visuomotor_gym.envs.actions import hand_target_action
+from visuomotor_gym.envs.reach import ShelfReachEnv, reach_observation
+from visuomotor_gym.registration import FAMILIES, family_of
+from visuomotor_gym.tasks.reach import SHELF_LAYOUT, ShelfLayout
+
+REACH_IDS = list(FAMILIES["reach"])
+ALLOWED = (r"A Box observation space minimum value is -infinity", r"A Box observation space maximum value is infinity",
+           r"render_mode='human' needs a display")
+PERCEPT = ("object_pos", "object_visible", "object_age")
+
+
+def _unexpected(records):
+    return [str(r.message) for r in records if not any(re.search(p, str(r.message)) for p in ALLOWED)]
+
+
+def _actions(n_act, seed, length=60):
+    return np.random.default_rng(seed).uniform(-1.0, 1.0, size=(length, n_act)).astype(np.float32)
+
+
+# --- scene ---------------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def model():
+    from visuomotor_gym.assets import asset_path
+
+    return mujoco.MjModel.from_xml_path(str(asset_path(reach_names.SCENE)))
+
+
+@pytest.mark.parametrize("kind", sorted(reach_names.ALL_NAMES))
+def test_reach_names_exist(model, kind):
+    obj = {"body": mujoco.mjtObj.mjOBJ_BODY, "geom": mujoco.mjtObj.mjOBJ_GEOM, "camera": mujoco.mjtObj.mjOBJ_CAMERA}[kind]
+    missing = [n for n in reach_names.ALL_NAMES[kind] if mujoco.mj_name2id(model, obj, n) < 0]
+    assert not missing
+
+
+def test_scene_matches_the_layout(model):
+    """Every object position of SHELF_LAYOUT stands on its board (top surface at the object's base), the
+    boards do not collide, the back panels do and stand panel_gap_m behind the far depth."""
+    data = mujoco.MjData(model)
+    mujoco.mj_kinematics(model, data)
+    targets = SHELF_LAYOUT.targets()
+    assert targets.shape == (30, 3)
+    for i, name in enumerate(reach_names.BOARDS):
+        g = model.geom(name).id
+        pos, half = data.geom_xpos[g], model.geom_size[g]
+        top = pos[2] + half[2]
+        assert top == pytest.approx(targets[i, 2] - SHELF_LAYOUT.object_half_height_m, abs=1e-3), name
+        assert np.linalg.norm(pos[:2] - targets[i, :2]) < 0.03, name  # under the object
+        assert model.geom_contype[g] == 0 and model.geom_conaffinity[g] == 0
+    for t, name in enumerate(reach_names.PANELS):
+        g = model.geom(name).id
+        r = np.linalg.norm(data.geom_xpos[g][:2])
+        assert r == pytest.approx(SHELF_LAYOUT.depth_m[1] + SHELF_LAYOUT.panel_gap_m, abs=1e-3)
+        az = math.degrees(math.atan2(data.geom_xpos[g][1], data.geom_xpos[g][0]))
+        assert az == pytest.approx(SHELF_LAYOUT.tower_azimuth_deg[t], abs=1e-6)
+        assert model.geom_conaffinity[g] == 1
+    obj = model.geom(reach_names.OBJECT_GEOM).id
+    assert model.geom_size[obj][:2] == pytest.approx([SHELF_LAYOUT.object_radius_m, SHELF_LAYOUT.object_half_height_m])
+    assert ShelfLayout.describe(29) == (2, 4, 1) and ShelfLayout.describe(10) == (1, 0, 0)
+
+
+def test_registration():
+    assert REACH_IDS == ["ShelfReachOracle-v0", "ShelfReachFullView-v0", "ShelfReach-v0", "ShelfReachDelayed-v0",
+                         "ShelfReachPoorVision-v0"]
+    assert all(family_of(i) == "reach" for i in REACH_IDS)
+    assert "EyeCatch-v0" in FAMILIES["catch"]  # the catch entries are untouched
+
+
+# --- API checkers --------------------------------------------------------------------------------
+@pytest.mark.render
+def test_gymnasium_check_env_with_render():
+    env = gym.make("ShelfReach-v0", render_mode="rgb_array")
+    try:
+        with warnings.catch_warnings(record=True) as records:
+            warnings.simplefilter("always")
+            gym_check_env(env.unwrapped, skip_render_check=False)
+    finally:
+        env.close()
+    assert not _unexpected(records)
+
+
+@pytest.mark.parametrize("kwargs", [{"obs_mode": "dict"}, {"control": "joint"}, {"reward": "shaped"},
+                                    {"hand_action": "bezier"}], ids=str)
+def test_gymnasium_check_env_variants(kwargs):
+    env = gym.make("ShelfReach-v0", **kwargs)
+    with warnings.catch_warnings(record=True) as records:
+        warnings.simplefilter("always")
+        gym_check_env(env.unwrapped, skip_render_check=True)
+    assert not _unexpected(records)
+
+
+@pytest.mark.parametrize("env_id,kwargs", [(i, {}) for i in REACH_IDS] + [("ShelfReach-v0", {"hand_action": "bezier"})])
+def test_sb3_check_env(env_id, kwargs):
+    from stable_baselines3.common.env_checker import check_env as sb3_check_env
+
+    env = gym.make(env_id, **kwargs)
+    with warnings.catch_warnings(record=True) as records:
+        warnings.simplefilter("always")
+        sb3_check_env(env.unwrapped, warn=True, skip_render_check=True)
+    assert not [str(r.message) for r in records]
+
+
+def test_docstring_tables_match_the_layout():
+    layout = ObservationLayout(reach_observation())
+    doc = ShelfReachEnv.__doc__
+    for name, s in layout.slices.items():
+        index = f"{s.start}" if s.stop - s.start == 1 else f"{s.start}-{s.stop - 1}"
+        assert f"| {index} | {name} |" in doc
+    assert f"({layout.size},)" in doc and "ACTION_TABLE" not in doc
+    for arg in ShelfReachEnv._argument_names():
+        assert f"``{arg}``" in doc, arg
+
+
+# --- determinism, pickling, rungs ----------------------------------------------------------------
+def _rollout(env, seed, actions):
+    out = []
+    obs, info = env.reset(seed=seed)
+    out.append((obs.copy(), info["target_index"]))
+    for a in actions:
+        obs, rew, te, tr, info = env.step(a)
+        out.append((obs.copy(), rew, te, tr, info["hand_pos"].copy()))
+        if te or tr:
+            break
+    return out
+
+
+def test_same_seed_same_episode_and_same_target_on_every_rung():
+    acts = _actions(9, 3)
+    a, b = gym.make("ShelfReach-v0"), gym.make("ShelfReach-v0")
+    ra, rb = _rollout(a, 5, acts), _rollout(b, 5, acts)
+    assert len(ra) == len(rb)
+    for x, y in zip(ra, rb):
+        assert data_equivalence(x, y, exact=True)
+    for seed in range(6):
+        targets = set()
+        for env_id in REACH_IDS:
+            env = gym.make(env_id)
+            _, info = env.reset(seed=seed)
+            targets.add((info["target_index"], tuple(np.round(info["object_pos"], 12))))
+        assert len(targets) == 1, (seed, targets)
+    seen = {gym.make("ShelfReach-v0").reset(seed=s)[1]["target_index"] for s in range(80)}
+    assert len(seen) >= 25  # uniform over the 30 targets
+
+
+def test_pickle_round_trip_continues_identically():
+    env = gym.make("ShelfReach-v0", hand_action="bezier").unwrapped
+    acts = _actions(17, 9)
+    env.reset(seed=4)
+    for a in acts[:5]:
+        env.step(a)
+    twin = pickle.loads(pickle.dumps(env))
+    for k, a in enumerate(acts[5:40]):
+        ta, tb = env.step(a), twin.step(a)
+        np.testing.assert_array_equal(ta[0], tb[0], err_msg=f"step {k}")
+        assert ta[1:4] == tb[1:4] and data_equivalence(ta[4], tb[4], exact=True)
+        if ta[2] or ta[3]:
+            break
+
+
+@pytest.mark.parametrize("env_id", REACH_IDS)
+def test_every_rung_runs_finite(env_id):
+    env = gym.make(env_id)
+    obs, info = env.reset(seed=1)
+    assert env.observation_space.contains(obs)
+    for a in _actions(env.action_space.shape[0], 2, 40):
+        obs, _r, te, tr, info = env.step(a)
+        assert np.all(np.isfinite(obs)) and not info["physics_diverged"]
+        assert set(info["reward_terms"]) <= {"reach", "panel_hit", "approach", "foveation", "effort"}
+        if te or tr:
+            break
+
+
+def test_oracle_rung_sees_the_true_position_and_foveated_rung_does_not():
+    s = ObservationLayout(reach_observation()).slices
+    oracle = gym.make("ShelfReachOracle-v0").unwrapped
+    obs, info = oracle.reset(seed=2)
+    true_eye = oracle.eye.to_eye(info["object_pos"], np.zeros(3))[0]
+    np.testing.assert_allclose(obs[s["object_pos"]], true_eye, atol=1e-5)
+    fov = gym.make("ShelfReachFullView-v0").unwrapped
+    obs, info = fov.reset(seed=2)
+    true_eye = fov.eye.to_eye(info["object_pos"], np.zeros(3))[0]
+    assert obs[s["object_visible"]][0] == 1.0
+    assert 1e-4 < np.linalg.norm(obs[s["object_pos"]] - true_eye) < 0.5  # noisy, not the truth
+
+
+# --- no leak of the object's true position -------------------------------------------------------
+@pytest.mark.parametrize("env_id", ["ShelfReach-v0", "ShelfReachDelayed-v0"])
+def test_no_leak_of_the_object_position(env_id):
+    """Moving the object changes nothing in the observation but the percept blocks, and nothing at all
+    while it is not seen: its true position reaches the agent only through the eye."""
+    s = ObservationLayout(reach_observation()).slices
+    a, b = gym.make(env_id).unwrapped, gym.make(env_id).unwrapped
+    a.reset(seed=3)
+    b.reset(seed=3)
+    other = SHELF_LAYOUT.targets()[(a.target_index + 7) % 30]
+    b.task.object.place(b.data, other)
+    b.task.object_pos = other.copy()
+    rest = [k for k in s if k not in PERCEPT]
+    differed = unseen = 0
+    for act in _actions(9, 6, 40) * np.array([0.3] * 4 + [1.0] * 5, dtype=np.float32):
+        oa, *_ = a.step(act)
+        ob, *_ = b.step(act)
+        for k in rest:
+            np.testing.assert_array_equal(oa[s[k]], ob[s[k]], err_msg=k)
+        if oa[s["object_visible"]][0] == 0 and ob[s["object_visible"]][0] == 0:
+            np.testing.assert_array_equal(oa[s["object_pos"]], ob[s["object_pos"]])
+            unseen += 1
+        differed += not np.array_equal(oa, ob)
+    assert differed > 0 or unseen == 40  # the test can see a difference when the object is seen
+
+
+def test_object_truth_is_in_info_only():
+    env = gym.make("ShelfReach-v0").unwrapped
+    obs, info = env.reset(seed=8)
+    truth = info["object_pos"]
+    seat = truth - np.array([0.0, 0.0, 0.5])
+    for frame_value in (truth, seat):
+        for k in range(len(obs) - 2):
+            assert not np.allclose(obs[k : k + 3], frame_value, atol=1e-6)
+
+
+# --- bad input -----------------------------------------------------------------------------------
+@pytest.mark.parametrize("kwargs,exc", [
+    ({"hand_action": "spline"}, ValueError), ({"hand_action": "bezier", "control": "joint"}, ValueError),
+    ({"reach_radius": 0.0}, ValueError), ({"reach_radius": float("nan")}, ValueError),
+    ({"arrival_speed_m_s": -1.0}, ValueError), ({"vision": "xray"}, ValueError), ({"reward": "dense"}, ValueError),
+    ({"reward_weights": {"catch": 1.0}}, ValueError), ({"visual_delay_s": 0.03}, ValueError),
+    ({"target": 3}, TypeError), ({"record_plant": "yes"}, TypeError), ({"render_camera": "side"}, ValueError),
+])
+def test_bad_arguments(kwargs, exc):
+    with pytest.raises(exc):
+        ShelfReachEnv(**kwargs)
+
+
+def test_bad_actions_and_order():
+    env = ShelfReachEnv()
+    with pytest.raises(RuntimeError, match="before reset"):
+        env.step(np.zeros(9, dtype=np.float32))
+    env.reset(seed=0)
+    for bad in (np.zeros(8), np.full(9, np.nan), np.array(["a"] * 9)):
+        with pytest.raises(ValueError):
+            env.step(bad)
+    with pytest.raises(ValueError):
+        env.reset(seed=0, options={"target": 1})
+
+
+# --- success, panel touches ----------------------------------------------------------------------
+def _scripted(env, grasp: bool, steps=120, offset=(0.0, 0.0, 0.0)):
+    """Drive the hand to the true object (a test oracle), gaze held."""
+    info = env.unwrapped.task.reset_info()
+    goal = info["object_pos"] + np.asarray(offset)
+    for _ in range(steps):
+        a = np.zeros(9, dtype=np.float32)
+        a[:3] = hand_target_action(goal)
+        a[3] = 1.0 if grasp else -1.0
+        _, _, te, tr, info = env.step(a)
+        if te or tr:
+            break
+    return info
+
+
+def test_success_needs_the_closed_hand_at_the_object_and_a_panel_touch_ends_the_episode():
+    env = gym.make("ShelfReachOracle-v0")
+    env.reset(seed=0)
+    assert _scripted(env, grasp=True)["is_success"]
+    env.reset(seed=0)
+    info = _scripted(env, grasp=False, steps=100)
+    assert not info["is_success"] and not info["panel_hit"]
+    # through the far target towards the panel: the touch ends the episode without success
+    for seed in range(40):
+        _, info0 = env.reset(seed=seed)
+        if info0["depth"] == 1 and info0["tower"] == 2:  # the right-hand tower: its panel is in the workspace
+            break
+    info = _scripted(env, grasp=False, offset=(0.0, -0.25, 0.0))
+    assert info["panel_hit"] and not info["is_success"]
+
+
+# --- the Bézier hand action ----------------------------------------------------------------------
+def test_bezier_mode_follows_its_curve():
+    env = gym.make("ShelfReachOracle-v0", hand_action="bezier").unwrapped
+    _, info = env.reset(seed=11)
+    body = env.body
+    start = body.hand.reference.copy()
+    end = info["object_pos"]
+    a = np.zeros(17, dtype=np.float32)
+    a[:3] = hand_target_action(end)
+    a[3:6] = np.array(handpath.FARAWAY_Y1) / BEZIER_OFFSET_RANGE
+    a[6:9] = np.array(handpath.FARAWAY_Y2) / BEZIER_OFFSET_RANGE
+    a[9] = 2.0 * (0.8 - 0.2) / (2.0 - 0.2) - 1.0  # 0.8 s
+    a[10] = 1.0
+    refs, hands = [], []
+    for k in range(40):
+        env.step(a)
+        refs.append(body.hand.reference.copy())
+        hands.append(env.data.site_xpos[body.catch_site].copy())
+    end_ws = np.asarray(body.reach_end)
+    n = 41
+    expected = np.array([bezier_point(start, end_ws, np.array(handpath.FARAWAY_Y1), np.array(handpath.FARAWAY_Y2),
+                                      min((k + 1) * env.dt / 0.8, 1.0)) for k in range(40)])
+    speeds = np.linalg.norm(np.diff(np.vstack([start, expected]), axis=0), axis=1) / env.dt
+    assert speeds.max() < 2.0  # no rate limiting: the reference is the curve itself
+    np.testing.assert_allclose(np.array(refs), expected, atol=1e-9)
+    # the curve is Faraway's path (the env's arc-length table vs the toolkit's, at the same relative times)
+    far = handpath.faraway_path(start, end_ws, n)
+    np.testing.assert_allclose(expected[:-1], far[1:-1], atol=2e-3)
+    # and the physical hand follows it within a few centimetres
+    assert np.max(np.linalg.norm(np.array(hands) - expected, axis=1)) < 0.05
+    # straight with zero offsets
+    env.reset(seed=11)
+    a[3:9] = 0.0
+    start = body.hand.reference.copy()
+    for _ in range(20):
+        env.step(a)
+        p = body.hand.reference - start
+        axis = np.asarray(body.reach_end) - start
+        assert np.linalg.norm(np.cross(p, axis)) / np.linalg.norm(axis) < 1e-9
+
+
+# --- the faraway baseline and its twin -----------------------------------------------------------
+def test_faraway_succeeds_and_beats_its_gaze_blind_twin():
+    from visuomotor_gym.bench.evaluate import evaluate
+
+    looking = evaluate("faraway", "ShelfReach-v0", episodes=20, seed=100, workers=1, keep_traces=True)
+    blind = evaluate("faraway:gaze_blind=true", "ShelfReach-v0", episodes=20, seed=100, workers=1, keep_traces=False)
+    sl, sb = looking.summary["success_rate"], blind.summary["success_rate"]
+    assert sl >= 0.9, sl
+    assert sb <= sl - 0.3, (sl, sb)
+    realism = looking.summary["gaze_realism"]["components"]
+    assert 0.5 < realism["curvature_index"]["value"] < 1.4  # Faraway-like, not straight
+    assert 0.3 < realism["gaze_hand_lead_s"]["value"] < 0.9  # gaze leads the hand (Land et al. 1999)
+    from visuomotor_gym.bench.results import validate_results  # noqa: F401  (the summary fits the schema)
+
+
+# --- realism measures ----------------------------------------------------------------------------
+class _Trace:
+    def __init__(self, path, obj, success=True, dt=0.02):
+        n = len(path)
+        self.hand_pos = path
+        self.object_pos = obj
+        self.t = np.arange(n) * dt
+        self.dt = dt
+        self.success = success
+        self.diverged = False
+        self.eye_pos = np.tile([0.1, 0.0, 1.13], (n, 1))
+        to = obj - self.eye_pos
+        self.gaze_dir = to / np.linalg.norm(to, axis=1, keepdims=True)
+        self.saccade_onset = np.zeros(n, bool)
+        self.saccade_onset[5] = True
+        self.env_id = "ShelfReach-v0"
+
+
+def test_reach_realism_tells_straight_from_faraway_paths():
+    from visuomotor_gym.metrics.reach_realism import reach_measures, reach_realism
+
+    start, end = np.array([0.32, -0.05, 0.74]), np.array([0.35, -0.55, 0.93])
+    rest = np.repeat(start[None], 10, axis=0)
+    far = np.vstack([rest, handpath.faraway_path(start, end, 40)])
+    straight = np.vstack([rest, handpath.minimum_jerk_path(start, end, 40)])
+    mf, ms = reach_measures(_Trace(far, end)), reach_measures(_Trace(straight, end))
+    assert mf["curvature_index"] == pytest.approx(1.0, abs=0.05) and mf["faraway_distance_cm"] < 1.0
+    assert ms["curvature_index"] == pytest.approx(0.0, abs=0.02)
+    assert 0.1 < mf["hand_after_saccade_s"] < 0.25  # rows 10+ move; the saccade started at t = 0.08 s
+    assert mf["gaze_hand_lead_s"] == pytest.approx(far.shape[0] * 0.02 - 0.02, abs=1e-9)  # gaze on it from t=0
+    rf, rs = reach_realism([_Trace(far, end)] * 3), reach_realism([_Trace(straight, end)] * 3)
+    assert rf["components"]["curvature_index"]["score"] == 1.0
+    assert rs["components"]["curvature_index"]["score"] < 0.5
