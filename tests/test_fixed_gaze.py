@@ -94,11 +94,32 @@ def test_joint_control_layout_and_bad_layout():
     env = gym.make("EyeCatch-v0", control="joint")
     held = _blocks(env)
     assert np.flatnonzero(held).tolist() == [11, 12, 14, 15]
-    blind = GazeBlind(make_agent("random", "EyeCatch-v0", 16, seed=1), 16)
+    blind = GazeBlind(make_agent("random", "EyeCatch-v0", 16, seed=1), env.unwrapped.action_structure)
     a, _ = blind.predict(env.reset(seed=0)[0])
     assert np.all(a[held] == 0.0) and np.any(a[~held] != 0.0)
-    with pytest.raises(ValueError, match="9 and 16"):
-        GazeBlind(make_agent("random", "EyeCatch-v0", 7), 7)
+    with pytest.raises(ValueError, match="'gaze' and 'head' blocks"):
+        GazeBlind(make_agent("random", "EyeCatch-v0", 7), {"hand_target": 3, "grasp": 1})
+
+
+@pytest.mark.parametrize("env_id, base", [("ObstacleWalk-v0", "iwao"), ("ShelfReach-v0", "faraway")])
+def test_the_twin_holds_gaze_and_head_in_every_family(env_id, base):
+    """The twin reads the env's action_structure: the walk and reach layouts hold their own blocks."""
+    env = gym.make(env_id)
+    structure = env.unwrapped.action_structure
+    blind = make_agent(f"gaze_blind:{base}", env_id, env.action_space.shape[0])
+    start, held = 0, []
+    for name, size in structure.items():
+        if name in ("gaze", "head"):
+            held += list(range(start, start + size))
+        start += size
+    assert np.flatnonzero(blind.held).tolist() == held
+    obs, _ = env.reset(seed=0)
+    for _ in range(30):
+        a, _ = blind.predict(obs)
+        assert np.all(a[held] == 0.0)
+        obs, _, terminated, truncated, _ = env.step(a)
+        if terminated or truncated:
+            break
 
 
 def test_bench_accepts_the_twin():

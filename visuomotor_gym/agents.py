@@ -28,6 +28,8 @@ Further names register with :func:`register_agent`.
 
 from __future__ import annotations
 
+import functools
+
 from typing import Any, Callable, Protocol, runtime_checkable
 
 import numpy as np
@@ -212,21 +214,24 @@ class GazeBlind:
 
     The base agent still runs its own filter on the observations, which report the held eye pose, so
     its estimate stays consistent; only where the eye looks changes. The action layout follows the
-    env's ``action_structure`` (``control="hand"``: 9 values, gaze 4-5, head 7-8; ``control="joint"``:
-    16 values, gaze 11-12, head 14-15).
+    env's ``action_structure`` (its ``"gaze"`` and ``"head"`` blocks), so it works for every family.
     """
 
-    GAZE_HEAD_BLOCKS = {9: ((4, 6), (7, 9)), 16: ((11, 13), (14, 16))}
+    HELD_BLOCKS = ("gaze", "head")
 
-    def __init__(self, base: Policy, action_dim: int):
-        if action_dim not in self.GAZE_HEAD_BLOCKS:
-            raise ValueError(f"gaze_blind knows the catch action layouts of size 9 and 16, not {action_dim}")
+    def __init__(self, base: Policy, action_structure: dict[str, int]):
+        if not isinstance(action_structure, dict) or not all(b in action_structure for b in self.HELD_BLOCKS):
+            raise ValueError(
+                f"gaze_blind needs an action layout with 'gaze' and 'head' blocks, got {action_structure!r}"
+            )
         self.base = base
-        self.action_dim = action_dim
-        (g0, g1), (h0, h1) = self.GAZE_HEAD_BLOCKS[action_dim]
-        self.held = np.zeros(action_dim, dtype=bool)
-        self.held[g0:g1] = True
-        self.held[h0:h1] = True
+        self.action_dim = sum(action_structure.values())
+        self.held = np.zeros(self.action_dim, dtype=bool)
+        start = 0
+        for name, size in action_structure.items():
+            if name in self.HELD_BLOCKS:
+                self.held[start : start + size] = True
+            start += size
 
     def reset(self) -> None:
         if hasattr(self.base, "reset"):
@@ -247,19 +252,37 @@ class GazeBlind:
         return getattr(self.base, name)
 
 
-def gaze_blind(agent: Policy, action_dim: int = 9) -> GazeBlind:
+@functools.lru_cache(maxsize=None)
+def _registered_action_structure(env_id: str) -> tuple[tuple[str, int], ...]:
+    import gymnasium as gym
+
+    import visuomotor_gym  # noqa: F401
+
+    env = gym.make(env_id)
+    try:
+        return tuple(env.unwrapped.action_structure.items())
+    finally:
+        env.close()
+
+
+def env_action_structure(env_id: str) -> dict[str, int]:
+    """The action blocks of a registered id (its env built once per process)."""
+    return dict(_registered_action_structure(env_id.removeprefix("visuomotor_gym:")))
+
+
+def gaze_blind(agent: Policy, action_structure: dict[str, int]) -> GazeBlind:
     """``agent`` with its gaze and head held (see :class:`GazeBlind`)."""
-    return GazeBlind(agent, action_dim)
+    return GazeBlind(agent, action_structure)
 
 
 def _gaze_blind(env_id, action_dim, seed, base=None, **kw):
     if kw:
         raise TypeError(f"gaze_blind takes no overrides of its own; put them on the base agent: {sorted(kw)}")
-    return GazeBlind(make_agent(base, env_id, action_dim, seed=seed), action_dim)
+    return GazeBlind(make_agent(base, env_id, action_dim, seed=seed), env_action_structure(env_id))
 
 
 def _fixed_gaze(env_id, action_dim, seed, **kw):
-    return GazeBlind(_eyecatch(env_id, action_dim, seed, **kw), action_dim)
+    return GazeBlind(_eyecatch(env_id, action_dim, seed, **kw), env_action_structure(env_id))
 
 
 def _oracle(env_id, action_dim, seed, **kw):
