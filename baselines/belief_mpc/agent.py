@@ -107,7 +107,11 @@ class BeliefMPCParams:
     head_lead_s: float = 0.08
     grasp_lead_s: float = 0.4  # close the hand when the ball is this far (in time) from the interception
     saccade_threshold_deg: float = 3.0  # the plant's
-    saccade_lookahead_s: float = 0.2  # how far along the plan a saccade target may lie
+    saccade_refractory_s: float = 0.2  # the plant's (Young & Stark 1963)
+    fixation_lookahead_s: float = 0.08  # the plan's fixated object is read this far ahead (2 nodes), where
+    # the plan has caught up with it (modelling choice)
+    first_saccade_min_latency_s: float = 0.18  # gaze held until then: human saccadic latency 180-200 ms
+    # (REFERENCES.md; the Eyecatch agent's value)
     # Vision assumed by the brain (set from the env id by ``for_env``).
     vision_noise_scale: float = 1.0
     foveated: bool = True
@@ -299,11 +303,8 @@ class BeliefMPCAgent:
             return self._action(hand if self.ready is None else self.ready, gaze_ret=(0.0, 0.0), head=head,
                                 fixation=None)
         h = self.h
-        nxt = self.plan.state_at(t + self.dt, h)
-        gaze_target = nxt[0:2]
-        if _angle(gaze, gaze_vector(*gaze_target)) > p.saccade_threshold_deg * DEG:
-            gaze_target = self._saccade_target(t, gaze_target)
-        gaze_ret = _retinal(rot, gaze_vector(*gaze_target))
+        gaze_target = self._gaze_request(t, obs, S, gaze, eye, live, delay)
+        gaze_ret = _retinal(rot, gaze_target)
         head_t = self.plan.state_at(t + p.head_lead_s, h)[2:4]
         hand_t = self.plan.state_at(t + p.hand_lead_s, h)[4:7]
         fixation = None
@@ -434,19 +435,60 @@ class BeliefMPCAgent:
             U[:, c] = np.interp(dst, src, old.U[:, c], right=0.0)
         return U
 
-    def _saccade_target(self, t: float, default: np.ndarray) -> np.ndarray:
-        """Where a planned gaze jump ends: the first plan node within the lookahead whose gaze speed is
-        back below the pursuit limit (the plant makes a saccade of the jump, so aim at its end)."""
+    def _desired_gaze(self, t: float, live: list[int], eye: np.ndarray, delay: float):
+        """The planned line of sight as a function of time: the predicted direction of the object the
+        plan fixates (the plan's own gaze when no object is tracked).
+
+        The plan starts at the eye's actual gaze and models the eye as an integrator (Eom 4.1); the
+        human plant is not one (saccades, pursuit with latency and gain), so what is executed is the
+        plan's *choice* of what to look at, not its first nodes: executing those (the request a step
+        along the plan) left the request stream moving with the eye itself, so the plant's pursuit
+        decayed and the eye fell 10-15 deg behind a fast ball (the miss rate doubled, issue 11). The
+        fixated object is the one nearest the plan's gaze ``fixation_lookahead_s`` ahead, where the
+        plan has reached it."""
+        p, plan, h = self.params, self.plan, self.h
+        t_look = t + p.fixation_lookahead_s
+        g_look = gaze_vector(*plan.state_at(t_look, h)[0:2])
+        best, best_ang = None, math.inf
+        for j in live:
+            d = self.balls[j].filter.extrapolate(delay + p.fixation_lookahead_s)[0] - eye
+            ang = _angle(g_look, d / max(float(np.linalg.norm(d)), 1e-9))
+            if ang <= best_ang:
+                best, best_ang = j, ang
+        if best is None:
+            return lambda s: gaze_vector(*plan.state_at(s, h)[0:2])
+        f = self.balls[best].filter
+
+        def direction(s: float) -> np.ndarray:
+            d = f.extrapolate(delay + (s - t))[0] - eye
+            return d / max(float(np.linalg.norm(d)), 1e-9)
+
+        return direction
+
+    def _gaze_request(self, t, obs, S, gaze, eye, live, delay) -> np.ndarray:
+        """The gaze request (world direction) that makes the human plant follow the planned line of
+        sight ``D``: as the Eyecatch agent does, the request is ``D`` a step ahead, so the request
+        stream moves with the fixated object and the plant pursues that motion (with its latency and
+        gain); when the plant can start a saccade and ``D`` is beyond its threshold, the request is
+        where ``D`` will be when the saccade lands (main-sequence duration plus a step), so the
+        catch-up saccade lands on the object rather than behind it. Until ``first_saccade_min_latency_s``
+        the gaze is held (human saccadic latency, as the Eyecatch agent's)."""
         p = self.params
-        plan, h = self.plan, self.h
-        k0 = int(math.ceil((t - plan.t0) / h + 1e-9))
-        k_max = min(len(plan.U), int((t - plan.t0 + p.saccade_lookahead_s) / h) + 1)
-        pursuit = 100.0 * DEG
-        for k in range(max(k0, 0), k_max):
-            speed = math.hypot(plan.U[k, 0] * math.cos(plan.X[k, 1]), plan.U[k, 1])
-            if speed < pursuit:
-                return plan.X[k, 0:2]
-        return plan.X[min(k_max, len(plan.X) - 1), 0:2] if k_max > k0 else default
+        if t < p.first_saccade_min_latency_s - 1e-9:
+            return gaze
+        D = self._desired_gaze(t, live, eye, delay)
+        in_saccade = obs[S["saccade"]][0] > 0.5
+        since_onset = float(obs[S["saccade"]][1])
+        ready = not in_saccade and since_onset >= p.saccade_refractory_s - 1e-9
+        nxt = D(t + self.dt)
+        error = _angle(gaze, nxt)
+        if ready and error > p.saccade_threshold_deg * DEG:
+            lead = self.dt
+            for _ in range(2):  # the landing time depends on the amplitude, which depends on it
+                amp_deg = _angle(gaze, D(t + lead)) / DEG
+                lead = self.dt + max(0.021 + 0.0022 * amp_deg, 1.875 * amp_deg / 800.0)  # plant's main sequence
+            return D(t + lead)
+        return nxt
 
     def _interception(self, ball: ObjectBelief, eye: np.ndarray, delay: float) -> tuple[np.ndarray, float]:
         """Where and when (s from now) the believed path first enters the preferred-distance sphere
