@@ -117,7 +117,8 @@ class BeliefMPCParams:
     foveated: bool = True
     visual_delay_s: float = 0.0
     gaze_action_range_deg: float = 60.0
-    reset_mahalanobis: float = 100.0  # real filter's adaptive reset (as the Eyecatch agent's)
+    reset_mahalanobis: float = KalmanParams().reset_mahalanobis  # real filter's adaptive reset: the one
+    # threshold of the Eyecatch filter (KalmanParams, chi^2 6 dof; issue 11: one threshold)
 
     def __post_init__(self) -> None:
         if self.gaze_cost not in GAZE_COSTS:
@@ -277,11 +278,16 @@ class BeliefMPCAgent:
         self._lap("perception")
 
         # --- target ball: the next to arrive ---------------------------------------------------------
+        # An object whose believed position is still vague (a first peripheral sighting of the second
+        # ball: depth std ~ 5 % of d / alpha, i.e. metres at 30 deg) has a meaningless arrival time; it
+        # becomes the hand's target only once known to ``hold_path_std_m`` (or when no other is).
         target, t_arr = None, math.inf
         intercepts = {}
         for j in live:
-            point, when = self._interception(self.balls[j], eye, delay)
-            intercepts[j] = (point, when)
+            intercepts[j] = self._interception(self.balls[j], eye, delay)
+        known = [j for j in live if np.trace(self.balls[j].filter.P[:3, :3]) / 3.0 <= p.hold_path_std_m**2]
+        for j in known or live:
+            when = intercepts[j][1]
             if when < t_arr:
                 target, t_arr = j, when
         self.target_ball = target
@@ -331,6 +337,10 @@ class BeliefMPCAgent:
                 ball_pos[:, j] = f.extrapolate(delay)[0]  # a first sighting: look where it is
             else:
                 ball_pos[:, j] = f.trajectory(times + delay)
+                # The catch ends the flight: past its interception the ball is in the hand, not on its
+                # ballistic path (planning along that path turned the head after a ball flying past it).
+                point, when = intercepts[j]
+                ball_pos[times > when, j] = point
             active[j] = self.balls[j].sigma is not None
         uct_weight = np.ones(nb)
         if p.gaze_cost == "sequential":
