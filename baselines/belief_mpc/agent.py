@@ -44,7 +44,7 @@ import time
 from dataclasses import dataclass, fields, replace
 
 import numpy as np
-from visuomotor_gym.baselines.eyecatch import KalmanParams
+from visuomotor_gym.baselines.eyecatch import EyecatchAgent, KalmanParams
 from visuomotor_gym.baselines.eyecatch.agent import SHOULDER_WORLD
 
 from visuomotor_gym.envs.actions import hand_action
@@ -73,6 +73,7 @@ class BeliefMPCParams:
     alpha: float = 0.2  # process noise Q = alpha I per 20 ms (Eom's alpha; 0.2 "realistic")
     fovea_smoothing_deg: float = 0.2  # eps of the smoothed eccentricity
     angular_uncertainty: bool = False  # r without its d^2 factor: uncertainty relative to distance
+    planner_slip: bool = True  # r grows with retinal slip, as the env's lateral noise (belief.py; issue 11)
     alpha_in_filter: bool = False  # also scale the real update's process noise by alpha / 0.2 (Eom's own
     # model uses one Q in planning and in the actual estimate; ours keeps the calibrated filter by default)
     prior_position_var: float = 1.0  # compact covariance of an object before its first observation (m^2)
@@ -194,10 +195,18 @@ class BeliefMPCAgent:
     def problems(self, n_objects: int) -> tuple[GazeBeliefProblem, HandProblem]:
         if n_objects not in self._problems:
             p = self.params
-            gaze = GazeBeliefProblem(n_objects, self.N, self.h, self.noise, self.q_plan, p.weights(), Limits(),
+            gaze = GazeBeliefProblem(n_objects, self.N, self.h, self.planning_noise, self.q_plan, p.weights(), Limits(),
                                      gaze_cost="distance" if p.gaze_cost == "distance" else "uncertainty")
             self._problems[n_objects] = (gaze, HandProblem(self.N, self.h, p.weights(), Limits()))
         return self._problems[n_objects]
+
+    @property
+    def planning_noise(self) -> ObservationNoise:
+        """The observation-noise model of the planner and of Eom's compact covariance: the env's vision
+        (``self.noise``, set by ``match_vision``), without its slip term when ``planner_slip`` is off."""
+        if self.params.planner_slip:
+            return self.noise
+        return replace(self.noise, knee_rad_s=math.inf)
 
     def reset(self) -> None:
         """Forget the episode (called by the evaluator, and on ``episode_start``)."""
@@ -272,7 +281,11 @@ class BeliefMPCAgent:
             if seen:
                 ball.fuse(np.concatenate([obs[S[bp]], obs[S[bv]]]), s_rot, s_eye, eye_turn, self.vision)
             s_az, s_el = math.atan2(s_rot[1, 0], s_rot[0, 0]), math.atan2(s_rot[2, 0], math.hypot(s_rot[0, 0], s_rot[1, 0]))
-            ball.update_sigma(seen, s_az, s_el, s_eye, self.noise, self.q_control)
+            slip = 0.0
+            if seen and ball.tracked:  # the retinal slip of the believed object during the step
+                f = ball.filter
+                slip = EyecatchAgent._retinal_speed(s_rot.T @ (f.x[:3] - s_eye), s_rot.T @ f.x[3:], eye_turn)
+            ball.update_sigma(seen, s_az, s_el, s_eye, self.planning_noise, self.q_control, slip=slip)
         delay = self.delay_steps * self.dt
         live = [j for j, b in enumerate(self.balls) if b.tracked and not caught[j]]
         self._lap("perception")
