@@ -44,7 +44,7 @@ import time
 from dataclasses import dataclass, fields, replace
 
 import numpy as np
-from visuomotor_gym.baselines.eyecatch import KalmanParams
+from visuomotor_gym.baselines.eyecatch import EyecatchAgent, KalmanParams
 from visuomotor_gym.baselines.eyecatch.agent import SHOULDER_WORLD
 
 from visuomotor_gym.envs.actions import hand_action
@@ -74,6 +74,7 @@ class BeliefMPCParams:
     alpha: float = 0.2  # process noise Q = alpha I per 20 ms (Eom's alpha; 0.2 "realistic")
     fovea_smoothing_deg: float = 0.2  # eps of the smoothed eccentricity
     angular_uncertainty: bool = False  # r without its d^2 factor: uncertainty relative to distance
+    planner_slip: bool = True  # r grows with retinal slip, as the env's lateral noise (belief.py; issue 11)
     alpha_in_filter: bool = False  # also scale the real update's process noise by alpha / 0.2 (Eom's own
     # model uses one Q in planning and in the actual estimate; ours keeps the calibrated filter by default)
     prior_position_var: float = 1.0  # compact covariance of an object before its first observation (m^2)
@@ -108,13 +109,18 @@ class BeliefMPCParams:
     head_lead_s: float = 0.08
     grasp_lead_s: float = 0.4  # close the hand when the ball is this far (in time) from the interception
     saccade_threshold_deg: float = 3.0  # the plant's
-    saccade_lookahead_s: float = 0.2  # how far along the plan a saccade target may lie
+    saccade_refractory_s: float = 0.2  # the plant's (Young & Stark 1963)
+    fixation_lookahead_s: float = 0.08  # the plan's fixated object is read this far ahead (2 nodes), where
+    # the plan has caught up with it (modelling choice)
+    first_saccade_min_latency_s: float = 0.18  # gaze held until then: human saccadic latency 180-200 ms
+    # (REFERENCES.md; the Eyecatch agent's value)
     # Vision assumed by the brain (set from the env id by ``for_env``).
     vision_noise_scale: float = 1.0
     foveated: bool = True
     visual_delay_s: float = 0.0
     gaze_action_range_deg: float = 60.0
-    reset_mahalanobis: float = 100.0  # real filter's adaptive reset (as the Eyecatch agent's)
+    reset_mahalanobis: float = KalmanParams().reset_mahalanobis  # real filter's adaptive reset: the one
+    # threshold of the Eyecatch filter (KalmanParams, chi^2 6 dof; issue 11: one threshold)
 
     def __post_init__(self) -> None:
         if self.gaze_cost not in GAZE_COSTS:
@@ -190,10 +196,18 @@ class BeliefMPCAgent:
     def problems(self, n_objects: int) -> tuple[GazeBeliefProblem, HandProblem]:
         if n_objects not in self._problems:
             p = self.params
-            gaze = GazeBeliefProblem(n_objects, self.N, self.h, self.noise, self.q_plan, p.weights(), Limits(),
+            gaze = GazeBeliefProblem(n_objects, self.N, self.h, self.planning_noise, self.q_plan, p.weights(), Limits(),
                                      gaze_cost="distance" if p.gaze_cost == "distance" else "uncertainty")
             self._problems[n_objects] = (gaze, HandProblem(self.N, self.h, p.weights(), Limits()))
         return self._problems[n_objects]
+
+    @property
+    def planning_noise(self) -> ObservationNoise:
+        """The observation-noise model of the planner and of Eom's compact covariance: the env's vision
+        (``self.noise``, set by ``match_vision``), without its slip term when ``planner_slip`` is off."""
+        if self.params.planner_slip:
+            return self.noise
+        return replace(self.noise, knee_rad_s=math.inf)
 
     def reset(self) -> None:
         """Forget the episode (called by the evaluator, and on ``episode_start``)."""
@@ -268,17 +282,26 @@ class BeliefMPCAgent:
             if seen:
                 ball.fuse(np.concatenate([obs[S[bp]], obs[S[bv]]]), s_rot, s_eye, eye_turn, self.vision)
             s_az, s_el = math.atan2(s_rot[1, 0], s_rot[0, 0]), math.atan2(s_rot[2, 0], math.hypot(s_rot[0, 0], s_rot[1, 0]))
-            ball.update_sigma(seen, s_az, s_el, s_eye, self.noise, self.q_control)
+            slip = 0.0
+            if seen and ball.tracked:  # the retinal slip of the believed object during the step
+                f = ball.filter
+                slip = EyecatchAgent._retinal_speed(s_rot.T @ (f.x[:3] - s_eye), s_rot.T @ f.x[3:], eye_turn)
+            ball.update_sigma(seen, s_az, s_el, s_eye, self.planning_noise, self.q_control, slip=slip)
         delay = self.delay_steps * self.dt
         live = [j for j, b in enumerate(self.balls) if b.tracked and not caught[j]]
         self._lap("perception")
 
         # --- target ball: the next to arrive ---------------------------------------------------------
+        # An object whose believed position is still vague (a first peripheral sighting of the second
+        # ball: depth std ~ 5 % of d / alpha, i.e. metres at 30 deg) has a meaningless arrival time; it
+        # becomes the hand's target only once known to ``hold_path_std_m`` (or when no other is).
         target, t_arr = None, math.inf
         intercepts = {}
         for j in live:
-            point, when = self._interception(self.balls[j], eye, delay)
-            intercepts[j] = (point, when)
+            intercepts[j] = self._interception(self.balls[j], eye, delay)
+        known = [j for j in live if np.trace(self.balls[j].filter.P[:3, :3]) / 3.0 <= p.hold_path_std_m**2]
+        for j in known or live:
+            when = intercepts[j][1]
             if when < t_arr:
                 target, t_arr = j, when
         self.target_ball = target
@@ -300,11 +323,8 @@ class BeliefMPCAgent:
             return self._action(hand if self.ready is None else self.ready, gaze_ret=(0.0, 0.0), head=head,
                                 fixation=None)
         h = self.h
-        nxt = self.plan.state_at(t + self.dt, h)
-        gaze_target = nxt[0:2]
-        if angle_between(gaze, gaze_vector(*gaze_target)) > p.saccade_threshold_deg * DEG:
-            gaze_target = self._saccade_target(t, gaze_target)
-        gaze_ret = _retinal(rot, gaze_vector(*gaze_target))
+        gaze_target = self._gaze_request(t, obs, S, gaze, eye, live, delay)
+        gaze_ret = _retinal(rot, gaze_target)
         head_t = self.plan.state_at(t + p.head_lead_s, h)[2:4]
         hand_t = self.plan.state_at(t + p.hand_lead_s, h)[4:7]
         fixation = None
@@ -331,6 +351,10 @@ class BeliefMPCAgent:
                 ball_pos[:, j] = f.extrapolate(delay)[0]  # a first sighting: look where it is
             else:
                 ball_pos[:, j] = f.trajectory(times + delay)
+                # The catch ends the flight: past its interception the ball is in the hand, not on its
+                # ballistic path (planning along that path turned the head after a ball flying past it).
+                point, when = intercepts[j]
+                ball_pos[times > when, j] = point
             active[j] = self.balls[j].sigma is not None
         uct_weight = np.ones(nb)
         if p.gaze_cost == "sequential":
@@ -435,19 +459,60 @@ class BeliefMPCAgent:
             U[:, c] = np.interp(dst, src, old.U[:, c], right=0.0)
         return U
 
-    def _saccade_target(self, t: float, default: np.ndarray) -> np.ndarray:
-        """Where a planned gaze jump ends: the first plan node within the lookahead whose gaze speed is
-        back below the pursuit limit (the plant makes a saccade of the jump, so aim at its end)."""
+    def _desired_gaze(self, t: float, live: list[int], eye: np.ndarray, delay: float):
+        """The planned line of sight as a function of time: the predicted direction of the object the
+        plan fixates (the plan's own gaze when no object is tracked).
+
+        The plan starts at the eye's actual gaze and models the eye as an integrator (Eom 4.1); the
+        human plant is not one (saccades, pursuit with latency and gain), so what is executed is the
+        plan's *choice* of what to look at, not its first nodes: executing those (the request a step
+        along the plan) left the request stream moving with the eye itself, so the plant's pursuit
+        decayed and the eye fell 10-15 deg behind a fast ball (the miss rate doubled, issue 11). The
+        fixated object is the one nearest the plan's gaze ``fixation_lookahead_s`` ahead, where the
+        plan has reached it."""
+        p, plan, h = self.params, self.plan, self.h
+        t_look = t + p.fixation_lookahead_s
+        g_look = gaze_vector(*plan.state_at(t_look, h)[0:2])
+        best, best_ang = None, math.inf
+        for j in live:
+            d = self.balls[j].filter.extrapolate(delay + p.fixation_lookahead_s)[0] - eye
+            ang = _angle(g_look, d / max(float(np.linalg.norm(d)), 1e-9))
+            if ang <= best_ang:
+                best, best_ang = j, ang
+        if best is None:
+            return lambda s: gaze_vector(*plan.state_at(s, h)[0:2])
+        f = self.balls[best].filter
+
+        def direction(s: float) -> np.ndarray:
+            d = f.extrapolate(delay + (s - t))[0] - eye
+            return d / max(float(np.linalg.norm(d)), 1e-9)
+
+        return direction
+
+    def _gaze_request(self, t, obs, S, gaze, eye, live, delay) -> np.ndarray:
+        """The gaze request (world direction) that makes the human plant follow the planned line of
+        sight ``D``: as the Eyecatch agent does, the request is ``D`` a step ahead, so the request
+        stream moves with the fixated object and the plant pursues that motion (with its latency and
+        gain); when the plant can start a saccade and ``D`` is beyond its threshold, the request is
+        where ``D`` will be when the saccade lands (main-sequence duration plus a step), so the
+        catch-up saccade lands on the object rather than behind it. Until ``first_saccade_min_latency_s``
+        the gaze is held (human saccadic latency, as the Eyecatch agent's)."""
         p = self.params
-        plan, h = self.plan, self.h
-        k0 = int(math.ceil((t - plan.t0) / h + 1e-9))
-        k_max = min(len(plan.U), int((t - plan.t0 + p.saccade_lookahead_s) / h) + 1)
-        pursuit = 100.0 * DEG
-        for k in range(max(k0, 0), k_max):
-            speed = math.hypot(plan.U[k, 0] * math.cos(plan.X[k, 1]), plan.U[k, 1])
-            if speed < pursuit:
-                return plan.X[k, 0:2]
-        return plan.X[min(k_max, len(plan.X) - 1), 0:2] if k_max > k0 else default
+        if t < p.first_saccade_min_latency_s - 1e-9:
+            return gaze
+        D = self._desired_gaze(t, live, eye, delay)
+        in_saccade = obs[S["saccade"]][0] > 0.5
+        since_onset = float(obs[S["saccade"]][1])
+        ready = not in_saccade and since_onset >= p.saccade_refractory_s - 1e-9
+        nxt = D(t + self.dt)
+        error = _angle(gaze, nxt)
+        if ready and error > p.saccade_threshold_deg * DEG:
+            lead = self.dt
+            for _ in range(2):  # the landing time depends on the amplitude, which depends on it
+                amp_deg = _angle(gaze, D(t + lead)) / DEG
+                lead = self.dt + max(0.021 + 0.0022 * amp_deg, 1.875 * amp_deg / 800.0)  # plant's main sequence
+            return D(t + lead)
+        return nxt
 
     def _interception(self, ball: ObjectBelief, eye: np.ndarray, delay: float) -> tuple[np.ndarray, float]:
         """Where and when (s from now) the believed path first enters the preferred-distance sphere

@@ -18,7 +18,21 @@ what keeps Eom's covariance compact, so ``r`` is the mean of the three positiona
 
     r = k^2 d^2 (1 + theta_s / E2)^2 + r_floor,   k^2 = s^2 (depth_frac^2 + 2 sigma_q^2) / 3
 
-with ``s`` the vision noise scale, ``depth_frac`` = 5 %, ``sigma_q`` = 1 arcmin and ``E2`` = 2 deg. The
+with ``s`` the vision noise scale, ``depth_frac`` = 5 %, ``sigma_q`` = 1 arcmin and ``E2`` = 2 deg.
+
+**Retinal slip** (issue 11): the environment's lateral std grows with the image's speed on the retina,
+``sigma_q max(1, slip / knee)`` (``VisionParams.position_slip_knee_deg_s`` = 2.5 deg/s, Westheimer &
+McKee 1975). The planner keeps the mean of the three variances with the two lateral ones scaled by a
+smooth ``1 + slip^2 / knee^2`` (modelling choice: differentiable, equal to the environment's
+``max(1, slip/knee)^2`` far above the knee and at most twice it near the knee)::
+
+    r = d^2 (1 + theta_s / E2)^2 (k^2 + k_lat^2 slip^2 / knee^2) + r_floor,   k_lat^2 = 2 s^2 sigma_q^2 / 3
+
+where ``slip`` is the angular speed of the object's direction minus the gaze's own: in the planner the
+gaze rate is a control, so the observation noise -- and through it Eom's uncertainty cost -- rewards
+pursuit that stabilises the image (and the planner's ``B`` depends on the trajectory). The lateral
+share is small at the fovea (1 arcmin against 5 % depth) and grows with slip: ~3 % of ``r`` at
+50 deg/s, ~40 % at 200 deg/s (an object crossing a still eye near the hand). The
 eccentricity is smoothed for differentiability: ``theta_s = sqrt(|g - u|^2 + eps^2)``, the chord
 between the unit gaze ``g`` and the unit direction ``u`` to the believed object (``|g - u| = 2 sin(theta/2)``,
 equal to ``theta`` to 1 % below 28 deg). Unlike Eom's saturating ``r``, this one keeps growing away from
@@ -60,14 +74,27 @@ class ObservationNoise:
     eps_rad: float = 0.2 * DEG  # eccentricity smoothing
     floor_m2: float = 1e-6  # measurement floor (1 mm std), as the Eyecatch filter's
     angular: bool = False  # True: drop the d^2 factor (uncertainty in units of the object's distance)
+    k2_slip: float = 0.0  # the lateral share of k2, scaled by slip^2 / knee^2 (module docstring)
+    knee_rad_s: float = math.inf  # slip knee (rad/s); inf: no slip term (the paper's static acuity)
 
     @classmethod
-    def from_vision(cls, vision: VisionParams, eps_deg: float = 0.2, angular: bool = False) -> ObservationNoise:
+    def from_vision(cls, vision: VisionParams, eps_deg: float = 0.2, angular: bool = False,
+                    slip: bool = True) -> ObservationNoise:
         s = vision.noise_scale
         sq = vision.retinal_position_std_arcmin * ARCMIN
         k2 = s * s * (vision.depth_std_fraction**2 + 2.0 * sq * sq) / 3.0
+        # The env applies the slip factor only with foveation (slip_factor); FullView has none.
+        knee = vision.position_slip_knee_deg_s * DEG if (slip and vision.foveated) else math.inf
         return cls(k2=k2, e2_rad=vision.fovea_e2_deg * DEG if vision.foveated else math.inf,
-                   eps_rad=eps_deg * DEG, angular=angular)
+                   eps_rad=eps_deg * DEG, angular=angular, k2_slip=2.0 * s * s * sq * sq / 3.0,
+                   knee_rad_s=knee)
+
+    @property
+    def slip_coef(self) -> float:
+        """``k_lat^2 / (k^2 knee^2)``: r = k^2 d^2 amp^2 (1 + slip_coef slip^2) + floor."""
+        if not math.isfinite(self.knee_rad_s) or self.k2 <= 0.0:
+            return 0.0
+        return self.k2_slip / (self.k2 * self.knee_rad_s**2)
 
 
 def gaze_vector(az, el):
@@ -85,10 +112,13 @@ def gaze_vector_derivatives(az, el):
     return g, g_az, g_el
 
 
-def observation_variance(noise: ObservationNoise, gaze_az, gaze_el, pos, eye, with_grad: bool = False):
+def observation_variance(noise: ObservationNoise, gaze_az, gaze_el, pos, eye, with_grad: bool = False,
+                         slip2=None):
     """``r`` for objects at world ``pos`` (..., 3) seen from ``eye`` (3,) with gaze (az, el) (...).
 
-    With ``with_grad`` also returns ``dr/d(az, el)`` (..., 2) and ``dr/dpos`` (..., 3).
+    ``slip2``: squared retinal slip (rad/s)^2 (broadcasts with the result; None: a stabilised image).
+    With ``with_grad`` also returns ``dr/d(az, el)`` (..., 2) and ``dr/dpos`` (..., 3), and, when
+    ``slip2`` is given, ``dr/dslip2`` (...).
     """
     rel = pos - eye
     d2 = np.maximum(np.einsum("...i,...i->...", rel, rel), 1e-12)
@@ -99,21 +129,26 @@ def observation_variance(noise: ObservationNoise, gaze_az, gaze_el, pos, eye, wi
     theta = np.sqrt(np.maximum(2.0 - 2.0 * gu, 0.0) + noise.eps_rad**2)
     amp = 1.0 + theta / noise.e2_rad
     scale = 1.0 if noise.angular else d2
-    r = noise.k2 * scale * amp * amp + noise.floor_m2
+    coef = noise.slip_coef
+    k2 = noise.k2 if slip2 is None or coef == 0.0 else noise.k2 * (1.0 + coef * np.asarray(slip2))
+    r = k2 * scale * amp * amp + noise.floor_m2
     if not with_grad:
         return r
     u = rel / d[..., None]
     g, g_az, g_el = gaze_vector_derivatives(gaze_az, gaze_el)
-    dr_dtheta = 2.0 * noise.k2 * scale * amp / noise.e2_rad
+    dr_dtheta = 2.0 * k2 * scale * amp / noise.e2_rad
     dtheta_dgu = -1.0 / theta
-    coef = dr_dtheta * dtheta_dgu  # dr / d(g.u)
-    dr_dgaze = np.stack([coef * np.sum(g_az * u, axis=-1), coef * np.sum(g_el * u, axis=-1)], axis=-1)
+    cgu = dr_dtheta * dtheta_dgu  # dr / d(g.u)
+    dr_dgaze = np.stack([cgu * np.sum(g_az * u, axis=-1), cgu * np.sum(g_el * u, axis=-1)], axis=-1)
     # d(g.u)/dpos = (g - (g.u) u) / d ;  d(d^2)/dpos = 2 rel
     dgu_dpos = (g - gu[..., None] * u) / d[..., None]
-    dr_dpos = coef[..., None] * dgu_dpos
+    dr_dpos = cgu[..., None] * dgu_dpos
     if not noise.angular:
-        dr_dpos = dr_dpos + (noise.k2 * amp * amp)[..., None] * 2.0 * rel
-    return r, dr_dgaze, dr_dpos
+        dr_dpos = dr_dpos + (k2 * amp * amp)[..., None] * 2.0 * rel
+    if slip2 is None:
+        return r, dr_dgaze, dr_dpos
+    dr_dslip2 = np.broadcast_to(noise.k2 * coef * scale * amp * amp, np.shape(r))
+    return r, dr_dgaze, dr_dpos, dr_dslip2
 
 
 def covariance_step(sigma: np.ndarray, r, h: float, q: float, with_grad: bool = False):

@@ -185,6 +185,22 @@ class GazeBeliefProblem:
         self._ux, self._uy, self._uz = (np.ascontiguousarray(self.ball_dir[..., c]) for c in range(3))
         self._kd2 = self.noise.k2 * (np.ones_like(d2) if self.noise.angular else d2)
         self._all_active = bool(np.all(self.active))
+        # Retinal slip (belief.py): the objects' angular velocity over each interval (azimuth and
+        # elevation rates, rad/s) against the gaze rate u; the azimuth difference is weighted by cos^2 of
+        # the elevation at the observed node (arc length on the sphere).
+        self._slip_coef = self.noise.slip_coef
+        az = np.arctan2(self.ball_dir[..., 1], self.ball_dir[..., 0])
+        el = np.arcsin(np.clip(self.ball_dir[..., 2], -1.0, 1.0))
+        self._w_az = ((np.diff(az, axis=0) + np.pi) % (2.0 * np.pi) - np.pi) / self.h  # (N, nb)
+        self._w_el = np.diff(el, axis=0) / self.h
+        self._c2 = np.cos(el[1:]) ** 2
+
+    def slip2(self, U: np.ndarray, i=slice(None)) -> np.ndarray:
+        """Squared retinal slip (rad/s)^2 of every object over interval(s) ``i`` for gaze rates ``U``
+        (..., m): ``cos^2(el) (u_az - w_az)^2 + (u_el - w_el)^2`` -> (..., nb)."""
+        da = U[..., 0:1] - self._w_az[i]
+        de = U[..., 1:2] - self._w_el[i]
+        return self._c2[i] * da * da + de * de
 
     # --- dynamics -----------------------------------------------------------------------------
     def step(self, x: np.ndarray, u: np.ndarray, i: int) -> np.ndarray:
@@ -199,7 +215,10 @@ class GazeBeliefProblem:
         # observation_variance() inlined (this is the innermost loop of every rollout)
         gu = ce * np.cos(az) * self._ux[j] + ce * np.sin(az) * self._uy[j] + np.sin(el) * self._uz[j]
         amp = 1.0 + np.sqrt(np.maximum(2.0 - 2.0 * gu, 0.0) + nz.eps_rad**2) / nz.e2_rad
-        r = self._kd2[j] * amp * amp + nz.floor_m2  # (B, nb)
+        if self._slip_coef:
+            r = self._kd2[j] * amp * amp * (1.0 + self._slip_coef * self.slip2(u, i)) + nz.floor_m2  # (B, nb)
+        else:
+            r = self._kd2[j] * amp * amp + nz.floor_m2
         sp, sv, spv = x[:, 4::3], x[:, 5::3], x[:, 6::3]
         a = sp + 2.0 * h * spv + h * h * sv + q
         b = spv + h * sv
@@ -217,17 +236,27 @@ class GazeBeliefProblem:
         N, nb = self.N, self.nb
         A = np.zeros((N, self.n, self.n))
         A[:, [0, 1, 2, 3], [0, 1, 2, 3]] = 1.0
-        r, dr_dg, _ = observation_variance(self.noise, X[:N, 0][:, None], X[:N, 1][:, None], self.ball_pos[1:],
-                                           self.eye, with_grad=True)
+        slip2 = self.slip2(U[:N]) if self._slip_coef else None
+        out = observation_variance(self.noise, X[:N, 0][:, None], X[:N, 1][:, None], self.ball_pos[1:],
+                                   self.eye, with_grad=True, slip2=slip2)
+        r, dr_dg = out[0], out[1]
         _, dsig, dr = covariance_step(X[:N, 4:].reshape(N, nb, 3), r, self.h, self.q, with_grad=True)
+        B = self.B
+        if slip2 is not None:  # the gaze rate changes the slip, so B depends on the trajectory
+            B = self.B.copy()
+            dr_ds = out[3]  # dr/dslip2 (N, nb)
+            dr_du = np.stack([dr_ds * 2.0 * self._c2 * (U[:N, 0:1] - self._w_az),
+                              dr_ds * 2.0 * (U[:N, 1:2] - self._w_el)], axis=-1)  # (N, nb, 2)
         for j in range(nb):
             s = slice(4 + 3 * j, 7 + 3 * j)
             if self.active[j]:
                 A[:, s, s] = dsig[:, j]
                 A[:, s, 0:2] = dr[:, j, :, None] * dr_dg[:, j, None, :]
+                if slip2 is not None:
+                    B[:, s, 0:2] = dr[:, j, :, None] * dr_du[:, j, None, :]
             else:
                 A[:, s, s] = np.eye(3)
-        return A, self.B
+        return A, B
 
     # --- cost ---------------------------------------------------------------------------------
     def _bounds(self, X):

@@ -73,11 +73,12 @@ class ObjectBelief:
         f.update(z, foveation.covariance(pos, speed, vision), rot, eye)
 
     def update_sigma(self, seen: bool, gaze_az: float, gaze_el: float, eye: np.ndarray,
-                     noise: ObservationNoise, q: float) -> None:
-        """Eom Eq. 4 for one control step with the actual gaze (prediction only when nothing was seen)."""
+                     noise: ObservationNoise, q: float, slip: float = 0.0) -> None:
+        """Eom Eq. 4 for one control step with the actual gaze (prediction only when nothing was seen);
+        ``slip``: the object's estimated retinal speed (rad/s) during the step."""
         if not self.filter.initialised:
             return
-        r = observation_variance(noise, gaze_az, gaze_el, self.filter.x[:3], eye) if seen else math.inf
+        r = observation_variance(noise, gaze_az, gaze_el, self.filter.x[:3], eye, slip2=slip * slip) if seen else math.inf
         if self.sigma is None:  # first sight: the prior, then this observation
             self.sigma = np.array(self.prior, dtype=float) if self.prior is not None else compact_from_covariance(self.filter.P)
         self.sigma = covariance_step(self.sigma, np.asarray(r), self.dt, q)
