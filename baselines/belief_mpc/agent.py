@@ -476,7 +476,7 @@ class BeliefMPCAgent:
         best, best_ang = None, math.inf
         for j in live:
             d = self.balls[j].filter.extrapolate(delay + p.fixation_lookahead_s)[0] - eye
-            ang = _angle(g_look, d / max(float(np.linalg.norm(d)), 1e-9))
+            ang = angle_between(g_look, d / max(float(np.linalg.norm(d)), 1e-9))
             if ang <= best_ang:
                 best, best_ang = j, ang
         if best is None:
@@ -505,11 +505,11 @@ class BeliefMPCAgent:
         since_onset = float(obs[S["saccade"]][1])
         ready = not in_saccade and since_onset >= p.saccade_refractory_s - 1e-9
         nxt = D(t + self.dt)
-        error = _angle(gaze, nxt)
+        error = angle_between(gaze, nxt)
         if ready and error > p.saccade_threshold_deg * DEG:
             lead = self.dt
             for _ in range(2):  # the landing time depends on the amplitude, which depends on it
-                amp_deg = _angle(gaze, D(t + lead)) / DEG
+                amp_deg = angle_between(gaze, D(t + lead)) / DEG
                 lead = self.dt + max(0.021 + 0.0022 * amp_deg, 1.875 * amp_deg / 800.0)  # plant's main sequence
             return D(t + lead)
         return nxt
