@@ -143,3 +143,19 @@ def register_envs() -> None:
             kwargs=dict(spec.kwargs),
             max_episode_steps=spec.max_episode_steps,
         )
+
+
+# The dodge family (issue 13; Eom et al. section 7): ObstacleDodge-v0 and its vision rungs.
+DODGE_ENTRY_POINT = "visuomotor_gym.envs.dodge:ObstacleDodgeEnv"
+DODGE_MAX_EPISODE_STEPS = 2000  # 40 s at 50 Hz: about three times the nominal walk (1.3 m/s) to the farthest (20 m) goal
+ENV_SPECS = ENV_SPECS + vision_rungs("ObstacleDodge", DODGE_ENTRY_POINT, family="dodge",
+                                     max_episode_steps=DODGE_MAX_EPISODE_STEPS, what="pedestrian")
+ENV_IDS = tuple(spec.id for spec in ENV_SPECS)
+FAMILIES.setdefault("dodge", tuple(s.id for s in ENV_SPECS if s.family == "dodge"))
+# The stones family (issue 13; Eom et al. 2019 section 7): SteppingStones-v0 and its vision rungs.
+STONES_ENTRY_POINT = "visuomotor_gym.envs.stones:SteppingStonesEnv"
+STONES_MAX_EPISODE_STEPS = 1000  # 20 s at 50 Hz: twice the nominal crossing (~18 steps of 0.5 s) (modelling choice)
+ENV_SPECS = ENV_SPECS + vision_rungs("SteppingStones", STONES_ENTRY_POINT, family="stones",
+                                     max_episode_steps=STONES_MAX_EPISODE_STEPS, what="stone")
+ENV_IDS = tuple(spec.id for spec in ENV_SPECS)
+FAMILIES["stones"] = FAMILIES.get("stones", ()) + tuple(s.id for s in ENV_SPECS if s.family == "stones")

@@ -1,0 +1,245 @@
+"""SteppingStones: cross a gap on stones seen only through a foveated, saccading eye (issue 13; Eom et
+al. 2019 section 7, seed 001).
+
+``SteppingStonesEnv`` composes the embodiment core (:mod:`visuomotor_gym.core`), the walker
+(:mod:`visuomotor_gym.body.walker_body`, unchanged) on ``envs_assets/stones.xml`` and the stepping-stones
+task (:mod:`visuomotor_gym.tasks.stepping_stones`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, fields, replace
+from typing import Any
+
+from visuomotor_gym.body import names
+from visuomotor_gym.body import walker_names as wn
+from visuomotor_gym.body.walker import GaitParams
+from visuomotor_gym.body.walker_body import WALKER_BLOCKS, WalkerBody
+from visuomotor_gym.core import args
+from visuomotor_gym.core.env import OBS_MODES, VisuomotorEnv
+from visuomotor_gym.core.eye import EYE_BLOCKS, Eye
+from visuomotor_gym.core.head import HEAD_BLOCKS, Head
+from visuomotor_gym.core.observation import ObservationLayout
+from visuomotor_gym.core.retina import VISION_MODES, Retina
+from visuomotor_gym.envs.walk import MAX_VISION_NOISE_SCALE, MAX_VISUAL_DELAY_S, WALK_VISION
+from visuomotor_gym.oculomotor.plant import DEG, OculomotorParams
+from visuomotor_gym.tasks.stepping_stones import (
+    DEFAULT_REWARD_WEIGHTS,
+    K_SLOTS,
+    PERCEPT_BLOCKS,
+    REWARD_TERMS,
+    STONES_SCENE,
+    STONES_SCENE_CAMERA,
+    TRAILING_BLOCKS,
+    CourseDistribution,
+    SteppingStonesTask,
+)
+from visuomotor_gym.vision.foveation import VisionParams
+
+__all__ = ["STONES_LAYOUT", "SteppingStonesEnv"]
+
+RENDER_CAMERAS = ("both", "side", "follow", "scene", "eye")
+STONES_LAYOUT = ObservationLayout(PERCEPT_BLOCKS + EYE_BLOCKS + HEAD_BLOCKS + WALKER_BLOCKS + TRAILING_BLOCKS)
+
+
+class SteppingStonesEnv(VisuomotorEnv):
+    """
+    ## Description
+
+    The walker of ObstacleWalk (pelvis, torso, two 5-DOF legs, neck and the cyclopean eye of every body
+    in this package) starts on a slab and crosses a gap on a path of stepping stones (radius 0.25 m,
+    0.65-0.85 m apart, the path turning by up to +-30 deg from one step to the next: the ALLSTEPS
+    benchmark, Xie et al. 2020), **seeing the stones only through a human-like eye**: the same
+    oculomotor plant, foveated noise (Eyecatch Eq. 1-3), saccadic suppression and vestibulo-ocular
+    reflex as the catch family, and the walk family's field: a stone is seen only within **20 deg of the
+    line of sight** (Iwao et al.'s view angle while walking, seed 003 section 4.2.3). The stone two steps
+    ahead lies ~45 deg below a level gaze: to place its feet the walker has to look down at the stones,
+    as humans fixate stepping targets about two steps ahead (Patla & Vickers 2003) and shift gaze to the
+    next stone as the foot starts its swing (Eom et al. 2019 section 7).
+
+    Walking is the scripted gait of ObstacleWalk with a **footstep-level action** (the next footstep's
+    length, lateral offset and toe clearance, read at each mid-stance; ``envs_assets/README.md``). The
+    stones and the slab are MuJoCo geoms that sense the feet: when a foot is flat after its heel strike
+    it must touch a support with its midfoot over the support's top, or the walker **falls** into the
+    gap. The walker keeps its heading (the gait does not turn), so the path stays within +-20 deg of the
+    slab's axis and every course is steppable (``visuomotor_gym.tasks.stepping_stones``). Physics
+    500 Hz, control 50 Hz. The rungs of the observability ladder are keyword arguments of this one
+    class (``visuomotor_gym.registration``).
+
+    ## Action Space
+
+    ``Box(-1, 1, (8,), float32)``; ``env.unwrapped.action_structure`` gives the blocks. Finite values
+    outside [-1, 1] are clipped; NaN, inf and wrong shapes raise ``ValueError``.
+
+    | index | block | meaning |
+    |---|---|---|
+    | 0 | footstep | step length, linear onto [0.25, 0.95] m, forward of the other foot's foothold |
+    | 1 | footstep | lateral offset from the nominal 0.12 m step width, linear onto [-0.3, 0.3] m (+ = left) |
+    | 2 | footstep | toe clearance (lowest sole point over the swing's carry phase), linear onto [0.02, 0.45] m |
+    | 3-4 | gaze | requested gaze change in retinal coordinates (azimuth, elevation) of the current eye frame, times ``gaze_action_range_deg`` (60 deg); 0 holds gaze fixed in the world |
+    | 5 | fixation | fixation (vergence) distance, log-mapped onto [0.1, 20] m; does not change the noise in v0 |
+    | 6-7 | head | head target: neck yaw in [-80, 80] deg and pitch in [-50, 40] deg (negative = down), reached at <= 300 deg/s |
+
+    The footstep is read at the mid-stance of each foot for the next step of that same foot (it lifts
+    ~0.3 s later and lands ~0.7 s later): ``gait_phase[2]`` says how long until the next read. The
+    foothold is the sole point under the ankle; the foot's centre is 7 cm ahead of it.
+
+    ## Observation Space
+
+    ``Box(-inf, inf, (N,), float32)`` (N in the table) by default, or with ``obs_mode="dict"`` a
+    ``Dict`` of the same blocks. The stone blocks are what the eye perceived of the centre of each stone's
+    top (the truth only with ``vision="oracle"``); everything else is proprioception. The four slots hold
+    the next four stones not yet stepped on (the id says which stone a slot holds).
+
+    OBSERVATION_TABLE
+
+    ## Rewards
+
+    A sum of named terms, each in ``info["reward_terms"]``: ``finish`` (+1 on landing on the last
+    stone), ``fall`` (-1 when a foot lands over the gap), ``stone`` (weight 0 by default; +1 per stone
+    landed on) and ``progress`` (weight 0 by default; x metres walked this step). ``reward_weights``
+    overrides any weight by name.
+
+    ## Starting State
+
+    The walker is in stride at 1.3 m/s on the slab, its left heel striking at the origin, head straight,
+    gaze level along the slab. Two more nominal footholds fit on the slab; the first stone is 0.65-0.85 m
+    beyond the second. The course is drawn from ``course_distribution`` (``CourseDistribution`` in
+    ``visuomotor_gym.tasks.stepping_stones``: 14 stones) before any vision noise, so a seed gives the same
+    course on every rung.
+
+    ## Episode End
+
+    Terminated when a foot lands off every support (``info["fell"]``), on landing on the last stone
+    (``info["finished"]``, ``info["is_success"]``), or when the physics diverges
+    (``info["physics_diverged"]``). Truncated only by the registered ``max_episode_steps`` (1000 steps =
+    20 s, twice the nominal crossing).
+
+    ## Arguments
+
+    | argument | default | meaning |
+    |---|---|---|
+    | ``render_mode`` | None | ``"rgb_array"`` or ``"human"`` |
+    | ``vision`` | ``"foveated"`` | ``"foveated"``, ``"full_view"`` (foveal noise everywhere, no field-of-view limit, no saccadic blindness) or ``"oracle"`` (true stone centres) |
+    | ``vision_noise_scale`` | 1.0 | multiplies every vision standard deviation (10: poor vision) |
+    | ``vision_params`` | None | ``VisionParams`` or a dict of its fields; default the walk family's (``field_of_view_deg`` = 20) |
+    | ``visual_delay_s`` | 0.0 | visual latency, a multiple of the control period |
+    | ``obs_mode`` | ``"flat"`` | ``"flat"`` or ``"dict"`` |
+    | ``reward_weights`` | None | dict overriding term weights (``finish``, ``fall``, ``stone``, ``progress``) |
+    | ``oculomotor_params`` | None | ``OculomotorParams`` or dict |
+    | ``gait_params`` | None | ``GaitParams`` or dict (``visuomotor_gym.body.walker``) |
+    | ``course_distribution`` | None | ``CourseDistribution`` or dict |
+    | ``control_dt`` | 0.02 | control period (s); a whole multiple of the 2 ms physics step |
+    | ``gaze_action_range_deg`` | 60.0 | gaze change at action +-1 |
+    | ``render_camera`` | ``"both"`` | ``"both"`` (side view beside the eye view), ``"side"``, ``"follow"``, ``"scene"``, ``"eye"`` |
+    | ``width``, ``height`` | 480, 360 | size of each rendered camera image |
+    | ``record_plant`` | False | keep the 500 Hz gaze trace |
+
+    ## Version History
+
+    * v0: initial release (issue 13).
+    """
+
+    render_cameras = {
+        "both": (wn.WALKER_SIDE_CAMERA, names.EYE_CAMERA),
+        "side": (wn.WALKER_SIDE_CAMERA,),
+        "follow": (wn.WALKER_FOLLOW_CAMERA,),
+        "scene": (STONES_SCENE_CAMERA,),
+        "eye": (names.EYE_CAMERA,),
+    }
+    eye_camera = names.EYE_CAMERA
+
+    def __init__(
+        self,
+        render_mode: str | None = None,
+        *,
+        vision: str = "foveated",
+        vision_noise_scale: float = 1.0,
+        vision_params: VisionParams | dict | None = None,
+        visual_delay_s: float = 0.0,
+        obs_mode: str = "flat",
+        reward_weights: dict[str, float] | None = None,
+        oculomotor_params: OculomotorParams | dict | None = None,
+        gait_params: GaitParams | dict | None = None,
+        course_distribution: CourseDistribution | dict | None = None,
+        control_dt: float = 0.02,
+        gaze_action_range_deg: float = 60.0,
+        render_camera: str = "both",
+        width: int = 480,
+        height: int = 360,
+        record_plant: bool = False,
+        **unknown: Any,
+    ):
+        self._reject_unknown(unknown)
+        if render_mode is not None:
+            args.choice(render_mode, self.metadata["render_modes"], "render_mode")
+        self.render_mode = render_mode
+        self.vision = args.choice(vision, VISION_MODES, "vision")
+        args.choice(obs_mode, OBS_MODES, "obs_mode")
+        self.render_camera = args.choice(render_camera, RENDER_CAMERAS, "render_camera")
+        scale = args.real(vision_noise_scale, "vision_noise_scale", low=0.0, high=MAX_VISION_NOISE_SCALE)
+        if isinstance(vision_params, dict):  # fields over the walk family's defaults (20 deg field)
+            allowed = {f.name for f in fields(VisionParams)}
+            bad = sorted(set(vision_params) - allowed)
+            if bad:
+                raise TypeError(f"vision_params: unknown field(s) {bad}; allowed: {sorted(allowed)}")
+            vision_params = replace(WALK_VISION, **vision_params)
+        elif vision_params is None:
+            vision_params = WALK_VISION
+        self.vision_params = args.coerce(VisionParams, vision_params, "vision_params").scaled(scale)
+        if vision == "full_view":
+            self.vision_params = VisionParams(**{**asdict(self.vision_params), "foveated": False})
+        self.oculomotor_params = args.coerce(OculomotorParams, oculomotor_params, "oculomotor_params")
+        self.gait_params = args.coerce(GaitParams, gait_params, "gait_params")
+        self.course_distribution = args.coerce(CourseDistribution, course_distribution, "course_distribution")
+        self.gaze_action_range = args.real(gaze_action_range_deg, "gaze_action_range_deg", low=0.0, high=180.0,
+                                           low_open=True) * DEG
+        weights = dict(DEFAULT_REWARD_WEIGHTS)
+        if reward_weights is not None and not isinstance(reward_weights, dict):
+            raise TypeError(f"reward_weights must be a dict of term -> weight, got {type(reward_weights).__name__}")
+        for name, value in (reward_weights or {}).items():
+            if name not in REWARD_TERMS:
+                raise ValueError(f"reward_weights: unknown term {name!r}; known terms: {list(REWARD_TERMS)}")
+            weights[name] = args.real(value, f"reward_weights[{name!r}]")
+        self.reward_weights = weights
+        self.record_plant = args.flag(record_plant, "record_plant")
+        control_dt = args.real(control_dt, "control_dt", low=0.0, high=1.0, low_open=True)
+        visual_delay_s = args.real(visual_delay_s, "visual_delay_s", low=0.0, high=MAX_VISUAL_DELAY_S)
+
+        self._load_physics(STONES_SCENE, control_dt)
+        self.visual_delay_s = float(visual_delay_s)
+        self.delay_steps = args.whole_multiple(visual_delay_s, self.dt, "visual_delay_s")
+        body = WalkerBody(self.model, self.gait_params)
+        task = SteppingStonesTask(self.model, body, course_distribution=self.course_distribution,
+                                  reward_weights=weights)
+        self._assemble(
+            body=body,
+            eye=Eye(self.model, self.oculomotor_params, self.gaze_action_range, record=self.record_plant),
+            head=Head(self.model, self.oculomotor_params),
+            retina=Retina(self.vision, self.vision_params, self.delay_steps, self.dt),
+            task=task,
+            obs_mode=obs_mode,
+            width=width,
+            height=height,
+        )
+        self.gait = body.gait
+
+    def _observe(self, saccading: bool):
+        # The pelvis frame moves: bring it (and the task's stone slots) up to date before the eye, head
+        # and body write their blocks in it.
+        self.frame.update(self.data)
+        self.task.update_slots(self.data)
+        return super()._observe(saccading)
+
+    @property
+    def course(self):
+        """This episode's course (:class:`~visuomotor_gym.tasks.stepping_stones.Course`; true state)."""
+        return self.task.course
+
+
+assert STONES_LAYOUT.structure == {b.name: b.size for b in STONES_LAYOUT.blocks}
+assert K_SLOTS == len(PERCEPT_BLOCKS)
+if SteppingStonesEnv.__doc__:
+    SteppingStonesEnv.__doc__ = SteppingStonesEnv.__doc__.replace(
+        "OBSERVATION_TABLE", "\n    ".join(STONES_LAYOUT.markdown_table().splitlines())
+    ).replace("(N,)", f"({STONES_LAYOUT.size},)").replace("(N in the table)", "")

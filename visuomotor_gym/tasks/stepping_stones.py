@@ -1,0 +1,306 @@
+"""The stepping-stones task (issue 13; Eom et al. 2019 section 7, seed 001): cross a gap on a path of
+stones seen only through the foveated eye; a foot that lands off every support ends the episode.
+
+**Course** (:func:`sample_course`, drawn first from the env's ``np_random`` so every rung of the ladder
+gets the same course for a seed): the walker starts on a slab (``envs_assets/stones.xml``) whose far
+edge lies 2.3 m ahead of its first heel strike; ``n_stones`` stones follow, each ``spacing_m`` from the
+previous one (0.65-0.85 m, ALLSTEPS: Xie et al. 2020, REFERENCES.md) in a direction that turns by up to
+``heading_change_deg`` (+-30 deg, ALLSTEPS) from the previous step's. The first stone is spaced from
+the nominal centre of the walker's last foot on the slab. Our walker does not turn its pelvis (the gait
+of :mod:`visuomotor_gym.body.walker` keeps one heading), so the path's direction stays within
+``max_heading_deg`` of the slab's axis and every course is *steppable*: a sequence of footholds exists
+with alternating feet, each foot's centre within ``foot_margin_m`` of its stone's centre and every
+lateral step inside the gait's range less ``lateral_slack_m`` (interval propagation; a draw that
+breaks it is redrawn). These three are modelling choices (stated with each constant).
+
+**Supports and falls.** The slab and the stones are MuJoCo geoms that sense the feet without pushing
+(``stones.xml``). When a foot is flat after its heel strike (the end of double support), it must touch a
+support (a contact in ``data.contact``) with its midfoot (the centre of the foot's box) over that
+support's top (within the stone's radius): otherwise it stands over the gap, the walker **falls** and
+the episode ends. Landing on the last stone is **success**. Stones may be skipped.
+
+**What the eye sees of a stone**: the centre of its top face (:class:`~visuomotor_gym.core.retina.PointTarget`;
+the radius, 0.25 m, is the same for every stone and part of the task's description). The observation
+holds the percepts of the ``K_SLOTS`` = 4 next stones (slot ``k`` = stone ``n + k``, ``n`` the first
+stone no foot has landed on yet): when the footstep onto stone ``n + 1`` is chosen (its mid-stance
+read) the slots reach two stones beyond it, as the walker must see >= 2 steps ahead (Matthis & Fajen
+2014) and ALLSTEPS' policy sees the next 2 targets. A stone not seen this step reads as zeros.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from visuomotor_gym.body import walker_names as wn
+from visuomotor_gym.core.observation import Block
+from visuomotor_gym.core.retina import PointTarget
+
+STONES_SCENE = "stones.xml"
+STONE_POOL = 16  # stone bodies in stones.xml (>= n_stones)
+STONE_NAMES = tuple(f"stone_{i:02d}" for i in range(STONE_POOL))  # mocap bodies and their cylinder geoms
+SLAB = "start_slab"
+STONES_SCENE_CAMERA = "stones_scene"
+STONE_TOP_Z = -0.005  # stones.xml: tops 5 mm below the soles' planned height (sensing, not pushing)
+K_SLOTS = 4
+FOOT_CENTRE_AHEAD_M = 0.07  # walker_body.xml: the foot box's centre is 7 cm ahead of the ankle (the foothold)
+REWARD_TERMS = ("finish", "fall", "stone", "progress")
+DEFAULT_REWARD_WEIGHTS = {"finish": 1.0, "fall": -1.0, "stone": 0.0, "progress": 0.0}
+LAST_STONE_RGBA = (0.20, 0.65, 0.30, 1.0)
+STONE_RGBA = (0.62, 0.60, 0.55, 1.0)
+
+
+@dataclass(frozen=True)
+class CourseDistribution:
+    """The course sampler's parameters (metres, degrees; uniform draws). Sources in the module docstring."""
+
+    n_stones: int = 14  # modelling choice: ~10 m of stones, 7 s of walking at 2 steps/s
+    spacing_m: tuple[float, float] = (0.65, 0.85)  # ALLSTEPS (Xie et al. 2020): centre-to-centre distance
+    heading_change_deg: float = 30.0  # ALLSTEPS: the path turns by up to +-30 deg from one step to the next
+    max_heading_deg: float = 20.0  # modelling choice: the walker keeps its heading; the path stays within +-20 deg
+    foot_margin_m: float = 0.12  # modelling choice: a steppable foot centre lies within 12 cm of the stone's centre
+    lateral_slack_m: float = 0.03  # modelling choice: the gait's lateral step range, less 3 cm each side
+    start_foot_x_m: float = 1.95 + FOOT_CENTRE_AHEAD_M  # nominal foot centre of the last foothold on the slab
+    start_foot_y_m: float = -0.06  # ... (the right foot, half the 0.12 m nominal step width to the right)
+    start_foot_spread_m: float = 0.10  # the slab leaves that foot this much freedom either side (modelling choice)
+
+
+@dataclass(frozen=True)
+class Course:
+    stones: np.ndarray  # (N, 2): centre x, y of each stone's top (world, the walker starts at the origin)
+    headings: np.ndarray  # (N,): direction (rad) from the previous stone (stone 0: from the last slab foot)
+
+
+def sample_course(rng: np.random.Generator, dist: CourseDistribution, lateral_range: tuple[float, float],
+                  step_width: tuple[float, float]) -> Course:
+    """One steppable course. ``lateral_range`` and ``step_width`` = (nominal, minimum) come from the
+    gait's parameters: a left foot lands ``max(nominal + lateral, minimum)`` left of the right foot."""
+    nominal, minimum = step_width
+    lo = max(nominal + lateral_range[0], minimum) + dist.lateral_slack_m  # smallest lateral step
+    hi = nominal + lateral_range[1] - dist.lateral_slack_m  # largest
+    m, turn, cap = dist.foot_margin_m, math.radians(dist.heading_change_deg), math.radians(dist.max_heading_deg)
+    x, y, psi = dist.start_foot_x_m, dist.start_foot_y_m, 0.0
+    a, b = y - dist.start_foot_spread_m, y + dist.start_foot_spread_m  # where the previous foot can be
+    rows, heads = [], []
+    for k in range(dist.n_stones):
+        left = k % 2 == 0  # stone 0 takes foothold 4, a left foot
+        ra, rb = (a + lo, b + hi) if left else (a - hi, b - lo)
+        for _ in range(100):
+            new_psi = min(max(psi + float(rng.uniform(-turn, turn)), -cap), cap)
+            s = float(rng.uniform(*dist.spacing_m))
+            nx, ny = x + s * math.cos(new_psi), y + s * math.sin(new_psi)
+            if max(ra, ny - m) <= min(rb, ny + m):
+                break
+        else:  # no draw was steppable: move the last one sideways into reach
+            ny = min(max(ny, ra - m + 1e-3), rb + m - 1e-3)
+            new_psi = math.atan2(ny - y, nx - x)
+        a, b = max(ra, ny - m), min(rb, ny + m)
+        rows.append((nx, ny))
+        heads.append(new_psi)
+        x, y, psi = nx, ny, new_psi
+    return Course(np.array(rows, dtype=float).reshape(-1, 2), np.array(heads, dtype=float))
+
+
+def stone_block(k: int) -> Block:
+    return Block(f"stone_{k}", 5, "-, m, 0/1",
+                 f"slot {k}: course index of the stone ({k} after the first one not yet stepped on); perceived "
+                 "centre of its top, eye frame (zeros when not seen); seen flag")
+
+
+PERCEPT_BLOCKS = tuple(stone_block(k) for k in range(K_SLOTS))
+TRAILING_BLOCKS = (
+    Block("odometry", 3, "m, m, rad", "pelvis x, y and heading relative to the start (path integration)"),
+    Block("stones_left", 1, "-", "stones not yet stepped on up to and including the last one"),
+    Block("time", 1, "s", "time since the start"),
+)
+
+
+class SteppingStonesTask:
+    """Course, visual targets, landings, rewards and info of SteppingStones. ``body`` is a
+    :class:`~visuomotor_gym.body.walker_body.WalkerBody` on ``stones.xml``."""
+
+    leading_blocks = PERCEPT_BLOCKS
+    trailing_blocks = TRAILING_BLOCKS
+    trace_step_fields = ("step_phase", "next_stone")
+    trace_flag_fields = ("stone_seen",)
+
+    def __init__(self, model: mujoco.MjModel, body, *, course_distribution: CourseDistribution,
+                 reward_weights: dict) -> None:
+        m = self.model = model
+        self.body = body
+        self.gait = body.gait
+        self.gait._ob_geom = {}  # no obstacle pool in this scene: the gait's trip checks see nothing
+        self.dist = course_distribution
+        if not 1 <= self.dist.n_stones <= STONE_POOL:
+            raise ValueError(f"course_distribution.n_stones must be in [1, {STONE_POOL}], got {self.dist.n_stones}")
+        self.reward_weights = reward_weights
+        self.geoms = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, n) for n in STONE_NAMES]
+        self.mocap = [int(m.body_mocapid[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, n)]) for n in STONE_NAMES]
+        self._park = [m.body_pos[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, n)].copy() for n in STONE_NAMES]
+        self.slab = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, SLAB)
+        if min(self.geoms + [self.slab]) < 0:
+            raise ValueError(f"the model lacks stones or the slab: is it envs_assets/{STONES_SCENE}?")
+        self.radius = float(m.geom_size[self.geoms[0], 0])  # one source: the XML (0.25 m, ALLSTEPS)
+        half_height = float(m.geom_size[self.geoms[0], 1])
+        self._stone_z = STONE_TOP_Z - half_height
+        sx, sy = m.geom_pos[self.slab, :2]
+        hx, hy = m.geom_size[self.slab, :2]
+        self.slab_box = (float(sx - hx), float(sx + hx), float(sy - hy), float(sy + hy))
+        self.support_of_geom = {g: i for i, g in enumerate(self.geoms)}
+        self.support_of_geom[self.slab] = -1
+        self.feet = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, wn.WALKER_LEG_GEOMS[s][2]) for s in (0, 1)]
+        self.all_targets = [PointTarget(n) for n in STONE_NAMES]
+        self.targets = self.all_targets
+        self.course = Course(np.zeros((0, 2)), np.zeros(0))
+        self.reset_state()
+
+    # --- episode ------------------------------------------------------------------------------
+    def reset_state(self) -> None:
+        self.success = self.fell = self.finished = False
+        self.next_stone = 0
+        self.landings: list[tuple[int, int, float]] = []  # (foothold, support: -1 slab / stone index, time)
+        self._next_check = 0  # the next foothold whose landing is checked
+        self._slots_for = -1
+        self._prev_x = 0.0
+        self.seen = [False] * K_SLOTS
+
+    def reset_episode(self, data: mujoco.MjData, rng: np.random.Generator) -> None:
+        """Draw the course and place the stones (the walker already stands at the start)."""
+        m, d, p = self.model, data, self.gait.p
+        self.course = course = sample_course(rng, self.dist, p.lateral_range_m, (p.step_width_m, p.min_step_width_m))
+        n = len(course.stones)
+        for i, t in enumerate(self.all_targets):
+            t.hidden = True
+            d.mocap_pos[self.mocap[i]] = self._park[i]
+        self.targets = self.all_targets[:n]
+        for i, (x, y) in enumerate(course.stones.tolist()):
+            d.mocap_pos[self.mocap[i]] = (x, y, self._stone_z)
+            m.geom_rgba[self.geoms[i]] = LAST_STONE_RGBA if i == n - 1 else STONE_RGBA
+            self.targets[i].place(x, y, STONE_TOP_Z)
+        self._prev_x = float(d.qpos[0])
+
+    def initial_gaze(self) -> tuple[np.ndarray, tuple[float, float]]:
+        """Gaze starts level, straight ahead along the slab's axis (as in ObstacleWalk)."""
+        return np.array([20.0, 0.0, 1.6]), (0.0, 0.0)
+
+    def initial_fixation(self, distance: float) -> float:
+        return distance
+
+    def reset_info(self) -> dict:
+        return {"stones": self.course.stones.copy(), "stone_radius": self.radius}
+
+    # --- what the evaluator records ----------------------------------------------------------
+    def trace_episode_fields(self) -> dict:
+        return {"stones": self.course.stones.copy(), "stone_radius": self.radius}
+
+    @staticmethod
+    def trace_final_fields(info: dict) -> dict:
+        return {"fell": bool(info["fell"]), "finished": bool(info["finished"])}
+
+    # --- physics ------------------------------------------------------------------------------
+    def before_physics(self, data: mujoco.MjData) -> None:
+        return None
+
+    def needs_substep_checks(self, data: mujoco.MjData) -> bool:
+        return False  # landings are checked once per control step (they fall on control-step boundaries)
+
+    def check_substep(self, data: mujoco.MjData) -> bool:
+        return False
+
+    # --- landings -----------------------------------------------------------------------------
+    def support_under(self, data: mujoco.MjData, side: int) -> int | None:
+        """The support (-1 slab, else stone index) that foot ``side`` stands on, or None over the gap:
+        a contact with the support and the midfoot over its top."""
+        foot = self.feet[side]
+        geom = data.contact.geom
+        mx, my = data.geom_xpos[foot, :2].tolist()
+        for i in range(data.ncon):
+            g1, g2 = int(geom[i, 0]), int(geom[i, 1])
+            other = g2 if g1 == foot else g1 if g2 == foot else None
+            s = self.support_of_geom.get(other) if other is not None else None
+            if s is None:
+                continue
+            if s < 0:
+                x0, x1, y0, y1 = self.slab_box
+                if x0 <= mx <= x1 and y0 <= my <= y1:
+                    return -1
+            else:
+                cx, cy = self.course.stones[s].tolist()
+                if (mx - cx) ** 2 + (my - cy) ** 2 <= self.radius ** 2:
+                    return s
+        return None
+
+    def _check_landings(self, data: mujoco.MjData) -> int:
+        """Check every foothold flat by now (heel strike + double support); return stones newly landed."""
+        g = self.gait
+        new = 0
+        while not self.fell and not self.finished and self._next_check * g.T + g.T_ds <= g.tick:
+            j = self._next_check
+            self._next_check += 1
+            s = self.support_under(data, g.side_of(j))
+            self.landings.append((j, -2 if s is None else s, float(data.time)))
+            if s is None:
+                self.fell = True
+            elif s >= 0:
+                new += 1
+                self.next_stone = max(self.next_stone, s + 1)
+                if s == len(self.course.stones) - 1:
+                    self.finished = True
+        return new
+
+    # --- observation --------------------------------------------------------------------------
+    def update_slots(self, data: mujoco.MjData) -> None:
+        """Sample only the slots' stones (the others cannot reach the observation)."""
+        if self._slots_for != self.next_stone:
+            n = self.next_stone
+            for i, t in enumerate(self.targets):
+                t.hidden = not (n <= i < n + K_SLOTS)
+            self._slots_for = n
+
+    def observe_leading(self, values: list, samples: list) -> None:
+        n_targets = len(samples)
+        for k in range(K_SLOTS):
+            i = self.next_stone + k
+            values.append(float(i))
+            if i < n_targets:
+                p, _, v = samples[i]
+            else:
+                p, v = [0.0, 0.0, 0.0], False
+            values += p
+            values.append(1.0 if v else 0.0)
+            self.seen[k] = bool(v)
+
+    def observe_trailing(self, values: list, samples: list, data: mujoco.MjData) -> None:
+        d = data
+        sx, sy = self.body.start_xy
+        values += (float(d.qpos[0]) - sx, float(d.qpos[1]) - sy, float(d.qpos[3]) - self.body.start_yaw,
+                   float(len(self.course.stones) - self.next_stone), float(d.time))
+
+    # --- outcome ------------------------------------------------------------------------------
+    def evaluate(self, data: mujoco.MjData, fired: bool, a: np.ndarray, eye) -> tuple[float, dict, bool, dict]:
+        was_fallen = self.fell
+        new = self._check_landings(data)
+        self.success = self.finished and not self.fell
+        x = float(data.qpos[0])
+        values = {"finish": 1.0 if (self.finished and new) else 0.0, "fall": 1.0 if self.fell and not was_fallen else 0.0,
+                  "stone": float(new), "progress": x - self._prev_x}
+        self._prev_x = x
+        terms = {k: w * values[k] for k, w in self.reward_weights.items() if w != 0.0}
+        return float(sum(terms.values())), terms, self.fell or self.finished, self.info(data)
+
+    def info(self, data: mujoco.MjData, *, diverged: bool = False) -> dict:
+        """Step information (no stone position: the course is in ``reset_info``, for scoring only)."""
+        return {
+            "fell": self.fell,
+            "finished": self.finished,
+            "next_stone": self.next_stone,
+            "stones_landed": sum(1 for _, s, _ in self.landings if s >= 0),
+            "stone_seen": False if diverged else any(self.seen),
+            "step_phase": self.gait.step_phase(),
+        }
+
+
+__all__ = ["K_SLOTS", "STONES_SCENE", "Course", "CourseDistribution", "SteppingStonesTask", "sample_course"]
