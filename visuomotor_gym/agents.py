@@ -371,3 +371,15 @@ def _faraway(env_id, action_dim, seed, **kw):
 # Reach family (issue 14). Its gaze-blind twin is ``faraway:gaze_blind=true`` (gaze, vergence and head held).
 register_agent("faraway", _faraway,
                "reach family: saccade to the object, then a reach along Faraway et al.'s (2007) Bézier path")
+
+
+def _fajen_warren(env_id, action_dim, seed, **kw):
+    from visuomotor_gym.baselines.fajen_warren import FajenWarrenAgent
+
+    return FajenWarrenAgent.for_env(env_id, **kw)
+
+
+# Dodge family (issue 13). Its gaze-blind twin is ``fajen_warren:gaze_blind=true`` (gaze and head held).
+register_agent("fajen_warren", _fajen_warren,
+               "dodge family: Fajen & Warren (2003) steering dynamics on filtered pedestrian percepts, gaze to the "
+               "highest collision risk (Olivier et al. 2012); fajen_warren:gaze_blind=true is its gaze-blind twin")

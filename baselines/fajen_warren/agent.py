@@ -1,0 +1,346 @@
+"""The ``fajen_warren`` agent for ObstacleDodge: Fajen & Warren's steering dynamics on its own estimates of
+the pedestrians, and gaze to the pedestrian with the highest collision risk.
+
+**Perception** (:class:`PedestrianFilter`): one constant-velocity Kalman filter per pedestrian slot in the
+path frame (x along the path from the start, y left). A visual sample (position and velocity in the eye
+frame) is placed in the path frame with the agent's proprioception (eye pose in the pelvis frame, the
+odometry block) and weighted by the vision model's own covariance (Eyecatch Eq. 1-3: depth 5 % and
+lateral 1 arcmin of the distance at the fovea, growing with eccentricity; velocity likewise), evaluated
+at the perceived point. Unmodelled accelerations (a veer) enter as white acceleration noise of
+``accel_std`` (modelling choice).
+
+**Steering** (Fajen & Warren 2003, JEP:HPP 29:343, the "steering dynamics" model; the same equations in
+Fajen, Warren, Temizer & Kaelbling 2003, IJCV 54:13): the direction of travel phi obeys
+
+    phi'' = -b phi' - k_g (phi - psi_g) (exp(-c1 d_g) + c2)
+            + sum_o k_o (phi - psi_o) exp(-c3 |phi - psi_o|) exp(-c4 d_o)
+
+with the goal at angle psi_g and distance d_g and each obstacle at psi_o, d_o; the gains are the
+paper's fits (b = 3.25 /s, k_g = 7.50 /s^2, c1 = 0.40 /m, c2 = 0.40, k_o = 198 /s^2, c3 = 6.5 /rad,
+c4 = 0.8 /m; values as we recall them from the paper, not re-read here). The model is for stationary
+obstacles at constant speed; for a moving pedestrian the obstacle term acts on where the pedestrian
+will be at the moment of closest approach (so the walker steers away from the meeting point, behind a
+crossing pedestrian), and only for pedestrians whose predicted closest distance is below
+``avoid_distance_m`` = 1 m (Olivier et al. 2012, Gait & Posture 36:399: walkers adapt only below a
+minimal predicted distance of ~1 m). Both adaptations are modelling choices. Speed stays at the nominal
+1.3 m/s, as in the model.
+
+**Gaze** (:meth:`FajenWarrenAgent._choose`): the agent fixates the pedestrian with the highest collision
+risk, where risk is the staleness of its estimate (time since it was last seen) weighted up for a
+pedestrian whose predicted closest distance is below 1 m soon (Olivier et al. 2012), and down for one
+that has passed; a fixation is held at least ``min_dwell_s`` = 0.3 s (about one human fixation while
+walking; modelling choice). Pedestrians not yet seen are searched for: the agent looks alternately
+``search_azimuth_deg`` = 45 deg to either side (where pedestrians 4-6 m to the side appear), each side
+an urgency that grows with the time since it was last scanned.
+
+``gaze_blind=True`` holds gaze and head (gaze action 0: gaze stays level at the goal; head straight):
+the gaze-blind twin of DESIGN section 2, the same filter and steering.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields, replace
+
+import numpy as np
+
+from visuomotor_gym.body.dodge_body import DodgeBody
+from visuomotor_gym.envs.dodge import DODGE_LAYOUT
+from visuomotor_gym.registration import env_vision
+from visuomotor_gym.tasks.obstacle_dodge import K_SLOTS, NOMINAL_SPEED
+from visuomotor_gym.vision.foveation import DEG, VisionParams, _los_rows, _sigmas
+
+_S = DODGE_LAYOUT.slices
+MIN_STD = 1e-3  # floor of the measurement std (the oracle rung is noiseless)
+
+
+@dataclass(frozen=True)
+class FajenWarrenParams:
+    # Vision assumed by the agent (set from the env id by ``for_env``).
+    vision_noise_scale: float = 1.0
+    foveated: bool = True
+    visual_delay_s: float = 0.0
+    gaze_action_range_deg: float = 60.0
+    control_dt: float = 0.02
+    # Fajen & Warren 2003 (see the module docstring).
+    b: float = 3.25
+    k_g: float = 7.50
+    c1: float = 0.40
+    c2: float = 0.40
+    k_o: float = 198.0
+    c3: float = 6.5
+    c4: float = 0.8
+    avoid_distance_m: float = 1.0  # Olivier et al. 2012
+    horizon_s: float = 6.0  # closest approaches further ahead are ignored (modelling choice)
+    heading_limit_deg: float = 25.0  # what the gait's +-0.3 m lateral step gives at 0.65 m steps
+    speed: float = NOMINAL_SPEED
+    # Speed (modelling choice beside the heading-only model; see the module docstring): candidate speeds,
+    # the footstep latency assumed before a new speed shows (~0.5-1 s: the step after next), and the
+    # preference for the nominal speed (m of predicted distance per m/s of change).
+    speeds: tuple = (0.7, 0.9, 1.1, 1.3, 1.5, 1.7, 1.9)
+    speed_latency_s: float = 0.7
+    speed_cost: float = 0.15
+    speed_margin_m: float = 1.2  # closest distances beyond this are all equally safe
+    # Perception and gaze (modelling choices, see the module docstring).
+    accel_std: float = 1.0  # m/s^2, white acceleration noise of the constant-velocity model
+    min_dwell_s: float = 0.3
+    search_azimuth_deg: float = 45.0
+    search_distance_m: float = 6.0
+    head_share: float = 0.5  # the head takes this share of a gaze shift's azimuth
+    gaze_blind: bool = False
+
+
+class PedestrianFilter:
+    """Constant-velocity Kalman filter of one pedestrian (path frame: x, y, vx, vy)."""
+
+    def __init__(self) -> None:
+        self.x = np.zeros(4)
+        self.P = np.eye(4) * 1e6
+        self.t = -1.0  # time of the last update (-1: never seen)
+        self.t_seen = -math.inf
+
+    @property
+    def known(self) -> bool:
+        return self.t >= 0.0
+
+    def predict_to(self, t: float, q: float) -> None:
+        if not self.known or t <= self.t:
+            return
+        dt = t - self.t
+        F = np.eye(4)
+        F[0, 2] = F[1, 3] = dt
+        G = np.array([[0.5 * dt * dt, 0.0], [0.0, 0.5 * dt * dt], [dt, 0.0], [0.0, dt]])
+        self.x = F @ self.x
+        self.P = F @ self.P @ F.T + (q * q) * (G @ G.T)
+        self.t = t
+
+    def update(self, t: float, z: np.ndarray, R: np.ndarray, q: float) -> None:
+        if not self.known:
+            self.x, self.P, self.t = z.copy(), R.copy(), t
+        else:
+            self.predict_to(t, q)
+            S = self.P + R
+            K = self.P @ np.linalg.inv(S)
+            self.x = self.x + K @ (z - self.x)
+            self.P = (np.eye(4) - K) @ self.P
+        self.t_seen = t
+
+
+class FajenWarrenAgent:
+    """See the module docstring. ``predict(obs) -> (action, state)`` on flat ObstacleDodge observations."""
+
+    def __init__(self, params: FajenWarrenParams | None = None) -> None:
+        self.params = p = params or FajenWarrenParams()
+        self.vision = VisionParams(noise_scale=p.vision_noise_scale, foveated=p.foveated)
+        self.delay_steps = round(p.visual_delay_s / p.control_dt)
+        self.gaze_range = p.gaze_action_range_deg * DEG
+        self.reset()
+
+    @classmethod
+    def for_env(cls, env_id: str, **overrides) -> FajenWarrenAgent:
+        base = FajenWarrenParams(**env_vision(env_id))
+        known = {f.name for f in fields(FajenWarrenParams)}
+        unknown = sorted(set(overrides) - known)
+        if unknown:
+            raise TypeError(f"unknown fajen_warren parameter(s) {unknown}; known: {sorted(known)}")
+        return cls(replace(base, **overrides))
+
+    def reset(self) -> None:
+        self.filters = [PedestrianFilter() for _ in range(K_SLOTS)]
+        self.phi = 0.0
+        self.phi_dot = 0.0
+        self.started = False
+        self.poses: list = []
+        self.target = None  # ("ped", k) or ("search", side)
+        self.target_since = -math.inf
+        self.scanned = {1: -math.inf, -1: -math.inf}
+        self.log: list[tuple] = []  # (time, target, phi) per step
+
+    def predict(self, observation, state=None, episode_start=None, deterministic=True):
+        obs = np.asarray(observation, dtype=float)
+        if obs.shape != (DODGE_LAYOUT.size,):
+            raise ValueError(f"FajenWarrenAgent expects the flat ObstacleDodge observation of size "
+                             f"{DODGE_LAYOUT.size}, got shape {obs.shape}")
+        if episode_start is not None and bool(np.asarray(episode_start).reshape(-1)[0]) and self.started:
+            self.reset()
+        self.started = True
+        return self._act(obs), state
+
+    # ------------------------------------------------------------------------------------------
+    def _act(self, obs: np.ndarray) -> np.ndarray:
+        p = self.params
+        ol = obs.tolist()
+        t = ol[_S["time"].start]
+        e0, r0, o0, pz = _S["eye_pos"].start, _S["eye_rot"].start, _S["odometry"].start, _S["pelvis"].start
+        odo = ol[o0:o0 + 3]
+        pose = (ol[e0:e0 + 3], ol[r0:r0 + 9], odo, ol[pz], t)
+        self.poses.append(pose)
+        if len(self.poses) > self.delay_steps + 1:
+            self.poses.pop(0)
+        seen_pose = self.poses[0] if len(self.poses) > self.delay_steps else pose
+        self._perceive(ol, seen_pose)
+        for f in self.filters:
+            f.predict_to(t, p.accel_std)
+        g0 = _S["to_goal"].start
+        c, s = math.cos(odo[2]), math.sin(odo[2])
+        goal = (odo[0] + c * ol[g0] - s * ol[g0 + 1], odo[1] + s * ol[g0] + c * ol[g0 + 1])
+        threats = self._threats(odo)
+        self._steer(odo, goal, threats)
+        v0 = _S["pelvis"].start
+        speed = self._speed(odo, (ol[v0 + 1], ol[v0 + 2]))
+        action = np.zeros(7, dtype=np.float32)
+        action[0:2] = DodgeBody.action_from_locomotion(self.phi - odo[2], speed)
+        if not p.gaze_blind:
+            action[2:7] = self._look(pose, threats, t)
+        return action
+
+    def _perceive(self, ol: list, pose) -> None:
+        eye_pos, rot, odo, _, t = pose
+        c, s = math.cos(odo[2]), math.sin(odo[2])
+        for k in range(K_SLOTS):
+            b = _S[f"pedestrian_{k}"].start
+            if ol[b] <= 0.0:
+                continue
+            pe, ve = ol[b + 1:b + 4], ol[b + 4:b + 7]
+            d = math.sqrt(pe[0] ** 2 + pe[1] ** 2 + pe[2] ** 2)
+            if d <= 0.0:
+                continue
+            ecc = math.acos(max(-1.0, min(1.0, pe[0] / d)))
+            lateral_speed = math.sqrt(max(ve[0] ** 2 + ve[1] ** 2 + ve[2] ** 2 - (sum(a * b for a, b in zip(pe, ve)) / d) ** 2, 0.0))
+            sig = _sigmas(d, ecc, lateral_speed / d, self.vision)
+            los = np.array(_los_rows(pe[0] / d, pe[1] / d, pe[2] / d))
+            Re = np.array(rot).reshape(3, 3)  # eye axes in the pelvis frame
+            Rw = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]) @ Re @ los  # line-of-sight axes, path frame
+            cov_p = Rw @ np.diag(np.maximum(sig[:3], MIN_STD) ** 2) @ Rw.T
+            cov_v = Rw @ np.diag(np.maximum(sig[3:], MIN_STD) ** 2) @ Rw.T
+            pw = np.array(rot).reshape(3, 3) @ np.array(pe) + np.array(eye_pos)
+            vw = np.array(rot).reshape(3, 3) @ np.array(ve)
+            z = np.array([odo[0] + c * pw[0] - s * pw[1], odo[1] + s * pw[0] + c * pw[1],
+                          c * vw[0] - s * vw[1], s * vw[0] + c * vw[1]])
+            R = np.zeros((4, 4))
+            R[:2, :2] = cov_p[:2, :2]
+            R[2:, 2:] = cov_v[:2, :2]
+            self.filters[k].update(t, z, R, self.params.accel_std)
+
+    def _threats(self, odo) -> list[tuple]:
+        """Per known pedestrian: (slot, closest-approach time, predicted closest distance, its position
+        then, whether it is still ahead or approaching)."""
+        p = self.params
+        wx, wy = odo[0], odo[1]
+        wvx, wvy = p.speed * math.cos(self.phi), p.speed * math.sin(self.phi)
+        out = []
+        for k, f in enumerate(self.filters):
+            if not f.known:
+                continue
+            x, y, vx, vy = f.x.tolist()
+            rx, ry, ux, uy = x - wx, y - wy, vx - wvx, vy - wvy
+            w2 = ux * ux + uy * uy
+            tca = min(max(-(rx * ux + ry * uy) / w2, 0.0), p.horizon_s) if w2 > 1e-9 else 0.0
+            dmin = math.hypot(rx + ux * tca, ry + uy * tca)
+            relevant = tca > 0.0 or rx > -0.5
+            out.append((k, tca, dmin, (x + vx * tca, y + vy * tca), relevant))
+        return out
+
+    def _steer(self, odo, goal, threats) -> None:
+        p = self.params
+        wx, wy = odo[0], odo[1]
+        psi_g = math.atan2(goal[1] - wy, goal[0] - wx)
+        d_g = math.hypot(goal[0] - wx, goal[1] - wy)
+        acc = -p.b * self.phi_dot - p.k_g * (self.phi - psi_g) * (math.exp(-p.c1 * d_g) + p.c2)
+        for _, tca, dmin, (ox, oy), relevant in threats:
+            if not relevant or dmin >= p.avoid_distance_m or tca <= 0.0:
+                continue
+            psi_o = math.atan2(oy - wy, ox - wx)
+            d_o = math.hypot(ox - wx, oy - wy)
+            diff = self.phi - psi_o
+            acc += p.k_o * diff * math.exp(-p.c3 * abs(diff)) * math.exp(-p.c4 * d_o)
+        dt = p.control_dt
+        self.phi_dot += acc * dt
+        self.phi += self.phi_dot * dt
+        lim = p.heading_limit_deg * DEG
+        if abs(self.phi - odo[2]) > lim:  # the gait's limit: the heading cannot go further
+            self.phi = odo[2] + math.copysign(lim, self.phi - odo[2])
+            self.phi_dot = 0.0
+
+    def _speed(self, odo, vel_local) -> float:
+        """The candidate speed whose predicted closest distance to every known pedestrian is largest
+        (capped at ``speed_margin_m``), less ``speed_cost`` per m/s away from the nominal speed. The
+        walker keeps its present velocity for ``speed_latency_s``, then walks at the candidate speed
+        along phi."""
+        p = self.params
+        known = [f for f in self.filters if f.known]
+        if not known:
+            return p.speed
+        c, s = math.cos(odo[2]), math.sin(odo[2])
+        v_now = np.array([c * vel_local[0] - s * vel_local[1], s * vel_local[0] + c * vel_local[1]])
+        tau = np.arange(0.0, p.horizon_s, 0.1)
+        lat = np.minimum(tau, p.speed_latency_s)
+        rest = np.maximum(tau - p.speed_latency_s, 0.0)
+        base = np.array(odo[:2])[None, :] + lat[:, None] * v_now[None, :]  # (T, 2)
+        direction = np.array([math.cos(self.phi), math.sin(self.phi)])
+        speeds = np.array(p.speeds)
+        walker = base[None, :, :] + speeds[:, None, None] * rest[None, :, None] * direction[None, None, :]  # (S, T, 2)
+        peds = np.array([f.x for f in known])  # (N, 4)
+        ped = peds[:, None, :2] + tau[None, :, None] * peds[:, None, 2:]  # (N, T, 2)
+        dist = np.linalg.norm(walker[:, None, :, :] - ped[None, :, :, :], axis=-1)  # (S, N, T)
+        closest = np.minimum(dist.min(axis=2).min(axis=1), p.speed_margin_m)
+        score = closest - p.speed_cost * np.abs(speeds - p.speed)
+        return float(speeds[int(np.argmax(score))])
+
+    # --- gaze ---------------------------------------------------------------------------------
+    def _choose(self, threats, t: float):
+        p = self.params
+        if self.target is not None and t - self.target_since < p.min_dwell_s:
+            return self.target
+        best, best_u = None, -math.inf
+        for k, tca, dmin, _, relevant in threats:
+            f = self.filters[k]
+            age = min(t - f.t_seen, 3.0)
+            w = 1.0 if relevant else 0.1
+            if relevant and dmin < p.avoid_distance_m + 0.5:
+                w *= 3.0 * (1.0 + 2.0 / (1.0 + tca))
+            u = (age + 0.05) * w
+            if u > best_u:
+                best, best_u = ("ped", k), u
+        unseen = sum(not f.known for f in self.filters)
+        if unseen:
+            for side in (1, -1):
+                u = 0.6 * min(t - self.scanned[side], 3.0)
+                if u > best_u:
+                    best, best_u = ("search", side), u
+        if best != self.target:
+            self.target, self.target_since = best, t
+        return self.target
+
+    def _look(self, pose, threats, t: float) -> list:
+        p = self.params
+        eye_pos, rot, odo, pelvis_z, _ = pose
+        target = self._choose(threats, t)
+        if target is None:
+            return [0.0] * 5
+        ex, ey = odo[0] + eye_pos[0], odo[1] + eye_pos[1]
+        ez = pelvis_z + eye_pos[2]
+        if target[0] == "ped":
+            x, y = self.filters[target[1]].x[:2].tolist()
+            tx, ty, tz = x, y, 1.5
+        else:
+            side = target[1]
+            self.scanned[side] = t
+            az = side * p.search_azimuth_deg * DEG
+            tx, ty, tz = ex + p.search_distance_m * math.cos(az), ey + p.search_distance_m * math.sin(az), ez
+        self.log.append((t, target, self.phi))
+        c, s = math.cos(odo[2]), math.sin(odo[2])
+        dx, dy, dz = tx - ex, ty - ey, tz - ez
+        wx, wy = c * dx + s * dy, -s * dx + c * dy  # pelvis frame
+        n = math.sqrt(wx * wx + wy * wy + dz * dz) or 1.0
+        wx, wy, wz = wx / n, wy / n, dz / n
+        (a00, a01, a02), (a10, a11, a12), (a20, a21, a22) = rot[0:3], rot[3:6], rot[6:9]
+        e0 = a00 * wx + a10 * wy + a20 * wz  # R^T w: in the eye frame
+        e1 = a01 * wx + a11 * wy + a21 * wz
+        e2 = a02 * wx + a12 * wy + a22 * wz
+        d_az = math.atan2(e1, e0)
+        d_el = math.atan2(e2, math.hypot(e0, e1))
+        r = self.gaze_range
+        head_yaw = p.head_share * math.atan2(wy, wx)
+        return [min(max(d_az / r, -1.0), 1.0), min(max(d_el / r, -1.0), 1.0), 0.0,
+                min(max(head_yaw / (80.0 * DEG), -1.0), 1.0), 0.0]

@@ -1,0 +1,231 @@
+"""ObstacleDodge: walk to a goal while pedestrians cross the path, seen only through a foveated, saccading
+eye (issue 13; Eom et al. section 7, seed 001).
+
+``ObstacleDodgeEnv`` composes the embodiment core (:mod:`visuomotor_gym.core`), the walker with a
+heading-and-speed action (:mod:`visuomotor_gym.body.dodge_body` over the scripted gait of
+:mod:`visuomotor_gym.body.walker`) and the dodge task (:mod:`visuomotor_gym.tasks.obstacle_dodge`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, fields, replace
+from typing import Any
+
+from visuomotor_gym.body import names
+from visuomotor_gym.body import walker_names as wn
+from visuomotor_gym.body.dodge_body import DodgeBody
+from visuomotor_gym.body.walker import GaitParams
+from visuomotor_gym.body.walker_body import WALKER_BLOCKS
+from visuomotor_gym.core import args
+from visuomotor_gym.core.env import OBS_MODES, VisuomotorEnv
+from visuomotor_gym.core.eye import EYE_BLOCKS, Eye
+from visuomotor_gym.core.head import HEAD_BLOCKS, Head
+from visuomotor_gym.core.observation import ObservationLayout
+from visuomotor_gym.core.retina import VISION_MODES, Retina
+from visuomotor_gym.envs.walk import MAX_VISION_NOISE_SCALE, MAX_VISUAL_DELAY_S, WALK_VISION
+from visuomotor_gym.oculomotor.plant import DEG, OculomotorParams
+from visuomotor_gym.tasks.obstacle_dodge import (
+    DEFAULT_REWARD_WEIGHTS,
+    PERCEPT_BLOCKS,
+    REWARD_TERMS,
+    TRAILING_BLOCKS,
+    CrowdDistribution,
+    ObstacleDodgeTask,
+)
+from visuomotor_gym.vision.foveation import VisionParams
+
+__all__ = ["DODGE_LAYOUT", "DODGE_SCENE", "ObstacleDodgeEnv"]
+
+DODGE_SCENE = "dodge.xml"
+DODGE_TOP_CAMERA = "dodge_top"
+RENDER_CAMERAS = ("both", "side", "follow", "top", "eye")
+DODGE_LAYOUT = ObservationLayout(PERCEPT_BLOCKS + EYE_BLOCKS + HEAD_BLOCKS + WALKER_BLOCKS + TRAILING_BLOCKS)
+
+
+class ObstacleDodgeEnv(VisuomotorEnv):
+    """
+    ## Description
+
+    The walker of ObstacleWalk-v0 (pelvis, torso, two 5-DOF legs, neck and the cyclopean eye of every
+    body in this package) walks to a goal line 15-20 m ahead while **four pedestrians** (capsules 0.25 m
+    in radius) appear at the sides, 4-6 m from the path, one every 1.5-3 s, and walk across it at
+    1.0-1.5 m/s; 10 % of them **veer onto a collision course** when they come within 3-5 m (Jovancevic,
+    Sullivan & Hayhoe). Coming closer to a pedestrian than the two bodies' radii is a **collision** and
+    ends the episode. The pedestrians are seen **only through the eye**: the same oculomotor plant,
+    foveated noise (Eyecatch Eq. 1-3), saccadic suppression and VOR as every family, within the walk
+    family's 20 deg recognition field (ObstacleWalk-v0); a pedestrian starting 5 m to the side lies
+    ~45 deg off a gaze along the path. Two or three pedestrians walk at once, on both sides: the eye has
+    to go from one to the other (Eom et al. section 7).
+
+    Walking is ObstacleWalk's scripted gait with a **heading-and-speed action**: the direction of travel
+    and the speed become the next footstep (length and lateral offset), read at each mid-stance; the
+    pelvis keeps facing the path (the gait has no turning step: ``visuomotor_gym.body.dodge_body``).
+    Physics 500 Hz, control 50 Hz. The rungs of the observability ladder are keyword arguments of this
+    one class (``visuomotor_gym.registration``).
+
+    ## Action Space
+
+    ``Box(-1, 1, (7,), float32)``; ``env.unwrapped.action_structure`` gives the blocks. Finite values
+    outside [-1, 1] are clipped; NaN, inf and wrong shapes raise ``ValueError``.
+
+    | index | block | meaning |
+    |---|---|---|
+    | 0 | locomotion | heading (direction of travel from the path, + = left), linear onto [-30, 30] deg; saturates at atan(0.3 m / step length) (25 deg at 1.3 m/s) |
+    | 1 | locomotion | speed, linear onto [0.7, 1.9] m/s (0: the nominal 1.3 m/s) |
+    | 2-3 | gaze | requested gaze change in retinal coordinates (azimuth, elevation) of the current eye frame, times ``gaze_action_range_deg`` (60 deg); 0 holds gaze fixed in the world |
+    | 4 | fixation | fixation (vergence) distance, log-mapped onto [0.1, 20] m; does not change the noise in v0 |
+    | 5-6 | head | head target: neck yaw in [-80, 80] deg and pitch in [-50, 40] deg (negative = down), reached at <= 300 deg/s |
+
+    ## Observation Space
+
+    ``Box(-inf, inf, (N,), float32)`` (N in the table) by default, or with ``obs_mode="dict"`` a
+    ``Dict`` of the same blocks. The pedestrian blocks are what the eye perceived this step (true
+    state only with ``vision="oracle"``): slot ``k`` holds pedestrian ``k`` of the episode (onset
+    order); everything else is proprioception, path integration and the goal's place (known).
+
+    OBSERVATION_TABLE
+
+    ## Rewards
+
+    A sum of named terms, each in ``info["reward_terms"]``: ``goal`` (+1 when the goal line is reached
+    without a collision), ``collision`` (-1) and ``progress`` (weight 0 by default; x metres walked
+    along the path this step). ``reward_weights`` overrides any weight by name.
+
+    ## Starting State
+
+    The walker is in stride at 1.3 m/s, its left heel striking at the origin, head straight, gaze level
+    at the goal. The crowd is drawn from ``crowd_distribution`` (``CrowdDistribution`` in
+    ``visuomotor_gym.tasks.obstacle_dodge``) before any vision noise, so a seed gives the same
+    pedestrians on every rung.
+
+    ## Episode End
+
+    Terminated at the first **collision** (``info["collided"]``), when the pelvis crosses the goal line
+    (``info["finished"]``; ``info["is_success"]`` when there was no collision), or when the physics
+    diverges (``info["physics_diverged"]``). Truncated only by the registered ``max_episode_steps``
+    (2000 steps = 40 s, about three times the nominal walk to the farthest goal).
+
+    ## Arguments
+
+    | argument | default | meaning |
+    |---|---|---|
+    | ``render_mode`` | None | ``"rgb_array"`` or ``"human"`` |
+    | ``vision`` | ``"foveated"`` | ``"foveated"``, ``"full_view"`` (foveal noise everywhere, no field-of-view limit, no saccadic blindness) or ``"oracle"`` (true state) |
+    | ``vision_noise_scale`` | 1.0 | multiplies every vision standard deviation (10: poor vision) |
+    | ``vision_params`` | None | ``VisionParams`` or a dict of its fields; the default is the walk family's (``field_of_view_deg`` = 20) |
+    | ``visual_delay_s`` | 0.0 | visual latency, a multiple of the control period |
+    | ``obs_mode`` | ``"flat"`` | ``"flat"`` or ``"dict"`` |
+    | ``reward_weights`` | None | dict overriding term weights (``goal``, ``collision``, ``progress``) |
+    | ``oculomotor_params`` | None | ``OculomotorParams`` or dict |
+    | ``gait_params`` | None | ``GaitParams`` or dict (``visuomotor_gym.body.walker``) |
+    | ``crowd_distribution`` | None | ``CrowdDistribution`` or dict |
+    | ``control_dt`` | 0.02 | control period (s); a whole multiple of the 2 ms physics step |
+    | ``gaze_action_range_deg`` | 60.0 | gaze change at action +-1 |
+    | ``render_camera`` | ``"both"`` | ``"both"`` (top view beside the eye view), ``"side"``, ``"follow"``, ``"top"``, ``"eye"`` |
+    | ``width``, ``height`` | 480, 360 | size of each rendered camera image |
+    | ``record_plant`` | False | keep the 500 Hz gaze trace |
+
+    ## Version History
+
+    * v0: initial release (issue 13).
+    """
+
+    render_cameras = {
+        "both": (DODGE_TOP_CAMERA, names.EYE_CAMERA),
+        "side": (wn.WALKER_SIDE_CAMERA,),
+        "follow": (wn.WALKER_FOLLOW_CAMERA,),
+        "top": (DODGE_TOP_CAMERA,),
+        "eye": (names.EYE_CAMERA,),
+    }
+    eye_camera = names.EYE_CAMERA
+
+    def __init__(
+        self,
+        render_mode: str | None = None,
+        *,
+        vision: str = "foveated",
+        vision_noise_scale: float = 1.0,
+        vision_params: VisionParams | dict | None = None,
+        visual_delay_s: float = 0.0,
+        obs_mode: str = "flat",
+        reward_weights: dict[str, float] | None = None,
+        oculomotor_params: OculomotorParams | dict | None = None,
+        gait_params: GaitParams | dict | None = None,
+        crowd_distribution: CrowdDistribution | dict | None = None,
+        control_dt: float = 0.02,
+        gaze_action_range_deg: float = 60.0,
+        render_camera: str = "both",
+        width: int = 480,
+        height: int = 360,
+        record_plant: bool = False,
+        **unknown: Any,
+    ):
+        self._reject_unknown(unknown)
+        if render_mode is not None:
+            args.choice(render_mode, self.metadata["render_modes"], "render_mode")
+        self.render_mode = render_mode
+        self.vision = args.choice(vision, VISION_MODES, "vision")
+        args.choice(obs_mode, OBS_MODES, "obs_mode")
+        self.render_camera = args.choice(render_camera, RENDER_CAMERAS, "render_camera")
+        scale = args.real(vision_noise_scale, "vision_noise_scale", low=0.0, high=MAX_VISION_NOISE_SCALE)
+        if isinstance(vision_params, dict):  # fields over the walk family's defaults (20 deg field)
+            allowed = {f.name for f in fields(VisionParams)}
+            bad = sorted(set(vision_params) - allowed)
+            if bad:
+                raise TypeError(f"vision_params: unknown field(s) {bad}; allowed: {sorted(allowed)}")
+            vision_params = replace(WALK_VISION, **vision_params)
+        elif vision_params is None:
+            vision_params = WALK_VISION
+        self.vision_params = args.coerce(VisionParams, vision_params, "vision_params").scaled(scale)
+        if vision == "full_view":
+            self.vision_params = VisionParams(**{**asdict(self.vision_params), "foveated": False})
+        self.oculomotor_params = args.coerce(OculomotorParams, oculomotor_params, "oculomotor_params")
+        self.gait_params = args.coerce(GaitParams, gait_params, "gait_params")
+        self.crowd_distribution = args.coerce(CrowdDistribution, crowd_distribution, "crowd_distribution")
+        self.gaze_action_range = args.real(gaze_action_range_deg, "gaze_action_range_deg", low=0.0, high=180.0,
+                                           low_open=True) * DEG
+        weights = dict(DEFAULT_REWARD_WEIGHTS)
+        if reward_weights is not None and not isinstance(reward_weights, dict):
+            raise TypeError(f"reward_weights must be a dict of term -> weight, got {type(reward_weights).__name__}")
+        for name, value in (reward_weights or {}).items():
+            if name not in REWARD_TERMS:
+                raise ValueError(f"reward_weights: unknown term {name!r}; known terms: {list(REWARD_TERMS)}")
+            weights[name] = args.real(value, f"reward_weights[{name!r}]")
+        self.reward_weights = weights
+        self.record_plant = args.flag(record_plant, "record_plant")
+        control_dt = args.real(control_dt, "control_dt", low=0.0, high=1.0, low_open=True)
+        visual_delay_s = args.real(visual_delay_s, "visual_delay_s", low=0.0, high=MAX_VISUAL_DELAY_S)
+
+        self._load_physics(DODGE_SCENE, control_dt)
+        self.visual_delay_s = float(visual_delay_s)
+        self.delay_steps = args.whole_multiple(visual_delay_s, self.dt, "visual_delay_s")
+        body = DodgeBody(self.model, self.gait_params)
+        task = ObstacleDodgeTask(self.model, body, crowd_distribution=self.crowd_distribution,
+                                 reward_weights=weights, dt=self.dt)
+        self._assemble(
+            body=body,
+            eye=Eye(self.model, self.oculomotor_params, self.gaze_action_range, record=self.record_plant),
+            head=Head(self.model, self.oculomotor_params),
+            retina=Retina(self.vision, self.vision_params, self.delay_steps, self.dt),
+            task=task,
+            obs_mode=obs_mode,
+            width=width,
+            height=height,
+        )
+        self.gait = body.gait
+
+    def _observe(self, saccading: bool):
+        self.frame.update(self.data)  # the pelvis frame moves: bring it up to date before the blocks
+        return super()._observe(saccading)
+
+    @property
+    def crowd(self):
+        """This episode's pedestrians (:class:`~visuomotor_gym.tasks.obstacle_dodge.Crowd`; true state)."""
+        return self.task.crowd
+
+
+assert DODGE_LAYOUT.structure == {b.name: b.size for b in DODGE_LAYOUT.blocks}
+if ObstacleDodgeEnv.__doc__:
+    ObstacleDodgeEnv.__doc__ = ObstacleDodgeEnv.__doc__.replace(
+        "OBSERVATION_TABLE", "\n    ".join(DODGE_LAYOUT.markdown_table().splitlines())
+    ).replace("(N,)", f"({DODGE_LAYOUT.size},)").replace("(N in the table)", "")

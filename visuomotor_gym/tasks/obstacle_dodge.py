@@ -1,0 +1,336 @@
+"""The obstacle-dodge task (issue 13; Eom et al. section 7, seed 001): walk to a goal 15-20 m ahead while
+pedestrians cross the path, seen only through the foveated eye; coming closer to one than the two bodies'
+radii is a collision and ends the episode.
+
+**Scenario** (:func:`sample_crowd`, drawn first from the env's ``np_random`` so every rung of the ladder
+gets the same crowd for a seed): the walker starts at the origin walking along +x at 1.3 m/s; the goal
+line lies 15-20 m ahead (issue 13). ``N_PEDESTRIANS`` = 4 pedestrians appear one after the other (onset
+0.3-1.5 s after the start, then every 1.5-3 s: modelling choice, so that two or three walk at once),
+each 4-6 m to one side, and walk straight across the path at 1.0-1.5 m/s (adults' comfortable walking
+speeds are 1.27-1.46 m/s, Bohannon 1997, Age Ageing 26:15; the wider range is a modelling choice), up to
+30 deg off the perpendicular (modelling choice). Each crosses the path where a walker going straight at
+the nominal 1.3 m/s would arrive ``timing_s`` later than the pedestrian (uniform in +-1.2 s: about 40 %
+of the crossers would hit a walker that neither looks nor steers; modelling choice). A pedestrian
+**veers** with probability 0.1 (Jovancevic, Sullivan & Hayhoe: 10 % of the pedestrians veered onto a
+collision course; REFERENCES.md): it starts on a course that misses (|timing| 1.0-1.5 s), and when it
+comes within 3-5 m of the walker it turns onto a collision course (toward the point where it would meet
+the walker if both kept their velocities) for ``veer_s`` = 1.5 s (the veer in Jovancevic et al. lasted
+~1 s before contact; 1.5 s: modelling choice), then resumes its course.
+
+**What the eye sees of a pedestrian**: one point on its axis at 1.5 m (upper chest, a modelling choice
+near the eyes' height so a level gaze sees it) with its velocity (:class:`PedestrianTarget`), sampled by
+the retina like any target (eccentricity-dependent noise on position and velocity, the walk family's 20
+deg recognition field, saccadic suppression, visual delay). The observation holds ``K_SLOTS`` = 4 slots,
+slot ``k`` = pedestrian ``k`` of the episode (in onset order; the number of pedestrians never exceeds the
+slots): seen flag, position and velocity in the eye frame (zeros when not seen this step).
+
+**Collision**: the horizontal distance from the pelvis axis to a pedestrian's axis below
+``PEDESTRIAN_RADIUS_M`` + the walker's half-width (its chest and arms, read from the model), checked every
+control step (closing speeds are <= 3.4 m/s: <= 7 cm per 20 ms step).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from visuomotor_gym.body import walker_names as wn
+from visuomotor_gym.core.observation import Block
+from visuomotor_gym.core.retina import VisualTarget
+
+N_PEDESTRIANS = 4
+K_SLOTS = N_PEDESTRIANS
+PEDESTRIAN_NAMES = tuple(f"pedestrian_{i}" for i in range(N_PEDESTRIANS))  # mocap bodies (envs_assets/dodge.xml)
+PEDESTRIAN_RADIUS_M = 0.25  # capsule radius in dodge.xml (shoulder breadth ~0.45-0.5 m; modelling choice)
+SEEN_HEIGHT_M = 1.5  # the point the eye sees on a pedestrian's axis (modelling choice, see above)
+NOMINAL_SPEED = 1.3  # m/s, the walker's nominal gait (visuomotor_gym.body.walker.GaitParams)
+PARK = (-30.0, 30.0, -5.0)
+REWARD_TERMS = ("goal", "collision", "progress")
+DEFAULT_REWARD_WEIGHTS = {"goal": 1.0, "collision": -1.0, "progress": 0.0}
+
+
+@dataclass(frozen=True)
+class CrowdDistribution:
+    """The scenario sampler's ranges (SI units; uniform draws). Sources in the module docstring."""
+
+    goal_m: tuple[float, float] = (15.0, 20.0)  # issue 13
+    first_onset_s: tuple[float, float] = (0.3, 1.5)
+    onset_gap_s: tuple[float, float] = (1.5, 3.0)
+    side_m: tuple[float, float] = (4.0, 6.0)  # lateral distance of the start from the path
+    speed_m_s: tuple[float, float] = (1.0, 1.5)
+    angle_deg: float = 30.0  # crossing direction within +-angle of the perpendicular
+    timing_s: float = 1.2  # walker's nominal arrival at the crossing point minus the pedestrian's
+    veer_p: float = 0.1  # Jovancevic, Sullivan & Hayhoe: 10 % veered onto a collision course
+    veer_timing_s: tuple[float, float] = (1.0, 1.5)  # |timing| of a veering pedestrian's first course
+    veer_distance_m: tuple[float, float] = (3.0, 5.0)  # the veer starts within this distance of the walker
+    veer_s: float = 1.5
+    min_crossing_m: float = 3.0  # crossing points between this far from the start ...
+    goal_clear_m: float = 1.0  # ... and this far before the goal
+
+
+@dataclass(frozen=True)
+class Crowd:
+    goal: float
+    # (N, 9): onset time, start x, start y, velocity x, velocity y, crossing x, timing, veers (0/1), veer distance
+    pedestrians: np.ndarray
+
+
+def sample_crowd(rng: np.random.Generator, dist: CrowdDistribution, n: int = N_PEDESTRIANS) -> Crowd:
+    goal = float(rng.uniform(*dist.goal_m))
+    rows = []
+    onset = float(rng.uniform(*dist.first_onset_s))
+    for _ in range(n):
+        side = 1.0 if rng.random() < 0.5 else -1.0
+        lateral = float(rng.uniform(*dist.side_m))
+        speed = float(rng.uniform(*dist.speed_m_s))
+        angle = float(rng.uniform(-dist.angle_deg, dist.angle_deg)) * math.pi / 180.0
+        veers = bool(rng.random() < dist.veer_p)
+        if veers:
+            timing = float(rng.uniform(*dist.veer_timing_s)) * (1.0 if rng.random() < 0.5 else -1.0)
+        else:
+            timing = float(rng.uniform(-dist.timing_s, dist.timing_s))
+        veer_distance = float(rng.uniform(*dist.veer_distance_m))
+        path = lateral / math.cos(angle)  # walked from the start to the crossing
+        t_cross = onset + path / speed
+        x_cross = NOMINAL_SPEED * (t_cross + timing)
+        x_cross = min(max(x_cross, dist.min_crossing_m), goal - dist.goal_clear_m)
+        vx, vy = speed * math.sin(angle), -side * speed * math.cos(angle)
+        x0, y0 = x_cross - vx * path / speed, -vy * path / speed
+        rows.append((onset, x0, y0, vx, vy, x_cross, timing, float(veers), veer_distance))
+        onset += float(rng.uniform(*dist.onset_gap_s))
+    return Crowd(goal, np.array(rows, dtype=float).reshape(-1, 9))
+
+
+class PedestrianTarget(VisualTarget):
+    """A pedestrian as the eye sees it: a point on its axis at ``SEEN_HEIGHT_M`` and its velocity, both
+    written by the task each step (world frame); hidden before its onset."""
+
+    def __init__(self, name: str) -> None:
+        self.name = name
+        self.position = np.array(PARK)
+        self.velocity = np.zeros(3)
+        self.hidden = True
+
+    def state(self, data: mujoco.MjData) -> tuple[np.ndarray, np.ndarray]:
+        return self.position, self.velocity
+
+
+def pedestrian_block(k: int) -> Block:
+    return Block(f"pedestrian_{k}", 7, "0/1, m, m/s",
+                 f"pedestrian {k} (onset order): seen flag, perceived position of its upper body (1.5 m up its "
+                 "axis) and perceived velocity, both in the eye frame (zeros when not seen this step)")
+
+
+PERCEPT_BLOCKS = tuple(pedestrian_block(k) for k in range(K_SLOTS))
+TRAILING_BLOCKS = (
+    Block("odometry", 3, "m, m, rad", "pelvis x, y and heading relative to the start (path integration)"),
+    Block("to_goal", 2, "m", "the goal line's centre relative to the pelvis, pelvis frame (x ahead, y left)"),
+    Block("time", 1, "s", "time since the start"),
+)
+
+
+class ObstacleDodgeTask:
+    """Crowd, visual targets, collision, rewards and info of ObstacleDodge. ``body`` is a
+    :class:`~visuomotor_gym.body.dodge_body.DodgeBody`."""
+
+    leading_blocks = PERCEPT_BLOCKS
+    trailing_blocks = TRAILING_BLOCKS
+    trace_step_fields = ("pedestrian_pos", "step_phase")
+    trace_flag_fields = ("pedestrian_seen",)
+
+    def __init__(self, model: mujoco.MjModel, body, *, crowd_distribution: CrowdDistribution,
+                 reward_weights: dict, dt: float) -> None:
+        self.model = model
+        self.body = body
+        self.gait = body.gait
+        self.dist = crowd_distribution
+        self.reward_weights = reward_weights
+        self.dt = dt
+        m = model
+        bodies = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, n) for n in PEDESTRIAN_NAMES]
+        if min(bodies) < 0:
+            raise ValueError("the model lacks the pedestrian bodies of envs_assets/dodge.xml")
+        self._mocap = [int(m.body_mocapid[b]) for b in bodies]
+        self._finish_mocap = int(m.body_mocapid[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, wn.WALKER_FINISH)])
+        chest = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "chest")
+        arm = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "left_arm")
+        arm_y = float(m.body_pos[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "left_arm")][1])
+        self.walker_radius = max(float(m.geom_size[chest][1] + m.geom_size[chest][0]),
+                                 arm_y + float(m.geom_size[arm][0]))
+        self.contact_distance = PEDESTRIAN_RADIUS_M + self.walker_radius
+        self.targets = [PedestrianTarget(n) for n in PEDESTRIAN_NAMES]
+        self.crowd = Crowd(0.0, np.zeros((0, 9)))
+        self.pos = np.zeros((N_PEDESTRIANS, 2))
+        self.vel = np.zeros((N_PEDESTRIANS, 2))
+        self.reset_state()
+
+    # --- episode ------------------------------------------------------------------------------
+    def reset_state(self) -> None:
+        self.success = self.collided = self.finished = False
+        self.active = [False] * N_PEDESTRIANS
+        self.veer_until = [-1.0] * N_PEDESTRIANS
+        self.veered = [False] * N_PEDESTRIANS
+        self.seen = [False] * N_PEDESTRIANS
+        self.min_gap = math.inf
+        self._prev_x = 0.0
+
+    def reset_episode(self, data: mujoco.MjData, rng: np.random.Generator) -> None:
+        self.crowd = sample_crowd(rng, self.dist)
+        self.pos = self.crowd.pedestrians[:, 1:3].copy()
+        self.vel = self.crowd.pedestrians[:, 3:5].copy()
+        for i in range(N_PEDESTRIANS):
+            self._park(data, i)
+        data.mocap_pos[self._finish_mocap] = (self.crowd.goal, 0.0, 0.0)
+        self._prev_x = float(data.qpos[0])
+        self._activate(data, 0.0)
+
+    def _park(self, data, i: int) -> None:
+        data.mocap_pos[self._mocap[i]] = PARK
+        t = self.targets[i]
+        t.hidden = True
+        t.position[:] = PARK
+        t.velocity[:] = 0.0
+
+    def _activate(self, data, t: float) -> None:
+        for i, row in enumerate(self.crowd.pedestrians.tolist()):
+            if not self.active[i] and t >= row[0] - 1e-9:
+                self.active[i] = True
+                self.targets[i].hidden = False
+                self._write(data, i)
+
+    def _write(self, data, i: int) -> None:
+        x, y = self.pos[i].tolist()
+        data.mocap_pos[self._mocap[i]] = (x, y, 0.0)
+        t = self.targets[i]
+        t.position[:] = (x, y, SEEN_HEIGHT_M)
+        t.velocity[:2] = self.vel[i]
+
+    def initial_gaze(self) -> tuple[np.ndarray, tuple[float, float]]:
+        """Gaze starts level, straight ahead at the goal, at eye height."""
+        return np.array([self.crowd.goal, 0.0, 1.6]), (0.0, 0.0)
+
+    def initial_fixation(self, distance: float) -> float:
+        return distance
+
+    def reset_info(self) -> dict:
+        return {"goal_distance": self.crowd.goal, "pedestrians": self.crowd.pedestrians.copy()}
+
+    def trace_episode_fields(self) -> dict:
+        return {"goal_distance": float(self.crowd.goal), "pedestrians": self.crowd.pedestrians.copy()}
+
+    @staticmethod
+    def trace_final_fields(info: dict) -> dict:
+        return {"collided": bool(info["collided"]), "finished": bool(info["finished"]),
+                "veered": np.asarray(info["veered"], dtype=bool), "min_gap": float(info["min_gap"])}
+
+    # --- physics: the pedestrians move kinematically, once per control step ------------------
+    def before_physics(self, data: mujoco.MjData) -> None:
+        t_end = float(data.time) + self.dt - self.body.gait.t0
+        wx, wy = float(data.qpos[0]), float(data.qpos[1])
+        wvx, wvy = float(data.qvel[0]), float(data.qvel[1])
+        rows = self.crowd.pedestrians
+        for i in range(N_PEDESTRIANS):
+            if not self.active[i]:
+                continue
+            row = rows[i]
+            px, py = self.pos[i].tolist()
+            if row[7] > 0.0 and not self.veered[i] and math.hypot(px - wx, py - wy) < row[8] and px > wx:
+                self.veered[i] = True
+                self.veer_until[i] = t_end + self.dist.veer_s
+                self.vel[i] = intercept_velocity(px, py, float(np.hypot(*row[3:5])), wx, wy, wvx, wvy)
+            elif self.veered[i] and 0.0 <= self.veer_until[i] <= t_end:
+                self.vel[i] = row[3:5]
+                self.veer_until[i] = -1.0
+            self.pos[i] += self.vel[i] * self.dt
+            self._write(data, i)
+        self._activate(data, t_end)
+
+    def needs_substep_checks(self, data: mujoco.MjData) -> bool:
+        return False
+
+    def check_substep(self, data: mujoco.MjData) -> bool:
+        return False
+
+    # --- observation --------------------------------------------------------------------------
+    def observe_leading(self, values: list, samples: list) -> None:
+        for k in range(K_SLOTS):
+            p, v, visible = samples[k]
+            self.seen[k] = visible
+            values.append(1.0 if visible else 0.0)
+            values += p
+            values += v
+
+    def observe_trailing(self, values: list, samples: list, data: mujoco.MjData) -> None:
+        sx, sy = self.body.start_xy
+        x, y = float(data.qpos[0]), float(data.qpos[1])
+        gx, gy, _ = self.body.frame.to_local(sx + self.crowd.goal, sy, 0.0)
+        values += (x - sx, y - sy, float(data.qpos[3]) - self.body.start_yaw, gx, gy, float(data.time))
+
+    # --- outcome ------------------------------------------------------------------------------
+    def gaps(self, data: mujoco.MjData) -> list[float]:
+        """Horizontal distance minus the contact distance, per active pedestrian (inf when inactive)."""
+        x, y = float(data.qpos[0]), float(data.qpos[1])
+        return [math.hypot(px - x, py - y) - self.contact_distance if a else math.inf
+                for (px, py), a in zip(self.pos.tolist(), self.active)]
+
+    def evaluate(self, data: mujoco.MjData, fired: bool, a: np.ndarray, eye) -> tuple[float, dict, bool, dict]:
+        gap = min(self.gaps(data))
+        self.min_gap = min(self.min_gap, gap)
+        new_collision = gap < 0.0 and not self.collided
+        self.collided = self.collided or gap < 0.0
+        x = float(data.qpos[0])
+        arrived = not self.finished and x - self.body.start_xy[0] >= self.crowd.goal
+        self.finished = self.finished or arrived
+        self.success = self.finished and not self.collided
+        values = {"goal": 1.0 if (arrived and self.success) else 0.0, "collision": 1.0 if new_collision else 0.0,
+                  "progress": x - self._prev_x}
+        self._prev_x = x
+        terms = {k: w * values[k] for k, w in self.reward_weights.items() if w != 0.0}
+        return float(sum(terms.values())), terms, self.collided or self.finished, self.info(data)
+
+    def info(self, data: mujoco.MjData, *, diverged: bool = False) -> dict:
+        """Step information (pedestrian positions are true state: for scoring only, never for a policy)."""
+        ped = np.full((N_PEDESTRIANS, 3), np.nan)
+        for i in range(N_PEDESTRIANS):
+            if self.active[i]:
+                ped[i] = (self.pos[i, 0], self.pos[i, 1], SEEN_HEIGHT_M)
+        return {
+            "collided": self.collided,
+            "finished": self.finished,
+            "min_gap": self.min_gap,
+            "veered": list(self.veered),
+            "pedestrian_pos": ped,
+            "pedestrian_seen": False if diverged else any(self.seen),
+            "step_phase": self.gait.step_phase(),
+        }
+
+
+def intercept_velocity(px: float, py: float, speed: float, wx: float, wy: float, wvx: float, wvy: float):
+    """The velocity of the given speed that meets a walker at (wx, wy) moving at (wvx, wvy) (the
+    smallest positive meeting time; straight at the walker when no meeting is possible)."""
+    rx, ry = wx - px, wy - py
+    a = wvx * wvx + wvy * wvy - speed * speed
+    b = 2.0 * (rx * wvx + ry * wvy)
+    c = rx * rx + ry * ry
+    t = math.inf
+    if abs(a) < 1e-9:
+        t = -c / b if b < 0.0 else math.inf
+    else:
+        disc = b * b - 4.0 * a * c
+        if disc >= 0.0:
+            roots = [(-b - math.sqrt(disc)) / (2.0 * a), (-b + math.sqrt(disc)) / (2.0 * a)]
+            positive = [r for r in roots if r > 0.0]
+            t = min(positive) if positive else math.inf
+    if math.isfinite(t):
+        dx, dy = rx + wvx * t, ry + wvy * t
+    else:
+        dx, dy = rx, ry
+    n = math.hypot(dx, dy) or 1.0
+    return np.array([speed * dx / n, speed * dy / n])
+
+
+__all__ = ["K_SLOTS", "N_PEDESTRIANS", "Crowd", "CrowdDistribution", "ObstacleDodgeTask", "PedestrianTarget",
+           "intercept_velocity", "sample_crowd"]
