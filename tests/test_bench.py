@@ -404,3 +404,40 @@ def test_bench_command_bad_arguments(tmp_path, capsys):
     assert not (tmp_path / "r.json").exists()
     args = parser.parse_args([*common, "--env", ORACLE_ENV, "--episodes", "0"])
     assert args.func(args) == 2 and "episodes must be >= 1" in capsys.readouterr().err
+
+
+def test_bench_gaze_gain_plays_the_twin_on_the_same_seeds(tmp_path):
+    """`vmgym bench --gaze-gain`: the twin (gaze_blind:<agent>) on the same seeds; gain = success - twin's."""
+    import json
+    import subprocess
+    import sys
+
+    out = tmp_path / "gain.json"
+    proc = subprocess.run(
+        [sys.executable, "-m", "visuomotor_gym.cli", "bench", "--agent", "eyecatch", "--env", "EyeCatch-v0",
+         "--episodes", "6", "--seed", "0", "--gaze-gain", "--out", str(out), "--no-progress"],
+        capture_output=True, text=True, timeout=600,
+    )
+    assert proc.returncode == 0, proc.stderr
+    results = json.loads(out.read_text())
+    gain = results["gaze_gain"]
+    assert gain["twin_agent"] == "gaze_blind:eyecatch"
+    twin = evaluate("gaze_blind:eyecatch", "EyeCatch-v0", 6, 0)
+    assert gain["twin_success_rate"] == twin.summary["success_rate"]
+    assert gain["gain"] == pytest.approx(results["success_rate"] - gain["twin_success_rate"])
+    assert "gaze gain" in proc.stdout and "--gaze-gain" in results["provenance"]["command"]
+    # a forged gain is refused by the results validator
+    from visuomotor_gym.bench.results import ResultsError, validate_results
+
+    results["gaze_gain"]["gain"] = 0.9
+    with pytest.raises(ResultsError, match="gain"):
+        validate_results(results)
+
+
+def test_the_twin_of_a_twin_is_refused():
+    from visuomotor_gym.bench.evaluate import twin_spec
+
+    assert twin_spec("belief_mpc") == "gaze_blind:belief_mpc"
+    for spec in ("fixed_gaze", "gaze_blind:eyecatch"):
+        with pytest.raises(ValueError, match="already a gaze-blind agent"):
+            twin_spec(spec)

@@ -29,6 +29,9 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, required=True, help="first seed (>= 0); episode i uses seed + i")
     p.add_argument("--out", required=True, help="results JSON file to write")
     p.add_argument("--workers", type=int, default=1, help="worker processes (default 1: in-process)")
+    p.add_argument("--gaze-gain", action="store_true",
+                   help="also play the agent's gaze-blind twin (gaze_blind:<agent>) on the same seeds and record "
+                        "the gaze gain (success minus the twin's)")
     p.add_argument("--backend", choices=("local", "ray"), default="local",
                    help="local: this process or a process pool of --workers (default); ray: Ray tasks on a "
                         "cluster (pip install 'visuomotor_gym[distributed]'), same per-seed outcomes")
@@ -48,6 +51,8 @@ def canonical_command(args: argparse.Namespace) -> str:
              "--seed", str(args.seed), "--workers", str(args.workers), "--out", Path(args.out).name]
     if getattr(args, "backend", "local") != "local":
         parts[-2:-2] = ["--backend", args.backend]
+    if getattr(args, "gaze_gain", False):
+        parts[-2:-2] = ["--gaze-gain"]
     if args.traces:
         parts += ["--traces", Path(args.traces).name]
     return shlex.join(parts)
@@ -81,6 +86,14 @@ def summary_rows(results: dict) -> list[tuple[str, str]]:
                        f"({results['caught']}/{results['episodes']})"),
         ("gaze realism", _fmt(gaze["score"])),
     ]
+    gain = results.get("gaze_gain")
+    if gain:
+        tlo, thi = gain["twin_success_rate_ci95"]
+        rows += [
+            ("gaze-blind twin", f"{gain['twin_success_rate']:.3f}  95% CI [{tlo:.3f}, {thi:.3f}]  "
+                                f"({gain['twin_agent']})"),
+            ("gaze gain", f"{gain['gain']:+.3f}  (success minus the twin's, same seeds)"),
+        ]
     for name, comp in gaze["components"].items():
         rows.append((f"  {name}", f"score {_fmt(comp.get('score'))}  (value {_fmt(comp.get('value'))})"))
     rows += [
@@ -182,6 +195,10 @@ def main_bench(args: argparse.Namespace) -> int:
         validate_inputs(args.agent, args.env, args.episodes, args.seed, args.workers)
         if args.address is not None and args.backend != "ray":
             raise ValueError("--address is only used with --backend ray")
+        if args.gaze_gain:
+            from visuomotor_gym.bench.evaluate import twin_spec
+
+            validate_inputs(twin_spec(args.agent), args.env, args.episodes, args.seed, args.workers)
         if args.backend == "ray":
             import importlib.util
 
@@ -193,8 +210,15 @@ def main_bench(args: argparse.Namespace) -> int:
     result = evaluate(args.agent, args.env, args.episodes, args.seed, workers=args.workers,
                       keep_traces=traces_path is not None, progress=not args.no_progress,
                       backend=args.backend, address=args.address)
+    twin = None
+    if args.gaze_gain:
+        from visuomotor_gym.bench.evaluate import twin_spec
+
+        twin = evaluate(twin_spec(args.agent), args.env, args.episodes, args.seed, workers=args.workers,
+                        keep_traces=False, progress=not args.no_progress, backend=args.backend,
+                        address=args.address)
     try:
-        results = build_results(result, canonical_command(args))
+        results = build_results(result, canonical_command(args), twin_result=twin)
         print_summary(results)
         write_results(out, results, force=args.force)
     except (ResultsError, OSError) as exc:  # FileExistsError, or the disk failing after the run

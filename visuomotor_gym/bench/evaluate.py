@@ -207,6 +207,14 @@ def _run_in_pool(agent, env_id, chunks, seeds, workers, progress) -> list[list[E
 BACKENDS = ("local", "ray")
 
 
+def twin_spec(agent: str) -> str:
+    """The gaze-blind twin of an agent spec: the same agent with its gaze and head held
+    (``gaze_blind:<spec>``; ``fixed_gaze`` is already the twin of ``eyecatch``)."""
+    if agent == "fixed_gaze" or agent.startswith("gaze_blind:"):
+        raise ValueError(f"{agent!r} is already a gaze-blind agent: it has no twin")
+    return f"gaze_blind:{agent}"
+
+
 def _run_on_ray(agent, env_id, chunks, seeds, address, progress) -> list[list[EpisodeTrace]]:
     """Spread the chunks over Ray tasks (one CPU each) on a local or remote cluster.
 

@@ -46,10 +46,11 @@ def load_schema() -> dict:
     return json.loads(text)
 
 
-def build_results(eval_result, command: str | None) -> dict:
+def build_results(eval_result, command: str | None, twin_result=None) -> dict:
     """The results object of an :class:`~visuomotor_gym.bench.evaluate.EvalResult` (validated).
 
     ``command`` is the command line recorded in the provenance (no personal paths, please).
+    ``twin_result``: the agent's gaze-blind twin on the same seeds (adds ``gaze_gain``).
     """
     from visuomotor_gym.bench.provenance import provenance
 
@@ -87,10 +88,27 @@ def build_results(eval_result, command: str | None) -> dict:
         },
         "provenance": provenance(command),
     }
+    if twin_result is not None:
+        obj["gaze_gain"] = gaze_gain_block(eval_result, twin_result)
     # Round-trip through JSON so the object holds plain JSON types only (no numpy scalars).
     obj = json.loads(json.dumps(obj, default=_json_default))
     validate_results(obj)
     return obj
+
+
+def gaze_gain_block(eval_result, twin_result) -> dict:
+    """``gaze_gain`` of the results: the twin's success on the same pinned seeds, and the gain."""
+    if (twin_result.env_id, twin_result.episodes, twin_result.seed) != (
+            eval_result.env_id, eval_result.episodes, eval_result.seed):
+        raise ValueError("the gaze-blind twin must play the same env id and pinned seeds as the agent")
+    t = twin_result.summary
+    return {
+        "twin_agent": twin_result.agent,
+        "twin_successes": int(round(t["success_rate"] * twin_result.episodes)),
+        "twin_success_rate": float(t["success_rate"]),
+        "twin_success_rate_ci95": [float(x) for x in t["success_rate_ci95"]],
+        "gain": float(eval_result.summary["success_rate"]) - float(t["success_rate"]),
+    }
 
 
 def is_real_time(p95_ms: float | None, control_period_ms: float) -> bool:
@@ -184,6 +202,7 @@ def _semantic_problems(obj: dict) -> list[tuple[str, str]]:
                                               f"{caught}/{episodes}, [{expected[0]}, {expected[1]}]"))
 
     out += _success_problems(obj, episodes if episodes_ok else None, rate, env_id)
+    out += _gaze_gain_problems(obj, episodes if episodes_ok else None)
 
     seeds = obj.get("seeds")
     if isinstance(seeds, dict) and _is_int(seed) and episodes_ok:
@@ -239,6 +258,30 @@ def _success_problems(obj: dict, episodes: int | None, catch_rate, env_id) -> li
     if env_id in CATCH_ENV_IDS and _is_num(catch_rate) and abs(rate - catch_rate) > TOLERANCE:
         out.append(("$.success_rate", f"success_rate = {rate} differs from catch_rate = {catch_rate}: on a "
                                        f"catch env id ({env_id}) success is the catch"))
+    return out
+
+
+def _gaze_gain_problems(obj: dict, episodes: int | None) -> list[tuple[str, str]]:
+    """``gaze_gain`` (optional): the twin's rate is its successes / episodes with their Wilson interval,
+    and the gain is success_rate minus the twin's."""
+    gain = obj.get("gaze_gain")
+    if not isinstance(gain, dict) or episodes is None:
+        return []
+    out = []
+    k, rate, ci, g = (gain.get(n) for n in ("twin_successes", "twin_success_rate", "twin_success_rate_ci95", "gain"))
+    if _is_int(k) and _is_num(rate):
+        if k > episodes or abs(rate - k / episodes) > TOLERANCE:
+            out.append(("$.gaze_gain.twin_success_rate", f"twin_success_rate = {rate} is not twin_successes / "
+                                                          f"episodes = {k}/{episodes}"))
+        elif isinstance(ci, list) and len(ci) == 2 and all(_is_num(x) for x in ci):
+            expected = _wilson(k, episodes)
+            if expected is not None and any(abs(a - b) > TOLERANCE for a, b in zip(ci, expected)):
+                out.append(("$.gaze_gain.twin_success_rate_ci95", f"interval {ci} is not the Wilson interval "
+                                                                   f"of {k}/{episodes}"))
+    success = obj.get("success_rate")
+    if _is_num(g) and _is_num(rate) and _is_num(success) and abs(g - (success - rate)) > TOLERANCE:
+        out.append(("$.gaze_gain.gain", f"gain = {g} differs from success_rate - twin_success_rate = "
+                                         f"{success} - {rate}"))
     return out
 
 

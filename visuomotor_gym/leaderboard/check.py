@@ -222,6 +222,9 @@ def consistency_problems(lb: Leaderboard, entry: Entry) -> list[Problem]:
     def add(where, msg):
         out.append(Problem(where, "consistency", msg))
 
+    if "gaze_gain" in r:  # a claim about another agent's play, which this entry's replay cannot verify
+        add(where_res, "gaze_gain is not accepted in leaderboard results: the leaderboard computes the gain "
+                       "from the gaze-blind twin's own entry (submit gaze_blind:<agent> on the same env id)")
     expected_file = f"{RESULTS_DIR}/{entry.results_path.name}"
     if rec["results"]["file"] != expected_file:
         add(where_rec, f"results.file is {rec['results']['file']!r}, expected {expected_file!r}")

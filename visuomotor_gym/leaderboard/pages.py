@@ -48,6 +48,7 @@ class Row:
     commit: str
     date: str
     policy: str | None  # policy file, relative to the leaderboard folder
+    gain: float | None = None  # success minus the gaze-blind twin's entry on the same env id (None: no twin)
 
     @property
     def key(self) -> str:
@@ -104,12 +105,33 @@ def _rows(lb: Leaderboard) -> tuple[list[Row], list[Row]]:
         return (rung, row.env_id, -row.rate, row.name)
 
     rows.sort(key=order)
+    _attach_gaze_gains(rows)
     return [r for r in rows if r.entry.superseded is None], [
         r for r in rows if r.entry.superseded is not None
     ]
 
 
+def twin_agents(agent: str) -> tuple[str, ...]:
+    """The agent specs that are ``agent``'s gaze-blind twin (``fixed_gaze`` is ``gaze_blind:eyecatch``)."""
+    return (f"gaze_blind:{agent}",) + (("fixed_gaze",) if agent == "eyecatch" else ())
+
+
+def _attach_gaze_gains(rows: list[Row]) -> None:
+    """Each current entry's gaze gain: its success rate minus that of a current entry of its gaze-blind
+    twin on the same env id and seeds (both re-scored entries); None when there is no such twin."""
+    current = [r for r in rows if r.entry.superseded is None]
+    for r in current:
+        twins = [t for t in current if t.env_id == r.env_id and t.agent in twin_agents(r.agent)
+                 and t.seeds == r.seeds and t.episodes == r.episodes]
+        if twins:
+            r.gain = r.rate - max(twins, key=lambda t: t.date).rate
+
+
 # ------------------------------------------------------------------------------ formatting
+
+
+def fmt_gain(x: float | None) -> str:
+    return "–" if x is None else f"{100.0 * x:+.1f} pts"
 
 
 def pct(x: float) -> str:
@@ -160,15 +182,15 @@ def render_readme(lb: Leaderboard) -> str:
         "vision or a bounce. "
         "[The page with plots](index.html) shows the same entries.",
         "",
-        "| agent | env id | success rate [95 % CI] | gaze realism | latency p95 (self-reported) | real time "
-        "| episodes | seeds "
+        "| agent | env id | success rate [95 % CI] | gaze gain | gaze realism | latency p95 (self-reported) "
+        "| real time | episodes | seeds "
         "| verified | commit | date |",
-        "|---|---|---|---|---|---|---|---|---|---|---|",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
         lines.append("| " + " | ".join(_md(c) for c in _cells_md(r)) + " |")
     if not rows:
-        lines.append("| *no entries yet* |  |  |  |  |  |  |  |  |  |  |")
+        lines.append("| *no entries yet* |  |  |  |  |  |  |  |  |  |  |  |")
     if old:
         lines += [
             "",
@@ -197,6 +219,9 @@ def render_readme(lb: Leaderboard) -> str:
     sample = proto.rescore_sample if proto is not None else "?"
     lines += [
         "",
+        "*gaze gain*: the success rate minus that of the agent's gaze-blind twin (the same agent with its gaze "
+        "and head actions held: `gaze_blind:<agent>`, or `fixed_gaze` for `eyecatch`) on the same env id and "
+        "seeds, both re-scored entries (a foveated env on which it is small does not test looking); "
         "*gaze realism*: mean score in [0, 1] of the gaze components against the sourced human reference "
         "table (`visuomotor_gym/metrics/human_reference.json`); *latency*: policy compute time per control "
         "step, as measured by the submitter (CI re-measures it on a new entry's re-scored episodes and "
@@ -260,6 +285,7 @@ def _cells_md(r: Row) -> list[str]:
         agent,
         f"`{r.env_id}`",
         fmt_rate(r),
+        fmt_gain(r.gain),
         fmt_score(r.realism),
         fmt_ms(r.latency["p95"]),
         "yes" if r.real_time else "no",
@@ -537,6 +563,7 @@ def _cells_html(r: Row) -> str:
         ("", agent),
         ("", f"<code>{E(r.env_id)}</code>"),
         ("num", E(fmt_rate(r))),
+        ("num", E(fmt_gain(r.gain))),
         ("num", fmt_score(r.realism)),
         ("num", fmt_ms(r.latency["p95"])),
         ("", "yes" if r.real_time else "no"),
@@ -554,7 +581,7 @@ def render_html(lb: Leaderboard) -> str:
     ladder = list(lb.protocol.env_ids) if lb.protocol is not None else []
     sample = lb.protocol.rescore_sample if lb.protocol is not None else "?"
     head = (
-        "<tr><th>agent</th><th>env id</th><th>success rate [95 % CI]</th><th>gaze realism</th>"
+        "<tr><th>agent</th><th>env id</th><th>success rate [95 % CI]</th><th>gaze gain</th><th>gaze realism</th>"
         "<th>latency p95 (self-reported)</th><th>real time</th><th>episodes</th><th>seeds</th><th>verified</th>"
         "<th>commit</th><th>date</th></tr>"
     )
