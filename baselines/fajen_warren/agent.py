@@ -83,9 +83,10 @@ class FajenWarrenParams:
     speed_margin_m: float = 1.2  # closest distances beyond this are all equally safe
     # Perception and gaze (modelling choices, see the module docstring).
     accel_std: float = 1.0  # m/s^2, white acceleration noise of the constant-velocity model
-    min_dwell_s: float = 0.3
+    min_dwell_s: float = 0.1
     search_azimuth_deg: float = 45.0
     search_distance_m: float = 6.0
+    search_weight: float = 0.25  # a side's search urgency per second since it was last scanned
     head_share: float = 0.5  # the head takes this share of a gaze shift's azimuth
     gaze_blind: bool = False
 
@@ -155,6 +156,7 @@ class FajenWarrenAgent:
         self.target_since = -math.inf
         self.scanned = {1: -math.inf, -1: -math.inf}
         self.log: list[tuple] = []  # (time, target, phi) per step
+        self._in_saccade = False
 
     def predict(self, observation, state=None, episode_start=None, deterministic=True):
         obs = np.asarray(observation, dtype=float)
@@ -174,6 +176,7 @@ class FajenWarrenAgent:
         e0, r0, o0, pz = _S["eye_pos"].start, _S["eye_rot"].start, _S["odometry"].start, _S["pelvis"].start
         odo = ol[o0:o0 + 3]
         pose = (ol[e0:e0 + 3], ol[r0:r0 + 9], odo, ol[pz], t)
+        self._in_saccade = ol[_S["saccade"].start] > 0.5
         self.poses.append(pose)
         if len(self.poses) > self.delay_steps + 1:
             self.poses.pop(0)
@@ -305,16 +308,20 @@ class FajenWarrenAgent:
         unseen = sum(not f.known for f in self.filters)
         if unseen:
             for side in (1, -1):
-                u = 0.6 * min(t - self.scanned[side], 3.0)
+                u = p.search_weight * min(t - self.scanned[side], 3.0)
                 if u > best_u:
                     best, best_u = ("search", side), u
         if best != self.target:
             self.target, self.target_since = best, t
+            if best is not None and best[0] == "search":
+                self.scanned[best[1]] = t
         return self.target
 
     def _look(self, pose, threats, t: float) -> list:
         p = self.params
         eye_pos, rot, odo, pelvis_z, _ = pose
+        if self._in_saccade:  # a fixation's dwell counts from the end of the saccade that brought it
+            self.target_since = t
         target = self._choose(threats, t)
         if target is None:
             return [0.0] * 5

@@ -94,6 +94,10 @@ def summarize(traces: Sequence) -> dict:
         from visuomotor_gym.metrics.walk_realism import walk_summary
 
         return to_json_safe(walk_summary(traces))
+    if traces and _family(traces[0]) == "dodge":  # the dodge family's realism and outcomes (issue 13)
+        from visuomotor_gym.metrics.dodge_realism import dodge_summary
+
+        return to_json_safe(dodge_summary(traces))
     n = len(traces)
     caught = sum(bool(tr.caught) for tr in traces)
     diverged = sum(bool(tr.diverged) for tr in traces)
