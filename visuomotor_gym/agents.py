@@ -383,3 +383,15 @@ def _fajen_warren(env_id, action_dim, seed, **kw):
 register_agent("fajen_warren", _fajen_warren,
                "dodge family: Fajen & Warren (2003) steering dynamics on filtered pedestrian percepts, gaze to the "
                "highest collision risk (Olivier et al. 2012); fajen_warren:gaze_blind=true is its gaze-blind twin")
+
+
+def _lookahead(env_id, action_dim, seed, **kw):
+    from visuomotor_gym.baselines.lookahead import LookaheadAgent
+
+    return LookaheadAgent.for_env(env_id, **kw)
+
+
+# Stones family (issue 13). Its gaze-blind twin is ``lookahead:gaze_blind=true`` (gaze and head held).
+register_agent("lookahead", _lookahead,
+               "stones family: fixates the stone two steps ahead from the swing start (Patla & Vickers 2003, "
+               "Eom 7), fused percepts, footsteps onto the believed stones")
