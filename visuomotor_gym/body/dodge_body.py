@@ -6,8 +6,9 @@ The scripted gait (:mod:`visuomotor_gym.body.walker`) keeps the pelvis facing th
 turning step. Its footstep action still steers: the lateral offset of each footstep moves the body
 sideways by that much per step. A heading is therefore realised as a *direction of travel* (the body
 walks obliquely, facing ahead), the footstep ``(v T cos h, v T sin h)`` for heading ``h`` and speed ``v``
-(T = 0.5 s per step), with the gait's limits: step length 0.25-0.95 m and lateral offset +-0.3 m, so the
-direction of travel saturates at atan(0.3 / length), 25 deg at the nominal 0.65 m step (modelling
+(T = 0.5 s per step), with the gait's limits: step length 0.25-0.95 m, lateral offset +-0.3 m and feet
+never closer than 0.06 m, so a stride moves at most 0.36 m sideways and the direction of travel saturates
+near 18 deg at 1.3 m/s (measured in tests/test_obstacle_dodge.py; modelling
 choice: a crab-walking abstraction of turning; steering in Fajen & Warren 2003 is the direction of
 locomotion). As with footsteps, the command is read at each mid-stance for the next step of that foot:
 it shows in the pelvis's path ~0.5-1 s later.

@@ -70,7 +70,7 @@ class ObstacleDodgeEnv(VisuomotorEnv):
 
     | index | block | meaning |
     |---|---|---|
-    | 0 | locomotion | heading (direction of travel from the path, + = left), linear onto [-30, 30] deg; saturates at atan(0.3 m / step length) (25 deg at 1.3 m/s) |
+    | 0 | locomotion | heading (direction of travel from the path, + = left), linear onto [-30, 30] deg; saturates near 18 deg at 1.3 m/s (feet never cross: at most 0.36 m sideways per stride) |
     | 1 | locomotion | speed, linear onto [0.7, 1.9] m/s (0: the nominal 1.3 m/s) |
     | 2-3 | gaze | requested gaze change in retinal coordinates (azimuth, elevation) of the current eye frame, times ``gaze_action_range_deg`` (60 deg); 0 holds gaze fixed in the world |
     | 4 | fixation | fixation (vergence) distance, log-mapped onto [0.1, 20] m; does not change the noise in v0 |

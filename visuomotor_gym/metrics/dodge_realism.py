@@ -3,7 +3,7 @@ scored against human data with :func:`visuomotor_gym.metrics.realism.score_compo
 human range, a Gaussian fall-off outside; the score is the mean of the components).
 
 Measures (from an :class:`~visuomotor_gym.bench.trace.EpisodeTrace` of an ObstacleDodge env: ``eye_pos``,
-``gaze_dir``, ``pedestrian_pos`` per step; the crowd ``pedestrians`` per episode):
+``gaze_dir``, ``pedestrian_pos`` per step (parked before the onset); the crowd ``pedestrians`` per episode):
 
 * ``pedestrian_fixated_share``: the share of the pedestrians that were fixated at least once while they
   were ahead of the eye (a *fixation*: the line of sight within ``FIXATION_DEG`` of the pedestrian's seen
@@ -69,6 +69,7 @@ def pedestrian_fixations(trace) -> tuple[float, list[float]]:
             cos = np.einsum("ij,ij->i", d, gaze) / n
         on = np.nan_to_num(cos, nan=-1.0) >= cos_fix
         on &= np.nan_to_num(d[:, 0], nan=-1.0) > 0.0  # ahead of the eye
+        on &= t >= onset - 1e-9  # parked before its onset
         run = 0
         for k, flag in enumerate(on.tolist()):
             run = run + 1 if flag else 0

@@ -293,10 +293,9 @@ class ObstacleDodgeTask:
 
     def info(self, data: mujoco.MjData, *, diverged: bool = False) -> dict:
         """Step information (pedestrian positions are true state: for scoring only, never for a policy)."""
-        ped = np.full((N_PEDESTRIANS, 3), np.nan)
+        ped = np.empty((N_PEDESTRIANS, 3))  # the seen points; parked (PARK) before the onset
         for i in range(N_PEDESTRIANS):
-            if self.active[i]:
-                ped[i] = (self.pos[i, 0], self.pos[i, 1], SEEN_HEIGHT_M)
+            ped[i] = (self.pos[i, 0], self.pos[i, 1], SEEN_HEIGHT_M) if self.active[i] else PARK
         return {
             "collided": self.collided,
             "finished": self.finished,

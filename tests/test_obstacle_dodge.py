@@ -1,0 +1,247 @@
+"""ObstacleDodge-v0 (issue 13): API checkers, determinism, pickling, bad input, no leak of the pedestrians'
+true state, every rung from the registry, the crowd sampler, collisions, fajen_warren against its
+gaze-blind twin, the dodge realism measures."""
+
+from __future__ import annotations
+
+import math
+import pickle
+from types import SimpleNamespace
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import visuomotor_gym  # noqa: F401  (registers the ids)
+from visuomotor_gym.agents import make_agent
+from visuomotor_gym.body.dodge_body import DodgeBody
+from visuomotor_gym.envs.dodge import DODGE_LAYOUT, ObstacleDodgeEnv
+from visuomotor_gym.metrics.dodge_realism import dodge_gaze_realism, pedestrian_fixations
+from visuomotor_gym.registration import ENV_SPECS, FAMILIES
+from visuomotor_gym.tasks.obstacle_dodge import (
+    N_PEDESTRIANS,
+    CrowdDistribution,
+    intercept_velocity,
+    sample_crowd,
+)
+
+DODGE_IDS = FAMILIES["dodge"]
+
+
+def rollout(env, seed, actions):
+    obs, info = env.reset(seed=seed)
+    out = [obs.copy()]
+    for a in actions:
+        obs, r, term, trunc, info = env.step(a)
+        out.append(np.append(obs, r))
+        if term or trunc:
+            break
+    return out
+
+
+def test_the_five_rungs_are_registered_in_the_dodge_family():
+    assert set(DODGE_IDS) == {"ObstacleDodgeOracle-v0", "ObstacleDodgeFullView-v0", "ObstacleDodge-v0",
+                              "ObstacleDodgeDelayed-v0", "ObstacleDodgePoorVision-v0"}
+    assert all(s.max_episode_steps == 2000 for s in ENV_SPECS if s.family == "dodge")
+
+
+@pytest.mark.parametrize("env_id", DODGE_IDS)
+def test_every_rung_runs_from_the_registry_on_the_same_crowd(env_id):
+    env = gym.make(env_id)
+    obs, info = env.reset(seed=7)
+    assert obs.shape == (DODGE_LAYOUT.size,) and env.observation_space.contains(obs)
+    _, ref_info = ObstacleDodgeEnv().reset(seed=7)
+    np.testing.assert_array_equal(info["pedestrians"], ref_info["pedestrians"])  # same scenario on every rung
+    for _ in range(5):
+        obs, r, term, trunc, info = env.step(env.action_space.sample())
+        assert env.observation_space.contains(obs) and np.isfinite(obs).all()
+
+
+def test_gymnasium_and_sb3_checkers():
+    from gymnasium.utils.env_checker import check_env as gym_check
+    from stable_baselines3.common.env_checker import check_env as sb3_check
+
+    gym_check(ObstacleDodgeEnv(), skip_render_check=True)
+    sb3_check(ObstacleDodgeEnv(), warn=True)
+    gym_check(ObstacleDodgeEnv(obs_mode="dict"), skip_render_check=True)
+
+
+def test_layout_docstring_and_spaces_agree():
+    env = ObstacleDodgeEnv()
+    assert env.observation_structure == DODGE_LAYOUT.structure
+    assert env.action_structure == {"locomotion": 2, "gaze": 2, "fixation": 1, "head": 2}
+    assert "| 0-6 | pedestrian_0 | 7 |" in ObstacleDodgeEnv.__doc__
+    assert f"({DODGE_LAYOUT.size},)" in ObstacleDodgeEnv.__doc__
+
+
+def test_same_seed_same_episode_and_pickling_mid_episode():
+    rng = np.random.default_rng(0)
+    actions = rng.uniform(-1, 1, (60, 7)).astype(np.float32)
+    a = rollout(ObstacleDodgeEnv(), 3, actions)
+    b = rollout(ObstacleDodgeEnv(), 3, actions)
+    assert len(a) == len(b) and all(np.array_equal(x, y) for x, y in zip(a, b))
+    env = ObstacleDodgeEnv()
+    env.reset(seed=3)
+    for act in actions[:20]:
+        env.step(act)
+    clone = pickle.loads(pickle.dumps(env))
+    for act in actions[20:40]:
+        o1, r1, *_ = env.step(act)
+        o2, r2, *_ = clone.step(act)
+        np.testing.assert_array_equal(o1, o2)
+        assert r1 == r2
+
+
+def test_bad_input_gives_clear_errors():
+    env = ObstacleDodgeEnv()
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match="shape"):
+        env.step(np.zeros(8, np.float32))
+    with pytest.raises(ValueError, match="NaN or inf"):
+        env.step(np.full(7, np.nan, np.float32))
+    with pytest.raises(TypeError, match="unknown argument"):
+        ObstacleDodgeEnv(course_distribution={})
+    with pytest.raises(ValueError, match="unknown term"):
+        ObstacleDodgeEnv(reward_weights={"trip": 1.0})
+    with pytest.raises(TypeError, match="unknown field"):
+        ObstacleDodgeEnv(vision_params={"fov": 30})
+    with pytest.raises(RuntimeError, match="before reset"):
+        ObstacleDodgeEnv().step(np.zeros(7, np.float32))
+
+
+def _look_up(n):
+    a = np.zeros((n, 7), np.float32)
+    a[:, 3] = 0.5  # gaze up
+    a[:, 6] = 1.0  # head up
+    return a
+
+
+@pytest.mark.parametrize("vision", ["foveated", "oracle"])
+def test_no_observation_leak_of_the_pedestrians_true_state(vision):
+    """Looking up at the sky, the foveated walker's observations do not depend on where the pedestrians
+    walk (the same episode with every pedestrian shifted 1 m gives identical observations); the oracle rung
+    (true state) is the positive control."""
+    actions = _look_up(80)
+    a, b = ObstacleDodgeEnv(vision=vision), ObstacleDodgeEnv(vision=vision)
+    a.reset(seed=5)
+    b.reset(seed=5)
+    b.task.pos += np.array([1.0, 0.5])
+    b.task.vel *= 1.3
+    differ = False
+    for act in actions:
+        oa, *_ = a.step(act)
+        ob, *_ = b.step(act)
+        differ |= not np.array_equal(oa, ob)
+    if vision == "foveated":
+        assert not differ
+    else:
+        assert differ
+
+
+def test_crowd_sampler_follows_its_distribution():
+    dist = CrowdDistribution()
+    rng = np.random.default_rng(1)
+    veer = []
+    for _ in range(400):
+        crowd = sample_crowd(rng, dist)
+        assert 15.0 <= crowd.goal <= 20.0 and crowd.pedestrians.shape == (N_PEDESTRIANS, 9)
+        onset, x0, y0, vx, vy, xc = crowd.pedestrians[:, :6].T
+        assert np.all(np.diff(onset) >= 1.5 - 1e-9)
+        assert np.all((np.abs(y0) >= 4.0 - 1e-9) & (np.abs(y0) <= 6.0 / math.cos(math.radians(30)) + 1e-9))
+        speed = np.hypot(vx, vy)
+        assert np.all((speed >= 1.0 - 1e-9) & (speed <= 1.5 + 1e-9))
+        assert np.all((xc >= 3.0 - 1e-9) & (xc <= crowd.goal - 1.0 + 1e-9))
+        assert np.all(np.sign(vy) == -np.sign(y0))  # they cross the path
+        veer += crowd.pedestrians[:, 7].tolist()
+    assert 0.07 < np.mean(veer) < 0.13  # 10 % veer (Jovancevic et al.)
+
+
+def test_intercept_velocity_meets_the_walker():
+    v = intercept_velocity(5.0, 3.0, 1.2, 0.0, 0.0, 1.3, 0.0)
+    assert math.isclose(float(np.hypot(*v)), 1.2)
+    # the meeting time t solves |p + v t - w(t)| = 0
+    a = v - np.array([1.3, 0.0])
+    t = -np.dot(np.array([5.0, 3.0]), a) / np.dot(a, a)
+    assert np.linalg.norm(np.array([5.0, 3.0]) + a * t) < 1e-6
+
+
+def test_a_collision_ends_the_episode_and_scores_minus_one():
+    env = ObstacleDodgeEnv()
+    env.reset(seed=0)
+    env.task.active[0] = True
+    env.task.pos[0] = (1.0, 0.0)  # put a pedestrian right in front of the walker, standing still
+    env.task.vel[0] = 0.0
+    done, info, total = False, {}, 0.0
+    for _ in range(100):
+        _, r, done, _, info = env.step(np.zeros(7, np.float32))
+        total += r
+        if done:
+            break
+    assert done and info["collided"] and not info["is_success"]
+    assert total == -1.0 and info["reward_terms"]["collision"] == -1.0
+    assert info["min_gap"] < 0.0
+
+
+def test_heading_action_moves_the_walker_sideways():
+    env = ObstacleDodgeEnv(crowd_distribution={"first_onset_s": (30.0, 31.0)})  # nobody appears
+    env.reset(seed=0)
+    act = np.zeros(7, np.float32)
+    act[0] = 1.0  # 30 deg left (the gait gives ~18 deg)
+    path = []
+    for _ in range(200):
+        _, _, done, _, info = env.step(act)
+        path.append(info["pelvis_pos"][:2])
+    (x0, y0), (x1, y1) = path[100], path[200 - 1]
+    # Left steps 0.12 + 0.3 m, right steps -0.06 m (feet never closer than 0.06 m): 0.36 m per 1.13 m stride
+    assert y1 > 1.0 and 0.25 < (y1 - y0) / (x1 - x0) < 0.4
+    assert DodgeBody.action_from_locomotion(0.0, 1.3) == [0.0, 0.0]
+
+
+def _bench(spec, seeds):
+    ok = 0
+    for seed in seeds:
+        env = gym.make("ObstacleDodge-v0")
+        agent = make_agent(spec, "ObstacleDodge-v0", 7, seed)
+        obs, info = env.reset(seed=seed)
+        done = False
+        while not done:
+            action, _ = agent.predict(obs)
+            obs, _, term, trunc, info = env.step(action)
+            done = term or trunc
+        ok += bool(info["is_success"])
+    return ok
+
+
+def test_fajen_warren_reaches_the_goal_more_often_than_its_gaze_blind_twin():
+    seeds = range(12)
+    looking = _bench("fajen_warren", seeds)
+    blind = _bench("fajen_warren:gaze_blind=true", seeds)
+    assert looking >= blind + 4, (looking, blind)
+
+
+def _trace(gaze_on, onset=0.2):
+    """A synthetic trace: one pedestrian 5 m ahead, gaze on it from step ``gaze_on`` (None: never)."""
+    n = 100
+    t = np.arange(n) * 0.02
+    eye = np.zeros((n, 3))
+    ped = np.full((n, N_PEDESTRIANS, 3), np.nan)
+    ped[:, 0] = (5.0, 2.0, 0.0)
+    ped[t < onset, 0] = np.nan
+    gaze = np.tile([1.0, 0.0, 0.0], (n, 1))
+    if gaze_on is not None:
+        gaze[gaze_on:] = np.array([5.0, 2.0, 0.0]) / math.hypot(5.0, 2.0)
+    crowd = np.zeros((N_PEDESTRIANS, 9))
+    crowd[:, 0] = (onset, 50.0, 50.0, 50.0)  # the other three appear after the end: not counted
+    return SimpleNamespace(t=t, dt=0.02, eye_pos=eye, gaze_dir=gaze, pedestrian_pos=ped, pedestrians=crowd,
+                           diverged=False)
+
+
+def test_dodge_realism_measures_on_synthetic_traces():
+    share, lat = pedestrian_fixations(_trace(gaze_on=40))
+    assert share == 1.0 and math.isclose(lat[0], 40 * 0.02 - 0.2)
+    share, lat = pedestrian_fixations(_trace(gaze_on=None))
+    assert share == 0.0 and lat == []
+    r = dodge_gaze_realism([_trace(gaze_on=40), _trace(gaze_on=None)])
+    assert r["components"]["pedestrian_fixated_share"]["value"] == 0.5
+    assert math.isclose(r["components"]["fixation_latency_s"]["value"], 0.6)
+    assert 0.0 <= r["score"] <= 1.0
