@@ -34,7 +34,7 @@ import numpy as np
 from visuomotor_gym.body.walker import GaitParams
 from visuomotor_gym.body.walker_body import WalkerBody
 from visuomotor_gym.envs.stones import STONES_LAYOUT
-from visuomotor_gym.registration import env_vision
+from visuomotor_gym.registration import env_vision, env_vision_params
 from visuomotor_gym.tasks.stepping_stones import FOOT_CENTRE_AHEAD_M, K_SLOTS
 from visuomotor_gym.vision.foveation import VisionParams
 
@@ -73,10 +73,11 @@ class LookaheadParams:
 class LookaheadAgent:
     """See the module docstring. ``predict(obs) -> (action, state)`` on flat SteppingStones observations."""
 
-    def __init__(self, params: LookaheadParams | None = None, gait: GaitParams | None = None) -> None:
+    def __init__(self, params: LookaheadParams | None = None, gait: GaitParams | None = None,
+                 vision: VisionParams | None = None) -> None:
         self.params = p = params or LookaheadParams()
         self.gait = gait or GaitParams()
-        self.vision = VisionParams(noise_scale=p.vision_noise_scale, foveated=p.foveated)
+        self.vision = vision or VisionParams(noise_scale=p.vision_noise_scale, foveated=p.foveated)
         self.delay_steps = round(p.visual_delay_s / p.control_dt)
         self.gaze_range = p.gaze_action_range_deg * DEG
         self.memory = StoneMemory(self.vision)
@@ -90,7 +91,7 @@ class LookaheadAgent:
         unknown = sorted(set(overrides) - known)
         if unknown:
             raise TypeError(f"unknown lookahead parameter(s) {unknown}; known: {sorted(known)}")
-        return cls(replace(base, **overrides))
+        return cls(replace(base, **overrides), vision=env_vision_params(env_id))
 
     def reset(self) -> None:
         self.memory.reset()
@@ -123,14 +124,17 @@ class LookaheadAgent:
         odo = (ol[o0], ol[o0 + 1], ol[o0 + 2], ol[p0])
         pose = (eye_pos, rot, odo)
         self.poses.append(pose)
-        if len(self.poses) > self.delay_steps + 1:
+        if len(self.poses) > self.delay_steps + 2:
             self.poses.pop(0)
-        seen_pose = self.poses[0] if len(self.poses) > self.delay_steps else pose
+        seen_pose = self.poses[-self.delay_steps - 1] if len(self.poses) > self.delay_steps else pose
+        seen_prev = self.poses[-self.delay_steps - 2] if len(self.poses) >= self.delay_steps + 2 else None
+        prev = None if seen_prev is None else StoneMemory.eye_pose(*seen_prev)
         self.next_stone = round(ol[_S["stone_0"].start])
         for k in range(K_SLOTS):
             b = _S[f"stone_{k}"].start
             if ol[b + 4] > 0.0:
-                self.memory.add(round(ol[b]), ol[b + 1:b + 4], seen_pose[0], seen_pose[1], seen_pose[2])
+                self.memory.add(round(ol[b]), ol[b + 1:b + 4], seen_pose[0], seen_pose[1], seen_pose[2], prev,
+                                self.params.control_dt)
         latch_in = ol[_S["gait_phase"].start + 2]
         if latch_in <= self.params.control_dt + 1e-6:  # this step's command is read at mid-stance
             self.footstep = self._plan(obs, odo)

@@ -21,6 +21,8 @@ import math
 from visuomotor_gym.tasks.stepping_stones import STONE_TOP_Z
 from visuomotor_gym.vision.foveation import VisionParams, _sigmas
 
+EyePose = tuple  # (eye position (3), eye axes as rows of a 3x3, columns = axes) in the path frame
+
 STONE_PLANE_Z = STONE_TOP_Z
 MIN_STD_M = 1e-4  # a floor for the noiseless oracle rung (its information would be infinite)
 MIN_DEPRESSION = 0.02  # rad: a direction this close to the horizon says little about where on the plane
@@ -45,9 +47,42 @@ class StoneMemory:
     def reset(self) -> None:
         self.stones = {}
 
-    def add(self, index: int, p_eye, eye_pos, rot_rows, odo) -> None:
+    @staticmethod
+    def eye_pose(eye_pos, rot_rows, odo) -> EyePose:
+        """The eye's pose in the path frame from its pose in the pelvis frame and the odometry."""
+        ox, oy, yaw, pz = odo
+        c, s = math.cos(yaw), math.sin(yaw)
+        pos = (ox + c * eye_pos[0] - s * eye_pos[1], oy + s * eye_pos[0] + c * eye_pos[1], pz + eye_pos[2])
+        rows = ((c * rot_rows[0][0] - s * rot_rows[1][0], c * rot_rows[0][1] - s * rot_rows[1][1],
+                 c * rot_rows[0][2] - s * rot_rows[1][2]),
+                (s * rot_rows[0][0] + c * rot_rows[1][0], s * rot_rows[0][1] + c * rot_rows[1][1],
+                 s * rot_rows[0][2] + c * rot_rows[1][2]),
+                tuple(rot_rows[2]))
+        return pos, rows
+
+    @staticmethod
+    def _in_eye(pose: EyePose, px: float, py: float, pz: float) -> tuple[float, float, float]:
+        (ex, ey, ez), ((a00, a01, a02), (a10, a11, a12), (a20, a21, a22)) = pose
+        dx, dy, dz = px - ex, py - ey, pz - ez
+        n = math.sqrt(dx * dx + dy * dy + dz * dz) or 1.0
+        return ((a00 * dx + a10 * dy + a20 * dz) / n, (a01 * dx + a11 * dy + a21 * dz) / n,
+                (a02 * dx + a12 * dy + a22 * dz) / n)
+
+    def retinal_slip(self, px: float, py: float, pose: EyePose, prev: EyePose | None, dt: float) -> float:
+        """Speed (rad/s) of the image of the still point (px, py) on the stones' plane over the last
+        control step, from the eye's own poses (the point's image moves as the eye translates and turns)."""
+        if prev is None:
+            return 0.0
+        a = self._in_eye(pose, px, py, STONE_PLANE_Z)
+        b = self._in_eye(prev, px, py, STONE_PLANE_Z)
+        dot = max(-1.0, min(1.0, a[0] * b[0] + a[1] * b[1] + a[2] * b[2]))
+        return math.acos(dot) / dt
+
+    def add(self, index: int, p_eye, eye_pos, rot_rows, odo, prev: EyePose | None = None, dt: float = 0.02) -> None:
         """One sample of stone ``index``: ``p_eye`` in the eye frame, ``eye_pos`` and ``rot_rows`` (3x3,
-        columns = eye axes) in the pelvis frame, ``odo`` = (x, y, yaw, pelvis height) of the pelvis."""
+        columns = eye axes) in the pelvis frame, ``odo`` = (x, y, yaw, pelvis height) of the pelvis;
+        ``prev`` the eye's pose (:meth:`eye_pose`) one control step ``dt`` earlier, for the retinal slip
+        that blurs a moving image (the lateral std grows above a knee: ``foveation.slip_factor``)."""
         ex, ey, ez = p_eye
         d = math.sqrt(ex * ex + ey * ey + ez * ez)
         if d <= 1e-9:
@@ -69,7 +104,10 @@ class StoneMemory:
         px, py = exw + t * hx, eyw + t * hy
         # The lateral noise is a distance at the true range (~t): seen from the eye at the perceived range
         # d it is an angle s_lat / d, which is t s_lat / d across the line of sight on the plane.
-        s_lat = max(_sigmas(t, ecc, 0.0, self.vision)[1] * t / d, MIN_STD_M)
+        est = self.estimate(index)
+        qx, qy = est[0] if est is not None else (px, py)
+        slip = self.retinal_slip(qx, qy, self.eye_pose(eye_pos, rot_rows, odo), prev, dt)
+        s_lat = max(_sigmas(t, ecc, slip, self.vision)[1] * t / d, MIN_STD_M)
         h = math.hypot(hx, hy)
         if h <= 1e-9:  # straight down: isotropic
             a_info = c_info = 1.0 / (s_lat * s_lat)
