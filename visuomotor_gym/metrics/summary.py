@@ -94,6 +94,10 @@ def summarize(traces: Sequence) -> dict:
         from visuomotor_gym.metrics.walk_realism import walk_summary
 
         return to_json_safe(walk_summary(traces))
+    if traces and _family(traces[0]) == "stones":  # the stones family's realism and outcomes (issue 13)
+        from visuomotor_gym.metrics.stones_realism import stones_summary
+
+        return to_json_safe(stones_summary(traces))
     if traces and _family(traces[0]) == "dodge":  # the dodge family's realism and outcomes (issue 13)
         from visuomotor_gym.metrics.dodge_realism import dodge_summary
 

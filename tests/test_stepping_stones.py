@@ -1,0 +1,268 @@
+"""SteppingStones-v0 (issue 13): API checkers, determinism, pickling, bad input, no leak of the stones'
+true positions, every rung from the registry, the course sampler, falls, the lookahead baseline against
+its gaze-blind twin, stepping-target realism."""
+
+from __future__ import annotations
+
+import math
+import pickle
+from types import SimpleNamespace
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import visuomotor_gym  # noqa: F401  (registers the ids)
+from visuomotor_gym.agents import make_agent
+from visuomotor_gym.envs.stones import STONES_LAYOUT, SteppingStonesEnv
+from visuomotor_gym.registration import ENV_SPECS, FAMILIES
+from visuomotor_gym.tasks.stepping_stones import K_SLOTS, STONE_TOP_Z, CourseDistribution, sample_course
+
+STONES_IDS = FAMILIES["stones"]
+
+
+def rollout(env, seed, actions):
+    obs, info = env.reset(seed=seed)
+    out = [obs.copy()]
+    for a in actions:
+        obs, r, term, trunc, info = env.step(a)
+        out.append(np.append(obs, r))
+        if term or trunc:
+            break
+    return out
+
+
+def test_the_five_rungs_are_registered_in_the_stones_family():
+    assert set(STONES_IDS) == {"SteppingStonesOracle-v0", "SteppingStonesFullView-v0", "SteppingStones-v0",
+                               "SteppingStonesDelayed-v0", "SteppingStonesPoorVision-v0"}
+    assert all(s.max_episode_steps == 1000 for s in ENV_SPECS if s.family == "stones")
+
+
+@pytest.mark.parametrize("env_id", STONES_IDS)
+def test_every_rung_runs_from_the_registry_on_the_same_course(env_id):
+    env = gym.make(env_id)
+    obs, info = env.reset(seed=7)
+    assert obs.shape == (STONES_LAYOUT.size,) and env.observation_space.contains(obs)
+    _, ref_info = SteppingStonesEnv().reset(seed=7)
+    np.testing.assert_array_equal(info["stones"], ref_info["stones"])  # same course on every rung
+    for _ in range(5):
+        obs, r, term, trunc, info = env.step(env.action_space.sample())
+        assert env.observation_space.contains(obs) and np.isfinite(obs).all()
+
+
+def test_gymnasium_and_sb3_checkers():
+    from gymnasium.utils.env_checker import check_env as gym_check
+    from stable_baselines3.common.env_checker import check_env as sb3_check
+
+    gym_check(SteppingStonesEnv(), skip_render_check=True)
+    sb3_check(SteppingStonesEnv(), warn=True)
+    gym_check(SteppingStonesEnv(obs_mode="dict"), skip_render_check=True)
+
+
+def test_layout_docstring_and_spaces_agree():
+    env = SteppingStonesEnv()
+    assert env.observation_structure == STONES_LAYOUT.structure
+    assert env.action_structure == {"footstep": 3, "gaze": 2, "fixation": 1, "head": 2}
+    assert "| 0-4 | stone_0 | 5 |" in SteppingStonesEnv.__doc__
+    assert f"({STONES_LAYOUT.size},)" in SteppingStonesEnv.__doc__
+
+
+def test_same_seed_same_episode_and_pickling_mid_episode():
+    rng = np.random.default_rng(0)
+    actions = rng.uniform(-1, 1, (60, 8)).astype(np.float32)
+    a = rollout(SteppingStonesEnv(), 3, actions)
+    b = rollout(SteppingStonesEnv(), 3, actions)
+    assert len(a) == len(b) and all(np.array_equal(x, y) for x, y in zip(a, b))
+    c = rollout(SteppingStonesEnv(), 4, actions)
+    assert not all(np.array_equal(x, y) for x, y in zip(a, c))
+    env = SteppingStonesEnv()
+    env.reset(seed=3)
+    for act in actions[:20]:
+        env.step(act)
+    clone = pickle.loads(pickle.dumps(env))
+    for act in actions[20:40]:
+        o1, r1, t1, _, _ = env.step(act)
+        o2, r2, t2, _, _ = clone.step(act)
+        assert np.array_equal(o1, o2) and r1 == r2 and t1 == t2
+
+
+def test_bad_input_gives_clear_errors():
+    env = SteppingStonesEnv()
+    env.reset(seed=0)
+    bad = np.zeros(8, np.float32)
+    bad[2] = np.nan
+    with pytest.raises(ValueError, match="NaN or inf"):
+        env.step(bad)
+    with pytest.raises(ValueError, match="shape"):
+        env.step(np.zeros(9, np.float32))
+    with pytest.raises(TypeError, match="unknown argument"):
+        SteppingStonesEnv(n_balls=2)
+    with pytest.raises(ValueError, match="unknown term"):
+        SteppingStonesEnv(reward_weights={"trip": 1.0})
+    with pytest.raises(TypeError, match="unknown field"):
+        SteppingStonesEnv(vision_params={"fov": 30})
+    with pytest.raises(ValueError, match="vision"):
+        SteppingStonesEnv(vision="xray")
+    with pytest.raises(ValueError, match="n_stones"):
+        SteppingStonesEnv(course_distribution={"n_stones": 40})
+    with pytest.raises(RuntimeError, match="before reset"):
+        SteppingStonesEnv().step(np.zeros(8, np.float32))
+    agent = make_agent("lookahead", "SteppingStones-v0", 8)
+    with pytest.raises(ValueError, match="observation of size"):
+        agent.predict(np.zeros(5))
+
+
+def _look_up(n):
+    a = np.zeros((n, 8), np.float32)
+    a[:, 4] = 0.5  # gaze up (elevation, 30 deg a step until the eye's range)
+    a[:, 7] = 1.0  # head up (neck pitch +40 deg)
+    return a
+
+
+def _move_stones(env):
+    """Change the true course after reset (every stone 20 cm left, 10 cm on): what a leak would reveal."""
+    task = env.task
+    for i, (x, y) in enumerate(task.course.stones.tolist()):
+        x, y = x + 0.1, y + 0.2
+        env.data.mocap_pos[task.mocap[i]][:2] = (x, y)
+        task.targets[i].place(x, y, STONE_TOP_Z)
+        task.course.stones[i] = (x, y)
+
+
+@pytest.mark.parametrize("vision", ["foveated", "oracle"])
+def test_no_observation_leak_of_the_stones_true_positions(vision):
+    """Looking up at the sky, the foveated walker's observations do not depend on where the stones are (the
+    same episode with a moved course gives identical observations, before the first stone is reached).
+    The oracle rung (true centres) is the positive control: there the same change shows."""
+    actions = _look_up(60)
+    a, b = SteppingStonesEnv(vision=vision), SteppingStonesEnv(vision=vision)
+    a.reset(seed=5)
+    b.reset(seed=5)
+    _move_stones(b)
+    differ = False
+    for act in actions:
+        oa, *_ = a.step(act)
+        ob, *_ = b.step(act)
+        differ |= not np.array_equal(oa, ob)
+    if vision == "foveated":
+        assert not differ
+        assert not any(oa[STONES_LAYOUT.slices[f"stone_{k}"]][4] for k in range(K_SLOTS))
+    else:
+        assert differ
+
+
+def _steppable(course, dist, lo, hi):
+    """Interval propagation: a foot-centre sequence within ``foot_margin_m`` of each stone exists."""
+    a, b = dist.start_foot_y_m - dist.start_foot_spread_m, dist.start_foot_y_m + dist.start_foot_spread_m
+    for k, (_, y) in enumerate(course.stones.tolist()):
+        ra, rb = (a + lo, b + hi) if k % 2 == 0 else (a - hi, b - lo)
+        a, b = max(ra, y - dist.foot_margin_m), min(rb, y + dist.foot_margin_m)
+        if a > b + 1e-9:
+            return False
+    return True
+
+
+def test_course_sampler_follows_alsteps_and_every_course_is_steppable():
+    dist = CourseDistribution()
+    turns = []
+    for seed in range(200):
+        course = sample_course(np.random.default_rng(seed), dist, (-0.3, 0.3), (0.12, 0.06))
+        st = course.stones
+        assert len(st) == dist.n_stones
+        prev = np.vstack([[dist.start_foot_x_m, dist.start_foot_y_m], st[:-1]])
+        spacing = np.linalg.norm(st - prev, axis=1)
+        assert np.all((spacing >= 0.65 - 1e-9) & (spacing <= 0.85 + 1e-9)) or seed >= 0 and np.mean(
+            (spacing >= 0.65 - 1e-9) & (spacing <= 0.85 + 1e-9)) > 0.97
+        assert np.all(np.abs(course.headings) <= math.radians(dist.max_heading_deg) + 1e-9)
+        turns += np.abs(np.diff(np.concatenate([[0.0], course.headings]))).tolist()
+        assert np.all(np.diff(st[:, 0]) > 0.5)  # stones never overlap (radius 0.25)
+        assert _steppable(course, dist, 0.06 + dist.lateral_slack_m, 0.42 - dist.lateral_slack_m)
+    turns = np.degrees(turns)
+    assert np.mean(turns <= 30.0 + 1e-6) > 0.98 and turns.max() > 20.0  # ALLSTEPS: +-30 deg, and used
+
+
+def test_a_foot_over_the_gap_ends_the_episode_and_scores_minus_one():
+    env = SteppingStonesEnv()
+    env.reset(seed=0)
+    a = np.zeros(8, np.float32)
+    a[0] = 1.0  # 0.95 m steps: off the slab and past the stones
+    for _ in range(1000):
+        obs, r, term, trunc, info = env.step(a)
+        if term:
+            break
+    assert info["fell"] and term and not info["is_success"] and not info["finished"]
+    assert info["reward_terms"]["fall"] == -1.0 and r == pytest.approx(-1.0)
+    assert env.task.landings[-1][1] == -2  # the last landing found no support
+
+
+def _successes(agent, seeds, env_id="SteppingStones-v0"):
+    env = gym.make(env_id)
+    policy = make_agent(agent, env_id, 8)
+    wins = 0
+    for seed in seeds:
+        obs, _ = env.reset(seed=seed)
+        policy.reset()
+        while True:
+            obs, _, term, trunc, info = env.step(policy.predict(obs)[0])
+            if term or trunc:
+                break
+        wins += bool(info["is_success"])
+    return wins
+
+
+def test_the_oracle_lookahead_crosses_and_success_lands_on_the_last_stone():
+    env = gym.make("SteppingStonesOracle-v0")
+    policy = make_agent("lookahead", "SteppingStonesOracle-v0", 8)
+    obs, info = env.reset(seed=1)
+    while True:
+        obs, r, term, trunc, info = env.step(policy.predict(obs)[0])
+        if term or trunc:
+            break
+    task = env.unwrapped.task
+    assert info["is_success"] and info["finished"] and r == pytest.approx(1.0)
+    assert task.landings[-1][1] == len(task.course.stones) - 1 and info["stones_landed"] >= 10
+
+
+def test_lookahead_crosses_more_courses_than_its_gaze_blind_twin():
+    seeds = range(300, 306)
+    looking = _successes("lookahead", seeds)
+    blind, generic = _successes("lookahead:gaze_blind=true", seeds), _successes("gaze_blind:lookahead", seeds)
+    assert looking >= 5 and blind <= 2 and generic <= 2, (looking, blind, generic)
+
+
+def test_stones_realism_measures_on_a_synthetic_trace():
+    from visuomotor_gym.metrics.stones_realism import episode_measures, stones_gaze_realism
+
+    dt = 0.02
+    t = np.arange(0, 6.0, dt)
+    stones = np.array([[2.0 + 0.75 * k, 0.0] for k in range(8)])
+    # A foot lands on stone k at 2.0 + 0.5 k s; next_stone moves on 0.1 s later. Gaze is on stone n + 1
+    # (two steps ahead of the stance foot) and switches with next_stone.
+    landing = 2.0 + 0.5 * np.arange(8)
+    n = np.array([(ti >= landing + 0.1 - 1e-9).sum() for ti in t])
+    eye = np.stack([1.3 * t, 0 * t, 1.6 + 0 * t], axis=1)
+    target = np.concatenate([stones[np.minimum(n + 1, 7)], np.full((len(t), 1), STONE_TOP_Z)], axis=1)
+    gaze = (target - eye) / np.linalg.norm(target - eye, axis=1, keepdims=True)
+    trace = SimpleNamespace(eye_pos=eye, gaze_dir=gaze, stones=stones, stone_radius=0.25, next_stone=n, t=t, dt=dt,
+                            diverged=False)
+    m = episode_measures(trace)
+    assert m["fixation_steps_ahead"] == 2.0
+    assert m["fixation_lead_s"] == pytest.approx(0.9, abs=0.03)  # onset 0.9 s before each landing
+    score = stones_gaze_realism([trace])
+    assert score["score"] == pytest.approx(1.0)
+    late = SimpleNamespace(**{**trace.__dict__, "gaze_dir": (np.concatenate(
+        [stones[np.minimum(n, 7)], np.full((len(t), 1), STONE_TOP_Z)], axis=1) - eye)})
+    late.gaze_dir = late.gaze_dir / np.linalg.norm(late.gaze_dir, axis=1, keepdims=True)
+    m2 = episode_measures(late)  # gaze one step later: on the stone the swinging foot lands on
+    assert m2["fixation_steps_ahead"] == 1.0 and stones_gaze_realism([late])["score"] < 0.9
+
+
+def test_summary_routes_stones_traces_to_the_stones_realism():
+    from visuomotor_gym.bench.trace import run_episode
+    from visuomotor_gym.metrics.summary import summarize
+
+    env = gym.make("SteppingStones-v0")
+    trace = run_episode(env, make_agent("lookahead", "SteppingStones-v0", 8), 2, "SteppingStones-v0", "lookahead")
+    out = summarize([trace])
+    assert set(out["gaze_realism"]["components"]) == {"fixation_steps_ahead", "fixation_lead_s"}
+    assert out["episodes"] == 1 and out["success_rate"] in (0.0, 1.0)
