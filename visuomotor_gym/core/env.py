@@ -21,6 +21,7 @@ from __future__ import annotations
 import math
 import os
 import warnings
+from dataclasses import asdict
 
 import gymnasium as gym
 import mujoco
@@ -28,11 +29,16 @@ import numpy as np
 
 from visuomotor_gym.assets import asset_path
 from visuomotor_gym.core import args
-from visuomotor_gym.core.eye import EYE_ACTION_STRUCTURE, EYE_BLOCKS
-from visuomotor_gym.core.head import HEAD_ACTION_STRUCTURE, HEAD_BLOCKS
+from visuomotor_gym.core.eye import EYE_ACTION_STRUCTURE, EYE_BLOCKS, Eye
+from visuomotor_gym.core.head import HEAD_ACTION_STRUCTURE, HEAD_BLOCKS, Head
 from visuomotor_gym.core.observation import ObservationLayout
+from visuomotor_gym.core.retina import VISION_MODES, Retina
+from visuomotor_gym.oculomotor.plant import DEG, OculomotorParams
+from visuomotor_gym.vision.foveation import VisionParams
 
 OBS_MODES = ("flat", "dict")
+MAX_VISION_NOISE_SCALE = 1000.0  # modelling choice: far beyond blindness (x10 is Eyecatch's poor vision)
+MAX_VISUAL_DELAY_S = 2.0  # modelling choice: 20x the human visual latency (~100 ms)
 _BAD_STATE_WARNINGS = (mujoco.mjtWarning.mjWARN_BADQPOS, mujoco.mjtWarning.mjWARN_BADQVEL,
                        mujoco.mjtWarning.mjWARN_BADQACC)
 
@@ -46,6 +52,82 @@ class VisuomotorEnv(gym.Env):
     eye_camera: str = ""
 
     # --- construction -------------------------------------------------------------------------
+    def _check_eye_arguments(
+        self,
+        *,
+        render_mode,
+        vision,
+        vision_noise_scale,
+        vision_params,
+        visual_delay_s,
+        oculomotor_params,
+        gaze_action_range_deg,
+        control_dt,
+        obs_mode,
+        render_camera,
+        record_plant,
+        vision_defaults: VisionParams | None = None,
+    ) -> tuple[float, float]:
+        """Check and keep the arguments every family shares (the eye, the retina, rendering); returns
+        the checked ``(control_dt, visual_delay_s)`` for :meth:`_load_physics` and :meth:`_assemble_eye`.
+
+        ``vision_defaults``: the family's default ``VisionParams`` (a dict of ``vision_params`` fields
+        overrides those); ``vision_noise_scale`` multiplies every standard deviation; ``full_view``
+        drops foveation.
+        """
+        if render_mode is not None:
+            args.choice(render_mode, self.metadata["render_modes"], "render_mode")
+        self.render_mode = render_mode
+        self.vision = args.choice(vision, VISION_MODES, "vision")
+        args.choice(obs_mode, OBS_MODES, "obs_mode")
+        self.render_camera = args.choice(render_camera, tuple(self.render_cameras), "render_camera")
+        scale = args.real(vision_noise_scale, "vision_noise_scale", low=0.0, high=MAX_VISION_NOISE_SCALE)
+        base = vision_defaults if vision_defaults is not None else VisionParams()
+        if isinstance(vision_params, dict):  # fields over the family's defaults (unknown fields refused)
+            vision_params = args.coerce(VisionParams, {**asdict(base), **vision_params}, "vision_params")
+        elif vision_params is None:
+            vision_params = base
+        self.vision_params = args.coerce(VisionParams, vision_params, "vision_params").scaled(scale)
+        if self.vision == "full_view":
+            self.vision_params = VisionParams(**{**asdict(self.vision_params), "foveated": False})
+        self.oculomotor_params = args.coerce(OculomotorParams, oculomotor_params, "oculomotor_params")
+        self.gaze_action_range = args.real(gaze_action_range_deg, "gaze_action_range_deg", low=0.0, high=180.0,
+                                           low_open=True) * DEG
+        self.record_plant = args.flag(record_plant, "record_plant")
+        control_dt = args.real(control_dt, "control_dt", low=0.0, high=1.0, low_open=True)
+        visual_delay_s = args.real(visual_delay_s, "visual_delay_s", low=0.0, high=MAX_VISUAL_DELAY_S)
+        return control_dt, visual_delay_s
+
+    @staticmethod
+    def _reward_weights(defaults: dict, reward_weights, terms) -> dict:
+        """``defaults`` with ``reward_weights`` (term -> finite weight) applied; unknown terms refused."""
+        weights = dict(defaults)
+        if reward_weights is not None and not isinstance(reward_weights, dict):
+            raise TypeError(f"reward_weights must be a dict of term -> weight, got {type(reward_weights).__name__}")
+        for name, value in (reward_weights or {}).items():
+            if name not in terms:
+                raise ValueError(f"reward_weights: unknown term {name!r}; known terms: {list(terms)}")
+            weights[name] = args.real(value, f"reward_weights[{name!r}]")
+        return weights
+
+    def _set_visual_delay(self, visual_delay_s: float) -> None:
+        """The visual latency in control steps (after :meth:`_load_physics` fixed the period)."""
+        self.visual_delay_s = float(visual_delay_s)
+        self.delay_steps = args.whole_multiple(visual_delay_s, self.dt, "visual_delay_s")
+
+    def _assemble_eye(self, *, body, task, obs_mode: str, width: int, height: int) -> None:
+        """:meth:`_assemble` with the eye, head and retina every family shares, from the checked arguments."""
+        self._assemble(
+            body=body,
+            eye=Eye(self.model, self.oculomotor_params, self.gaze_action_range, record=self.record_plant),
+            head=Head(self.model, self.oculomotor_params),
+            retina=Retina(self.vision, self.vision_params, self.delay_steps, self.dt),
+            task=task,
+            obs_mode=obs_mode,
+            width=width,
+            height=height,
+        )
+
     def _load_physics(self, scene: str, control_dt: float) -> None:
         """Compile ``scene`` (a file in ``envs_assets/``) and fix the control period."""
         self.model = mujoco.MjModel.from_xml_path(str(asset_path(scene)))

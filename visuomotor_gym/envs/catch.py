@@ -9,20 +9,16 @@ documentation.
 from __future__ import annotations
 
 import math
-from dataclasses import asdict
 from typing import Any
 
 from visuomotor_gym.body import names
 from visuomotor_gym.body.seated import CONTROL_MODES, HAND_WORKSPACE, SEAT_ORIGIN, SeatedBody
 from visuomotor_gym.control.hand import HandControlParams
 from visuomotor_gym.core import args
-from visuomotor_gym.core.env import OBS_MODES, VisuomotorEnv
-from visuomotor_gym.core.eye import Eye
-from visuomotor_gym.core.head import Head
-from visuomotor_gym.core.retina import VISION_MODES, Retina
+from visuomotor_gym.core.env import VisuomotorEnv
 from visuomotor_gym.envs.observation import SECOND_BALL_OBSERVATION, ObservationLayout, catch_observation
 from visuomotor_gym.tasks.catch_rewards import REWARD_TERMS, SHAPED_WEIGHTS, SPARSE_WEIGHTS
-from visuomotor_gym.oculomotor.plant import DEG, OculomotorParams
+from visuomotor_gym.oculomotor.plant import OculomotorParams
 from visuomotor_gym.scenarios.throws import ThrowDistribution
 from visuomotor_gym.tasks.catch import CatchTask, catch_scene
 from visuomotor_gym.vision.foveation import VisionParams
@@ -30,9 +26,6 @@ from visuomotor_gym.vision.foveation import VisionParams
 __all__ = ["EyeCatchEnv", "HAND_WORKSPACE", "SEAT_ORIGIN"]
 
 REWARD_MODES = ("sparse", "shaped")
-RENDER_CAMERAS = ("both", "scene", "eye", "over_shoulder")
-MAX_VISION_NOISE_SCALE = 1000.0  # modelling choice: far beyond blindness (x10 is the paper's poor vision)
-MAX_VISUAL_DELAY_S = 2.0  # modelling choice: 20x the human visual latency (~100 ms)
 
 
 class EyeCatchEnv(VisuomotorEnv):
@@ -209,18 +202,13 @@ class EyeCatchEnv(VisuomotorEnv):
         **unknown: Any,
     ):
         self._reject_unknown(unknown)
-        if render_mode is not None:
-            args.choice(render_mode, self.metadata["render_modes"], "render_mode")
-        self.render_mode = render_mode
-        self.vision = args.choice(vision, VISION_MODES, "vision")
+        control_dt, visual_delay_s = self._check_eye_arguments(
+            render_mode=render_mode, vision=vision, vision_noise_scale=vision_noise_scale,
+            vision_params=vision_params, visual_delay_s=visual_delay_s, oculomotor_params=oculomotor_params,
+            gaze_action_range_deg=gaze_action_range_deg, control_dt=control_dt, obs_mode=obs_mode,
+            render_camera=render_camera, record_plant=record_plant,
+        )
         self.control = args.choice(control, CONTROL_MODES, "control")
-        args.choice(obs_mode, OBS_MODES, "obs_mode")
-        self.render_camera = args.choice(render_camera, RENDER_CAMERAS, "render_camera")
-        scale = args.real(vision_noise_scale, "vision_noise_scale", low=0.0, high=MAX_VISION_NOISE_SCALE)
-        self.vision_params = args.coerce(VisionParams, vision_params, "vision_params").scaled(scale)
-        if vision == "full_view":
-            self.vision_params = VisionParams(**{**asdict(self.vision_params), "foveated": False})
-        self.oculomotor_params = args.coerce(OculomotorParams, oculomotor_params, "oculomotor_params")
         self.hand_params = args.coerce(HandControlParams, hand_params, "hand_params")
         self.throw_distribution = args.coerce(ThrowDistribution, throw_distribution, "throw_distribution")
         self.bounce_wall = args.flag(bounce_wall, "bounce_wall")
@@ -233,43 +221,22 @@ class EyeCatchEnv(VisuomotorEnv):
         self.catch_radius = args.real(catch_radius, "catch_radius", low=0.0, high=0.5, low_open=True)
         self.grasp_closed_fraction = args.real(grasp_closed_fraction, "grasp_closed_fraction", low=0.0, high=1.0,
                                                low_open=True)
-        self.gaze_action_range = args.real(gaze_action_range_deg, "gaze_action_range_deg", low=0.0, high=180.0,
-                                           low_open=True) * DEG
-        weights = dict(SPARSE_WEIGHTS if args.choice(reward, REWARD_MODES, "reward") == "sparse" else SHAPED_WEIGHTS)
-        if reward_weights is not None and not isinstance(reward_weights, dict):
-            raise TypeError(f"reward_weights must be a dict of term -> weight, got {type(reward_weights).__name__}")
-        for name, value in (reward_weights or {}).items():
-            if name not in REWARD_TERMS:
-                raise ValueError(f"reward_weights: unknown term {name!r}; known terms: {list(REWARD_TERMS)}")
-            weights[name] = args.real(value, f"reward_weights[{name!r}]")
-        self.reward_mode = reward
-        self.reward_weights = weights
-        self.record_plant = args.flag(record_plant, "record_plant")
-        control_dt = args.real(control_dt, "control_dt", low=0.0, high=1.0, low_open=True)
-        visual_delay_s = args.real(visual_delay_s, "visual_delay_s", low=0.0, high=MAX_VISUAL_DELAY_S)
+        self.reward_mode = args.choice(reward, REWARD_MODES, "reward")
+        self.reward_weights = self._reward_weights(
+            SPARSE_WEIGHTS if self.reward_mode == "sparse" else SHAPED_WEIGHTS, reward_weights, REWARD_TERMS)
 
         self._load_physics(catch_scene(self.n_balls), control_dt)
-        self.visual_delay_s = float(visual_delay_s)
-        self.delay_steps = args.whole_multiple(visual_delay_s, self.dt, "visual_delay_s")
+        self._set_visual_delay(visual_delay_s)
         body = SeatedBody(self.model, self.control, self.hand_params, self.dt)
         task = CatchTask(
             self.model, body, n_balls=self.n_balls, bounce_wall=self.bounce_wall,
             release_after_catch_s=self.release_after_catch_s, catch_radius=self.catch_radius,
             grasp_closed_fraction=self.grasp_closed_fraction, throw_distribution=self.throw_distribution,
-            reward_weights=weights, dt=self.dt, visual_delay_s=self.visual_delay_s,
+            reward_weights=self.reward_weights, dt=self.dt, visual_delay_s=self.visual_delay_s,
             neutral_fixation_m=math.sqrt(self.oculomotor_params.fixation_range_m[0]
                                          * self.oculomotor_params.fixation_range_m[1]),
         )
-        self._assemble(
-            body=body,
-            eye=Eye(self.model, self.oculomotor_params, self.gaze_action_range, record=self.record_plant),
-            head=Head(self.model, self.oculomotor_params),
-            retina=Retina(self.vision, self.vision_params, self.delay_steps, self.dt),
-            task=task,
-            obs_mode=obs_mode,
-            width=width,
-            height=height,
-        )
+        self._assemble_eye(body=body, task=task, obs_mode=obs_mode, width=width, height=height)
         self.hand = body.hand
 
     @property
@@ -292,3 +259,5 @@ if EyeCatchEnv.__doc__:
     EyeCatchEnv.__doc__ = EyeCatchEnv.__doc__.replace(
         "OBSERVATION_TABLE", ObservationLayout(catch_observation(1)).markdown_table()
     )
+
+RENDER_CAMERAS = tuple(EyeCatchEnv.render_cameras)
