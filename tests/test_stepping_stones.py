@@ -22,10 +22,10 @@ STONES_IDS = FAMILIES["stones"]
 
 
 def rollout(env, seed, actions):
-    obs, info = env.reset(seed=seed)
+    obs, _ = env.reset(seed=seed)
     out = [obs.copy()]
     for a in actions:
-        obs, r, term, trunc, info = env.step(a)
+        obs, r, term, trunc, _ = env.step(a)
         out.append(np.append(obs, r))
         if term or trunc:
             break
@@ -46,7 +46,7 @@ def test_every_rung_runs_from_the_registry_on_the_same_course(env_id):
     _, ref_info = SteppingStonesEnv().reset(seed=7)
     np.testing.assert_array_equal(info["stones"], ref_info["stones"])  # same course on every rung
     for _ in range(5):
-        obs, r, term, trunc, info = env.step(env.action_space.sample())
+        obs, *_ = env.step(env.action_space.sample())
         assert env.observation_space.contains(obs) and np.isfinite(obs).all()
 
 
@@ -164,19 +164,20 @@ def _steppable(course, dist, lo, hi):
 
 def test_course_sampler_follows_alsteps_and_every_course_is_steppable():
     dist = CourseDistribution()
-    turns = []
+    turns, in_range = [], []
     for seed in range(200):
         course = sample_course(np.random.default_rng(seed), dist, (-0.3, 0.3), (0.12, 0.06))
         st = course.stones
         assert len(st) == dist.n_stones
         prev = np.vstack([[dist.start_foot_x_m, dist.start_foot_y_m], st[:-1]])
         spacing = np.linalg.norm(st - prev, axis=1)
-        assert np.all((spacing >= 0.65 - 1e-9) & (spacing <= 0.85 + 1e-9)) or seed >= 0 and np.mean(
-            (spacing >= 0.65 - 1e-9) & (spacing <= 0.85 + 1e-9)) > 0.97
+        in_range += ((spacing >= 0.65 - 1e-9) & (spacing <= 0.85 + 1e-9)).tolist()
+        assert np.all((spacing > 0.5) & (spacing < 1.0))  # a redrawn stone moves sideways only
         assert np.all(np.abs(course.headings) <= math.radians(dist.max_heading_deg) + 1e-9)
         turns += np.abs(np.diff(np.concatenate([[0.0], course.headings]))).tolist()
         assert np.all(np.diff(st[:, 0]) > 0.5)  # stones never overlap (radius 0.25)
         assert _steppable(course, dist, 0.06 + dist.lateral_slack_m, 0.42 - dist.lateral_slack_m)
+    assert np.mean(in_range) > 0.98  # ALLSTEPS' 0.65-0.85 m spacing (the rare redraw moves a stone sideways)
     turns = np.degrees(turns)
     assert np.mean(turns <= 30.0 + 1e-6) > 0.98 and turns.max() > 20.0  # ALLSTEPS: +-30 deg, and used
 
@@ -187,7 +188,7 @@ def test_a_foot_over_the_gap_ends_the_episode_and_scores_minus_one():
     a = np.zeros(8, np.float32)
     a[0] = 1.0  # 0.95 m steps: off the slab and past the stones
     for _ in range(1000):
-        obs, r, term, trunc, info = env.step(a)
+        _, r, term, _, info = env.step(a)
         if term:
             break
     assert info["fell"] and term and not info["is_success"] and not info["finished"]
