@@ -8,7 +8,6 @@ task (:mod:`visuomotor_gym.tasks.stepping_stones`).
 
 from __future__ import annotations
 
-from dataclasses import asdict, fields, replace
 from typing import Any
 
 from visuomotor_gym.body import names
@@ -16,13 +15,12 @@ from visuomotor_gym.body import walker_names as wn
 from visuomotor_gym.body.walker import GaitParams
 from visuomotor_gym.body.walker_body import WALKER_BLOCKS, WalkerBody
 from visuomotor_gym.core import args
-from visuomotor_gym.core.env import OBS_MODES, VisuomotorEnv
-from visuomotor_gym.core.eye import EYE_BLOCKS, Eye
-from visuomotor_gym.core.head import HEAD_BLOCKS, Head
+from visuomotor_gym.core.env import VisuomotorEnv
+from visuomotor_gym.core.eye import EYE_BLOCKS
+from visuomotor_gym.core.head import HEAD_BLOCKS
 from visuomotor_gym.core.observation import ObservationLayout
-from visuomotor_gym.core.retina import VISION_MODES, Retina
-from visuomotor_gym.envs.walk import MAX_VISION_NOISE_SCALE, MAX_VISUAL_DELAY_S, WALK_VISION
-from visuomotor_gym.oculomotor.plant import DEG, OculomotorParams
+from visuomotor_gym.envs.walk import WALK_VISION
+from visuomotor_gym.oculomotor.plant import OculomotorParams
 from visuomotor_gym.tasks.stepping_stones import (
     DEFAULT_REWARD_WEIGHTS,
     K_SLOTS,
@@ -171,57 +169,23 @@ class SteppingStonesEnv(VisuomotorEnv):
         **unknown: Any,
     ):
         self._reject_unknown(unknown)
-        if render_mode is not None:
-            args.choice(render_mode, self.metadata["render_modes"], "render_mode")
-        self.render_mode = render_mode
-        self.vision = args.choice(vision, VISION_MODES, "vision")
-        args.choice(obs_mode, OBS_MODES, "obs_mode")
-        self.render_camera = args.choice(render_camera, RENDER_CAMERAS, "render_camera")
-        scale = args.real(vision_noise_scale, "vision_noise_scale", low=0.0, high=MAX_VISION_NOISE_SCALE)
-        if isinstance(vision_params, dict):  # fields over the walk family's defaults (20 deg field)
-            allowed = {f.name for f in fields(VisionParams)}
-            bad = sorted(set(vision_params) - allowed)
-            if bad:
-                raise TypeError(f"vision_params: unknown field(s) {bad}; allowed: {sorted(allowed)}")
-            vision_params = replace(WALK_VISION, **vision_params)
-        elif vision_params is None:
-            vision_params = WALK_VISION
-        self.vision_params = args.coerce(VisionParams, vision_params, "vision_params").scaled(scale)
-        if vision == "full_view":
-            self.vision_params = VisionParams(**{**asdict(self.vision_params), "foveated": False})
-        self.oculomotor_params = args.coerce(OculomotorParams, oculomotor_params, "oculomotor_params")
+        control_dt, visual_delay_s = self._check_eye_arguments(
+            render_mode=render_mode, vision=vision, vision_noise_scale=vision_noise_scale,
+            vision_params=vision_params, visual_delay_s=visual_delay_s, oculomotor_params=oculomotor_params,
+            gaze_action_range_deg=gaze_action_range_deg, control_dt=control_dt, obs_mode=obs_mode,
+            render_camera=render_camera, record_plant=record_plant,
+            vision_defaults=WALK_VISION,  # the walk family's 20 deg recognition field
+        )
         self.gait_params = args.coerce(GaitParams, gait_params, "gait_params")
         self.course_distribution = args.coerce(CourseDistribution, course_distribution, "course_distribution")
-        self.gaze_action_range = args.real(gaze_action_range_deg, "gaze_action_range_deg", low=0.0, high=180.0,
-                                           low_open=True) * DEG
-        weights = dict(DEFAULT_REWARD_WEIGHTS)
-        if reward_weights is not None and not isinstance(reward_weights, dict):
-            raise TypeError(f"reward_weights must be a dict of term -> weight, got {type(reward_weights).__name__}")
-        for name, value in (reward_weights or {}).items():
-            if name not in REWARD_TERMS:
-                raise ValueError(f"reward_weights: unknown term {name!r}; known terms: {list(REWARD_TERMS)}")
-            weights[name] = args.real(value, f"reward_weights[{name!r}]")
-        self.reward_weights = weights
-        self.record_plant = args.flag(record_plant, "record_plant")
-        control_dt = args.real(control_dt, "control_dt", low=0.0, high=1.0, low_open=True)
-        visual_delay_s = args.real(visual_delay_s, "visual_delay_s", low=0.0, high=MAX_VISUAL_DELAY_S)
+        self.reward_weights = self._reward_weights(DEFAULT_REWARD_WEIGHTS, reward_weights, REWARD_TERMS)
 
         self._load_physics(STONES_SCENE, control_dt)
-        self.visual_delay_s = float(visual_delay_s)
-        self.delay_steps = args.whole_multiple(visual_delay_s, self.dt, "visual_delay_s")
+        self._set_visual_delay(visual_delay_s)
         body = WalkerBody(self.model, self.gait_params)
         task = SteppingStonesTask(self.model, body, course_distribution=self.course_distribution,
-                                  reward_weights=weights)
-        self._assemble(
-            body=body,
-            eye=Eye(self.model, self.oculomotor_params, self.gaze_action_range, record=self.record_plant),
-            head=Head(self.model, self.oculomotor_params),
-            retina=Retina(self.vision, self.vision_params, self.delay_steps, self.dt),
-            task=task,
-            obs_mode=obs_mode,
-            width=width,
-            height=height,
-        )
+                                  reward_weights=self.reward_weights)
+        self._assemble_eye(body=body, task=task, obs_mode=obs_mode, width=width, height=height)
         self.gait = body.gait
 
     def _observe(self, saccading: bool):
