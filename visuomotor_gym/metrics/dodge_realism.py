@@ -105,31 +105,7 @@ def dodge_summary(traces: Sequence) -> dict:
     """:func:`visuomotor_gym.metrics.summary.summarize` for dodge traces: the same keys (``caught`` counts
     successes), ``gaze_realism`` from :func:`dodge_gaze_realism`; ``time_to_catch_s`` is the time to the
     goal of the successful walks, ``miss_distance_m`` the distance left to the goal in the failed ones."""
-    from visuomotor_gym.metrics.gaze import first_saccade_latency
-    from visuomotor_gym.metrics.stats import mean_median, wilson_interval
-    from visuomotor_gym.metrics.summary import latency_summary
+    from visuomotor_gym.metrics.summary import goal_summary
 
-    traces = list(traces)
-    n = len(traces)
-    succeeded = sum(bool(tr.success) for tr in traces)
-    valid = [tr for tr in traces if not tr.diverged]
-    low, high = wilson_interval(succeeded, n)
-    left = [max(float(tr.goal_distance) - float(np.asarray(tr.pelvis_pos)[-1, 0]), 0.0)
-            for tr in valid if not tr.success]
-    return {
-        "episodes": n,
-        "caught": succeeded,
-        "catch_rate": succeeded / n if n else float("nan"),
-        "catch_rate_ci95": [low, high],
-        "success_rate": succeeded / n if n else float("nan"),
-        "success_rate_ci95": [low, high],
-        "diverged": sum(bool(tr.diverged) for tr in traces),
-        "gaze_realism": dodge_gaze_realism(valid),
-        "latency_ms": latency_summary(traces),
-        "reaction_times_s": {
-            "first_saccade": mean_median([first_saccade_latency(tr) for tr in valid]),
-            "hand_onset": mean_median([float("nan")]),
-        },
-        "miss_distance_m": mean_median(left),
-        "time_to_catch_s": mean_median([float(tr.t[-1]) for tr in valid if tr.success]),
-    }
+    return goal_summary(traces, dodge_gaze_realism,
+                        lambda tr: max(float(tr.goal_distance) - float(np.asarray(tr.pelvis_pos)[-1, 0]), 0.0))

@@ -86,22 +86,9 @@ def summarize(traces: Sequence) -> dict:
     catch rate and latency.
     """
     traces = list(traces)
-    if traces and _family(traces[0]) == "reach":  # the reach family's realism and outcomes (issue 14)
-        from visuomotor_gym.metrics.reach_realism import reach_summary
-
-        return to_json_safe(reach_summary(traces))
-    if traces and _family(traces[0]) == "walk":  # the walk family's realism and outcomes (issue 12)
-        from visuomotor_gym.metrics.walk_realism import walk_summary
-
-        return to_json_safe(walk_summary(traces))
-    if traces and _family(traces[0]) == "stones":  # the stones family's realism and outcomes (issue 13)
-        from visuomotor_gym.metrics.stones_realism import stones_summary
-
-        return to_json_safe(stones_summary(traces))
-    if traces and _family(traces[0]) == "dodge":  # the dodge family's realism and outcomes (issue 13)
-        from visuomotor_gym.metrics.dodge_realism import dodge_summary
-
-        return to_json_safe(dodge_summary(traces))
+    family = _family(traces[0]) if traces else None
+    if family in _FAMILY_SUMMARIES:  # a family with its own realism table and outcome measures
+        return to_json_safe(_FAMILY_SUMMARIES[family](traces))
     n = len(traces)
     caught = sum(bool(tr.caught) for tr in traces)
     diverged = sum(bool(tr.diverged) for tr in traces)
@@ -129,3 +116,53 @@ def summarize(traces: Sequence) -> dict:
         "time_to_catch_s": mean_median([time_to_catch(tr) for tr in valid if tr.caught]),
     }
     return to_json_safe(out)
+
+
+def goal_summary(traces: Sequence, realism, distance_left) -> dict:
+    """:func:`summarize` for a family whose goal is not a catch (walk, stones, dodge): the same keys,
+    ``caught`` and ``catch_rate`` counting successes; ``gaze_realism`` from the family's ``realism(valid
+    traces)``; ``time_to_catch_s`` the time to the goal of the successful episodes and
+    ``miss_distance_m`` ``distance_left(trace)`` of the failed ones (diverged episodes left out of the
+    behavioural measures, as for catching)."""
+    from visuomotor_gym.metrics.gaze import first_saccade_latency
+
+    traces = list(traces)
+    n = len(traces)
+    succeeded = sum(bool(tr.success) for tr in traces)
+    valid = [tr for tr in traces if not tr.diverged]
+    low, high = wilson_interval(succeeded, n)
+    return {
+        "episodes": n,
+        "caught": succeeded,
+        "catch_rate": succeeded / n if n else float("nan"),
+        "catch_rate_ci95": [low, high],
+        "success_rate": succeeded / n if n else float("nan"),
+        "success_rate_ci95": [low, high],
+        "diverged": sum(bool(tr.diverged) for tr in traces),
+        "gaze_realism": realism(valid),
+        "latency_ms": latency_summary(traces),
+        "reaction_times_s": {
+            "first_saccade": mean_median([first_saccade_latency(tr) for tr in valid]),
+            "hand_onset": mean_median([float("nan")]),
+        },
+        "miss_distance_m": mean_median([distance_left(tr) for tr in valid if not tr.success]),
+        "time_to_catch_s": mean_median([float(tr.t[-1]) for tr in valid if tr.success]),
+    }
+
+
+def _family_summary(module: str, function: str):
+    def run(traces):
+        import importlib
+
+        return getattr(importlib.import_module(f"visuomotor_gym.metrics.{module}"), function)(traces)
+
+    return run
+
+
+# The families with their own summary (realism table and outcome measures); catch is summarize() itself.
+_FAMILY_SUMMARIES = {
+    "reach": _family_summary("reach_realism", "reach_summary"),
+    "walk": _family_summary("walk_realism", "walk_summary"),
+    "stones": _family_summary("stones_realism", "stones_summary"),
+    "dodge": _family_summary("dodge_realism", "dodge_summary"),
+}
