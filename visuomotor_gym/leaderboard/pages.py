@@ -175,11 +175,12 @@ def render_readme(lb: Leaderboard) -> str:
         "",
         "# visuomotor_gym leaderboard",
         "",
-        "Agents catch thrown balls seeing only through a human-like eye. Every number comes from the "
+        "Agents catch thrown balls, reach to shelves, walk over obstacles and step on stones, seeing only "
+        "through a human-like eye. Every number comes from the "
         "evaluator of `vmgym bench` on the standard protocol ([protocol.json](protocol.json)): a fixed "
-        "number of episodes per env id on pinned seeds (episode *i* uses seed + *i*). The env ids climb the "
+        "number of episodes per env id on pinned seeds (episode *i* uses seed + *i*). The catch ids climb the "
         "observability ladder from the true ball state to a foveated, saccading eye with latency, poor "
-        "vision or a bounce. "
+        "vision or a bounce; each other family is scored on its foveated id. "
         "[The page with plots](index.html) shows the same entries.",
         "",
         "| agent | env id | success rate [95 % CI] | gaze gain | gaze realism | latency p95 (self-reported) "
@@ -226,7 +227,7 @@ def render_readme(lb: Leaderboard) -> str:
         "table (`visuomotor_gym/metrics/human_reference.json`); *latency*: policy compute time per control "
         "step, as measured by the submitter (CI re-measures it on a new entry's re-scored episodes and "
         "refuses a claim more than 10x below its own); *success rate*: episodes that met the task's goal "
-        "(on these catch env ids: the catch rate); *real time*: latency p95 below the control period; "
+        "(on the catch env ids: the catch rate); *real time*: latency p95 below the control period; "
         "*verified*: a new entry is re-played by CI on every pinned seed, and existing entries on "
         f"{sample} seeds drawn from the base commit.",
         "",
@@ -601,8 +602,9 @@ def render_html(lb: Leaderboard) -> str:
         "<title>visuomotor_gym leaderboard</title>",
         f"<style>{CSS}</style></head><body>",
         "<h1>visuomotor_gym leaderboard</h1>",
-        '<p class="lede">Agents catch thrown balls seeing only through a human-like eye: sharp only near the '
-        "line of sight, noisy, blind during saccades. Every number comes from the evaluator of "
+        '<p class="lede">Agents catch thrown balls, reach, walk over obstacles and step on stones seeing only '
+        "through a human-like eye: sharp only near the line of sight, noisy, blind during saccades. The gaze "
+        "gain is the success rate minus that of the agent's gaze-blind twin. Every number comes from the evaluator of "
         "<code>vmgym bench</code> on the standard protocol "
         '(<a href="protocol.json">protocol.json</a>), pinned '
         f"seeds per env id; CI re-plays a new entry on every pinned seed and existing entries on {sample} "
