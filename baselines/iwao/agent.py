@@ -26,12 +26,12 @@ import numpy as np
 from visuomotor_gym.body.walker import GaitParams
 from visuomotor_gym.body.walker_body import WalkerBody
 from visuomotor_gym.envs.walk import WALK_LAYOUT
-from visuomotor_gym.registration import env_vision
+from visuomotor_gym.registration import env_vision, env_vision_params
 from visuomotor_gym.tasks.obstacle_walk import K_SLOTS
 from visuomotor_gym.vision.foveation import VisionParams
 
 from .gaze import DEG, IwaoGazeParams, peak_angles, pitch_at
-from .perception import ObstacleMemory
+from .perception import ObstacleMemory, eye_motion
 from .planner import FootstepPlanner, PlannerParams
 
 _S = WALK_LAYOUT.slices
@@ -45,10 +45,24 @@ class IwaoParams:
     foveated: bool = True
     visual_delay_s: float = 0.0
     gaze_action_range_deg: float = 60.0
+    # The knee of the eye's slip term (VisionParams.position_slip_knee_deg_s; Westheimer & McKee 1975):
+    # the agent predicts each sample's retinal slip from its own eye motion and weights it accordingly
+    # (a brain adapted to its own eye); set from the env id by ``for_env``.
+    position_slip_knee_deg_s: float = 2.5
     # With no obstacle known ahead, look at the ground this far ahead of the eye: travel fixations 1-2 m
     # ahead of the feet (Patla & Vickers 1997); 2 m, the far end (modelling choice: the farther the
     # point, the more of the path ahead lies near the fovea).
     travel_look_ahead_m: float = 2.0
+    # Around the peak of each cycle's Gaussians (|t - T_F/2| <= this many sigma) the gaze holds the
+    # cycle's fixation point instead of sweeping with the Gaussian (modelling choice; see _look).
+    fixation_window_sigma: float = 1.0
+    # The fixation point lies at most this far beyond the target (modelling choice: keeps it on the
+    # ground near the obstacle when theta_V is large).
+    fixation_beyond_max_m: float = 2.0
+    # An optional pursuit lead (s): the request runs this far ahead on the eye's predicted path, as humans
+    # pursue predictable targets without the onset latency (Bahill & McDonald 1983). 0 by default: a lead
+    # of the plant's 150 ms latency did not lower the fixated point's slip (docs/reproductions/iwao.md).
+    pursuit_lead_s: float = 0.0
     gaze_blind: bool = False
     control_dt: float = 0.02
 
@@ -62,16 +76,20 @@ class IwaoAgent:
         self.gaze_params = gaze or IwaoGazeParams()
         self.gait = gait or GaitParams()
         self.planner = FootstepPlanner(self.gait, planner)
-        self.vision = VisionParams(noise_scale=p.vision_noise_scale, foveated=p.foveated)
+        self.vision = VisionParams(noise_scale=p.vision_noise_scale, foveated=p.foveated,
+                                   position_slip_knee_deg_s=p.position_slip_knee_deg_s)
         self.delay_steps = round(p.visual_delay_s / p.control_dt)
         self.gaze_range = p.gaze_action_range_deg * DEG
         self.memory = ObstacleMemory(self.vision)
+        self.period_steps = round(self.gait.step_s / p.control_dt)
+        self.lead_steps = min(round(p.pursuit_lead_s / p.control_dt), self.period_steps)
         self.reset()
 
     @classmethod
     def for_env(cls, env_id: str, **overrides) -> IwaoAgent:
         """An agent whose assumed vision matches the registered env (noise, foveation, latency)."""
-        base = IwaoParams(**env_vision(env_id))
+        base = IwaoParams(**env_vision(env_id),
+                          position_slip_knee_deg_s=env_vision_params(env_id).position_slip_knee_deg_s)
         known = {f.name for f in fields(IwaoParams)}
         unknown = sorted(set(overrides) - known)
         if unknown:
@@ -82,6 +100,9 @@ class IwaoAgent:
         self.memory.reset()
         self.started = False
         self.poses: list = []  # (eye_pos, rot rows, odometry) of the last steps, for delayed percepts
+        self.prev_seen_eye = None
+        self.eye_history: list = []  # eye positions (path frame) of the last step, for the pursuit lead
+        self.fix_offset = None  # (azimuth, elevation) offset of the led request, set at each fixation's start  # (eye position, gaze direction), path frame, of the last percepts' pose
         self.cycle_start_phase = None
         self.peaks = (0.0, 0.0)
         self.target = None  # (x, y, z) of the point looked at this cycle, path frame
@@ -126,6 +147,9 @@ class IwaoAgent:
 
     def _perceive(self, ol: list, pose) -> None:
         eye_pos, rot_rows, odo = pose
+        seen_eye = _eye_in_path(pose)
+        prev, self.prev_seen_eye = self.prev_seen_eye, seen_eye
+        motion = None if prev is None else eye_motion(prev, seen_eye, self.params.control_dt)
         for k in range(K_SLOTS):
             b = _S[f"obstacle_{k}"].start
             near, far = ol[b + 7], ol[b + 8]
@@ -133,9 +157,9 @@ class IwaoAgent:
                 continue
             index = round(ol[b])
             if near > 0.0:
-                self.memory.add(index, 0, ol[b + 1:b + 4], eye_pos, rot_rows, odo)
+                self.memory.add(index, 0, ol[b + 1:b + 4], eye_pos, rot_rows, odo, motion)
             if far > 0.0:
-                self.memory.add(index, 1, ol[b + 4:b + 7], eye_pos, rot_rows, odo)
+                self.memory.add(index, 1, ol[b + 4:b + 7], eye_pos, rot_rows, odo, motion)
 
     def _footholds(self, obs: np.ndarray, odo) -> list[tuple[float, float, float]]:
         f = obs[_S["footholds"]].reshape(3, 3)
@@ -171,17 +195,63 @@ class IwaoAgent:
         new_cycle = self.cycle_start_phase is None or phase < self.cycle_start_phase
         self.cycle_start_phase = phase
         if new_cycle or self.target is None:
+            self.fix_offset = None
             self.target, self.target_id = self._choose_target(obs, pose)
             # theta_G and l predicted at the cycle's middle (Eq. 8 evaluates them at t = T_F / 2).
             l_mid = max(self.target[0] - ex - self.gait.nominal_step_m / T * (0.5 * T - t), 0.3)
             theta_g = math.atan2(ez - self.target[2], l_mid)
             self.peaks = peak_angles(theta_g, l_mid, gp)
+            # The cycle's fixation point: where the peak gaze (theta_G - theta_V below the horizontal,
+            # from the eye at mid-cycle) meets the plane of the target's top; the target itself when
+            # theta_V = 0 (beyond beta * theta_Vmax).
+            peak = self.peaks[0] + self.peaks[1]
+            reach = (ez - self.target[2]) / math.tan(peak) if peak > 1e-3 else 1e3
+            reach = min(max(reach, l_mid), l_mid + self.params.fixation_beyond_max_m)
+            mx = self.target[0] - l_mid  # the eye's predicted x at mid-cycle
+            dx, dy = self.target[0] - mx, self.target[1] - ey
+            k = reach / max(math.hypot(dx, dy), 1e-6)
+            self.fixation = (mx + k * dx, ey + k * dy, self.target[2])
         head, eye = pitch_at(t, T, self.peaks[0], self.peaks[1], gp)
+        ex, ey, ez = _eye_in_path(pose)[0]
+        sigma = gp.sigma_fraction * T
+        fixating = abs(t - 0.5 * T) <= self.params.fixation_window_sigma * sigma
         self.log.append((float(obs[_S["time"]][0]), self.target_id, head, eye))
-        pitch = head + eye  # downward gaze below the horizontal
-        az = math.atan2(self.target[1] - ey, max(self.target[0] - ex, 0.3))
-        cp = math.cos(pitch)
-        wx, wy, wz = cp * math.cos(az), cp * math.sin(az), -math.sin(pitch)  # pelvis-frame axes
+        self.eye_history.append((ex, ey, ez))
+        n = len(self.eye_history)
+        if n > self.period_steps + 1:
+            self.eye_history.pop(0)
+            n -= 1
+        if fixating:
+            # Hold the fixation point: ask for its direction every step, so the request moves as the point's
+            # image would and the plant's pursuit counter-rotates the eye (gaze stabilised on a ground point
+            # while walking: Matthis, Yates & Hayhoe 2018). Pursuit answers the request's motion after its
+            # latency; for a predictable target humans pursue with none (Bahill & McDonald 1983), so the
+            # request moves as the point's direction will from the eye ``pursuit_lead_s`` ahead, the eye's
+            # path predicted as the last step's path moved on by one step (the bob repeats every step),
+            # offset so that it starts where the point is now.
+            fx, fy, fz = self.fixation
+            k = self.lead_steps
+            if self.params.pursuit_lead_s > 0.0 and n > self.period_steps:
+                h = self.eye_history
+                a, b = h[n - 1 - self.period_steps + k], h[0]
+                px, py, pz = ex + a[0] - b[0], ey + a[1] - b[1], ez + a[2] - b[2]
+            else:
+                px, py, pz = ex, ey, ez
+            az_now, el_now = _angles(fx - ex, fy - ey, fz - ez)
+            az_lead, el_lead = _angles(fx - px, fy - py, fz - pz)
+            if self.fix_offset is None:
+                self.fix_offset = (az_now - az_lead, el_now - el_lead)
+            az_r, el_r = az_lead + self.fix_offset[0], el_lead + self.fix_offset[1]
+            ce = math.cos(el_r)
+            wx, wy, wz = ce * math.cos(az_r), ce * math.sin(az_r), math.sin(el_r)
+        else:
+            self.fix_offset = None
+            pitch = head + eye  # downward gaze below the horizontal
+            az = math.atan2(self.target[1] - ey, max(self.target[0] - ex, 0.3))
+            cp = math.cos(pitch)
+            wx, wy, wz = cp * math.cos(az), cp * math.sin(az), -math.sin(pitch)
+        c, s_ = math.cos(odo[2]), math.sin(odo[2])
+        wx, wy = c * wx + s_ * wy, -s_ * wx + c * wy  # path frame to pelvis frame (yaw)
         (a00, a01, a02), (a10, a11, a12), (a20, a21, a22) = rot
         e0 = a00 * wx + a10 * wy + a20 * wz  # R^T w: in the eye frame
         e1 = a01 * wx + a11 * wy + a21 * wz
@@ -193,3 +263,18 @@ class IwaoAgent:
                 0.0,  # fixation distance: unused in v0
                 0.0,  # head yaw straight
                 min(max(-head / (NECK_PITCH_DOWN_DEG * DEG), -1.0), 0.0)]
+
+
+def _angles(x: float, y: float, z: float) -> tuple[float, float]:
+    """(azimuth, elevation) of a direction."""
+    return math.atan2(y, x), math.atan2(z, math.hypot(x, y))
+
+
+def _eye_in_path(pose):
+    """(eye position, gaze direction) in the path frame from a pose (eye_pos and rot rows in the pelvis
+    frame, odometry (x, y, yaw, pelvis height))."""
+    eye_pos, rot, (ox, oy, yaw, pz) = pose
+    c, s = math.cos(yaw), math.sin(yaw)
+    gx, gy, gz = rot[0][0], rot[1][0], rot[2][0]
+    ex, ey = eye_pos[0], eye_pos[1]
+    return ((ox + c * ex - s * ey, oy + s * ex + c * ey, pz + eye_pos[2]), (c * gx - s * gy, s * gx + c * gy, gz))

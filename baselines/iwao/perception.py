@@ -21,6 +21,31 @@ from visuomotor_gym.vision.foveation import VisionParams, _sigmas
 MIN_STD_M = 1e-4  # a floor for the noiseless oracle rung (its information would be infinite)
 
 
+def eye_motion(prev, now, dt: float):
+    """(eye velocity, gaze angular velocity) in the path frame between two eye poses ``(eye position,
+    gaze direction)`` (path frame) ``dt`` seconds apart: the same finite differences as the env's
+    retinal slip (``core.eye.Eye.retinal_speed``)."""
+    (p0, g0), (p1, g1) = prev, now
+    v = ((p1[0] - p0[0]) / dt, (p1[1] - p0[1]) / dt, (p1[2] - p0[2]) / dt)
+    w = ((g0[1] * g1[2] - g0[2] * g1[1]) / dt, (g0[2] * g1[0] - g0[0] * g1[2]) / dt,
+         (g0[0] * g1[1] - g0[1] * g1[0]) / dt)
+    return v, w
+
+
+def still_point_slip(u, d: float, v, w) -> float:
+    """Speed (rad/s) of the image of a still point at distance ``d`` along the unit line of sight ``u``
+    for an eye moving at ``v`` whose gaze turns at ``w``: the line of sight's angular velocity
+    ``u x (-v) / d`` minus ``w``, across the line of sight."""
+    ux, uy, uz = u
+    ax, ay, az = -v[0], -v[1], -v[2]
+    sx = (uy * az - uz * ay) / d - w[0]
+    sy = (uz * ax - ux * az) / d - w[1]
+    sz = (ux * ay - uy * ax) / d - w[2]
+    along = sx * ux + sy * uy + sz * uz
+    sx, sy, sz = sx - along * ux, sy - along * uy, sz - along * uz
+    return math.sqrt(sx * sx + sy * sy + sz * sz)
+
+
 class Corner:
     """Information-form estimate of one still point."""
 
@@ -99,10 +124,14 @@ class ObstacleMemory:
     def reset(self) -> None:
         self.corners = {}
 
-    def add(self, index: int, which: int, p_eye, eye_pos, rot_rows, odo) -> None:
+    def add(self, index: int, which: int, p_eye, eye_pos, rot_rows, odo, motion=None) -> None:
         """One sample of corner ``which`` (0 near-left, 1 far-right) of obstacle ``index``: ``p_eye`` in
         the eye frame, ``eye_pos`` and ``rot_rows`` (3x3, columns = eye axes) in the pelvis frame,
-        ``odo`` = (x, y, yaw, pelvis height) placing the pelvis frame in the path frame."""
+        ``odo`` = (x, y, yaw, pelvis height) placing the pelvis frame in the path frame. ``motion`` =
+        (eye velocity, gaze angular velocity), path frame, over the control step that ended with this
+        sample (the agent's efference copy and proprioception: :func:`eye_motion`): the retinal slip of
+        a still corner, which widens the lateral noise above the knee (``VisionParams``
+        ``position_slip_knee_deg_s``, Westheimer & McKee 1975), is predicted from it; None: no slip."""
         ex, ey, ez = p_eye
         d = math.sqrt(ex * ex + ey * ey + ez * ez)
         if d <= 0.0:
@@ -140,7 +169,8 @@ class ObstacleMemory:
             if d < 0.3 * d_ref:  # too near to trust its direction
                 return
         d_ref = min(max(d_ref, 0.3), 30.0)
-        s_depth, s_lat = _sigmas(d_ref, ecc, 0.0, self.vision)[:2]
+        slip = 0.0 if motion is None else still_point_slip(u, d_ref, *motion)
+        s_depth, s_lat = _sigmas(d_ref, ecc, slip, self.vision)[:2]
         corner.add(z, u, max(s_depth, MIN_STD_M), max(s_lat, MIN_STD_M))
 
     def obstacle(self, index: int) -> ObstacleEstimate | None:
