@@ -74,7 +74,8 @@ def _finite_or_none(x) -> float | None:
 def episode_record(trace) -> dict:
     """The outcome record of one :class:`~visuomotor_gym.bench.trace.EpisodeTrace`."""
     from visuomotor_gym.metrics.gaze import first_saccade_latency
-    from visuomotor_gym.metrics.outcome import miss_distance, time_to_catch
+    from visuomotor_gym.metrics.outcome import time_to_catch
+    from visuomotor_gym.metrics.summary import episode_miss_distance
 
     return {
         "seed": int(trace.seed),
@@ -82,7 +83,7 @@ def episode_record(trace) -> dict:
         "diverged": bool(trace.diverged),
         "steps": int(trace.steps),
         "catch_time_s": _finite_or_none(time_to_catch(trace)),
-        "miss_distance_m": _finite_or_none(miss_distance(trace)),
+        "miss_distance_m": _finite_or_none(episode_miss_distance(trace)),
         "first_saccade_s": _finite_or_none(first_saccade_latency(trace)),
     }
 

@@ -101,11 +101,15 @@ def dodge_gaze_realism(traces: Sequence, reference: dict | None = None) -> dict:
     return {"score": score if math.isfinite(score) else float("nan"), "components": components}
 
 
+def distance_left(tr) -> float:
+    """How far from the goal an episode ended: the distance (m) left to the goal (its ``miss_distance_m``)."""
+    return max(float(tr.goal_distance) - float(np.asarray(tr.pelvis_pos)[-1, 0]), 0.0)
+
+
 def dodge_summary(traces: Sequence) -> dict:
     """:func:`visuomotor_gym.metrics.summary.summarize` for dodge traces: the same keys (``caught`` counts
     successes), ``gaze_realism`` from :func:`dodge_gaze_realism`; ``time_to_catch_s`` is the time to the
     goal of the successful walks, ``miss_distance_m`` the distance left to the goal in the failed ones."""
     from visuomotor_gym.metrics.summary import goal_summary
 
-    return goal_summary(traces, dodge_gaze_realism,
-                        lambda tr: max(float(tr.goal_distance) - float(np.asarray(tr.pelvis_pos)[-1, 0]), 0.0))
+    return goal_summary(traces, dodge_gaze_realism, distance_left)

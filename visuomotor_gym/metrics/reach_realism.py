@@ -137,6 +137,12 @@ def reach_realism(traces: Sequence, reference: Mapping | None = None) -> dict:
     return {"score": float(np.mean(scores)) if scores else _nan(), "components": components}
 
 
+def closest_distance(tr) -> float:
+    """The closest the catch site came to the object over the episode (m): a failed reach's miss distance."""
+    d = np.linalg.norm(np.asarray(tr.hand_pos, dtype=float) - np.asarray(tr.object_pos, dtype=float).reshape(3), axis=1)
+    return float(d.min())
+
+
 def reach_outcomes(traces: Sequence) -> dict:
     """The evaluator's outcome fields for reach traces: ``miss_distance_m`` (closest catch-site to object
     distance over the episodes not reached) and ``time_to_catch_s`` (time to success), ``{"mean", "median"}``;
@@ -145,11 +151,7 @@ def reach_outcomes(traces: Sequence) -> dict:
     from visuomotor_gym.metrics.hand import hand_onset_time
     from visuomotor_gym.metrics.stats import mean_median
 
-    miss = []
-    for tr in traces:
-        if not tr.success:
-            d = np.linalg.norm(np.asarray(tr.hand_pos, dtype=float) - np.asarray(tr.object_pos, dtype=float).reshape(3), axis=1)
-            miss.append(float(d.min()))
+    miss = [closest_distance(tr) for tr in traces if not tr.success]
     return {
         "reaction_times_s": {
             "first_saccade": mean_median([first_saccade_latency(tr) for tr in traces]),

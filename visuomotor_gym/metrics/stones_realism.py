@@ -130,6 +130,11 @@ def stones_gaze_realism(traces: Sequence, reference: dict | None = None) -> dict
     return {"score": score if math.isfinite(score) else float("nan"), "components": components}
 
 
+def distance_left(tr) -> float:
+    """How far from the goal an episode ended: the stones left (count) (its ``miss_distance_m``)."""
+    return float(len(np.asarray(tr.stones).reshape(-1, 2)) - np.asarray(tr.next_stone)[-1])
+
+
 def stones_summary(traces: Sequence) -> dict:
     """:func:`visuomotor_gym.metrics.summary.summarize` for stones-family traces: the same keys (``caught``
     and ``catch_rate`` count successes), ``gaze_realism`` from :func:`stones_gaze_realism`;
@@ -137,5 +142,4 @@ def stones_summary(traces: Sequence) -> dict:
     the number of stones left in the failed ones (a count, under the shared key), ``hand_onset`` NaN."""
     from visuomotor_gym.metrics.summary import goal_summary
 
-    return goal_summary(traces, stones_gaze_realism,
-                        lambda tr: float(len(np.asarray(tr.stones).reshape(-1, 2)) - np.asarray(tr.next_stone)[-1]))
+    return goal_summary(traces, stones_gaze_realism, distance_left)

@@ -159,6 +159,25 @@ def _family_summary(module: str, function: str):
     return run
 
 
+# Each non-catch family's miss distance of one failed episode (the catch family's is metrics.outcome's).
+_FAMILY_MISS_DISTANCE = {
+    "reach": _family_summary("reach_realism", "closest_distance"),
+    "walk": _family_summary("walk_realism", "distance_left"),
+    "stones": _family_summary("stones_realism", "distance_left"),
+    "dodge": _family_summary("dodge_realism", "distance_left"),
+}
+
+
+def episode_miss_distance(trace) -> float:
+    """The miss distance of one episode in its family's terms: the ball's closest approach to the catch
+    site, the hand's closest approach to the object, or the distance (stones) left to the goal. (The
+    summaries average it over the failed episodes only.)"""
+    family = _family(trace)
+    if family in _FAMILY_MISS_DISTANCE:
+        return float(_FAMILY_MISS_DISTANCE[family](trace))
+    return float(miss_distance(trace))
+
+
 # The families with their own summary (realism table and outcome measures); catch is summarize() itself.
 _FAMILY_SUMMARIES = {
     "reach": _family_summary("reach_realism", "reach_summary"),

@@ -137,6 +137,11 @@ def walk_gaze_realism(traces: Sequence, reference: dict | None = None) -> dict:
     return {"score": score if math.isfinite(score) else float("nan"), "components": components}
 
 
+def distance_left(tr) -> float:
+    """How far from the goal an episode ended: the distance (m) left to the finish line (its ``miss_distance_m``)."""
+    return max(float(tr.course_length) - float(np.asarray(tr.pelvis_pos)[-1, 0]), 0.0)
+
+
 def walk_summary(traces: Sequence) -> dict:
     """:func:`visuomotor_gym.metrics.summary.summarize` for walk-family traces: the same keys (``caught``
     and ``catch_rate`` count successes, equal to ``success_rate``), ``gaze_realism`` from
@@ -145,5 +150,4 @@ def walk_summary(traces: Sequence) -> dict:
     (no hand). Diverged episodes are left out of the behavioural measures, as for catching."""
     from visuomotor_gym.metrics.summary import goal_summary
 
-    return goal_summary(traces, walk_gaze_realism,
-                        lambda tr: max(float(tr.course_length) - float(np.asarray(tr.pelvis_pos)[-1, 0]), 0.0))
+    return goal_summary(traces, walk_gaze_realism, distance_left)
