@@ -245,6 +245,7 @@ class OculomotorPlant:
         self.pursuit_omega = (0.0, 0.0, 0.0)
         self._drive_queue: list[tuple[float, float, float, float]] = []
         self._drive = (0.0, 0.0, 0.0)
+        self._goal = (0.0, 0.0, 0.0)  # the pursuit velocity goal of the current drive (cached)
         self._last_sample = (0.0, 0.0, 0.0)
         self._prev_request: tuple[float, float, float] | None = None
         self._suppressed = False
@@ -285,14 +286,18 @@ class OculomotorPlant:
     def _pursuit_goal(self, t: float) -> tuple[float, float, float]:
         """The eye's pursuit velocity goal at time ``t``: the delayed target motion times the gain."""
         queue = self._drive_queue
+        if not queue or queue[0][0] > t + 1e-9:  # the drive is unchanged: so is its goal (runs per substep)
+            return self._goal
         while queue and queue[0][0] <= t + 1e-9:  # its latency has passed: it drives the eye now
             self._drive = queue.pop(0)[1:]
         wx, wy, wz = self._drive
         speed = math.sqrt(wx * wx + wy * wy + wz * wz)
         if speed < 1e-12:
-            return 0.0, 0.0, 0.0
-        k = self.params.pursuit_velocity(speed / DEG) * DEG / speed
-        return wx * k, wy * k, wz * k
+            self._goal = (0.0, 0.0, 0.0)
+        else:
+            k = self.params.pursuit_velocity(speed / DEG) * DEG / speed
+            self._goal = (wx * k, wy * k, wz * k)
+        return self._goal
 
     def step(
         self,
