@@ -15,11 +15,15 @@ Every 20 ms control step the agent
    the cheapest of a few candidates evaluated in one batched rollout: the warm start, and gaze paths
    that follow each ball (with two balls, also switching once between them), the head taking up what
    the eye's range cannot;
-3. **executes** the plan through the env's own low levels: the gaze target is the plan's gaze a step
-   ahead (or, when that is a jump above the saccade threshold, where the planned jump ends) in retinal
-   coordinates; the head target and the hand target (seat frame, the env's DLS arm controller) are the
-   plan's a little ahead, to cover the servos' lag (``head_lead_s``, ``hand_lead_s``); the fixation
-   distance is the target ball's; the grasp closes when the target ball is ``grasp_lead_s`` from the
+3. **executes** the plan through the env's own low levels: gaze through the human oculomotor plant
+   (saccades; pursuit of the request stream's motion with latency and gain): the plan chooses the
+   object to look at (the one nearest its gaze ``fixation_lookahead_s`` ahead) and the request is
+   that object's predicted direction a step ahead (pursuit), or where it will be when a saccade lands
+   when the plant can start one and the object is beyond its threshold (catch-up saccades; see
+   ``_gaze_request``; gaze held for the human first-saccade latency); the head target and the hand
+   target (seat frame, the env's DLS arm controller) are the plan's a little ahead, to cover the
+   servos' lag (``head_lead_s``, ``hand_lead_s``); the fixation distance is the target ball's (the next
+   to arrive among the balls known to ``hold_path_std_m``); the grasp closes when the target ball is ``grasp_lead_s`` from the
    interception point (as the Eyecatch heuristic does) and stays closed while a ball is held.
 
 The catching task (Eom section 7): ``c_tsk = |p_hand - p_arrival|^2``, where ``p_arrival`` is where the
