@@ -361,12 +361,12 @@ def test_params_overrides_and_validation():
         BeliefMPCAgent().predict(np.zeros(10))
 
 
-def test_end_to_end_catches_through_the_evaluator_in_real_time():
+def test_end_to_end_catches_through_the_evaluator():
     result = evaluate("belief_mpc", "EyeCatch-v0", episodes=4, seed=0, workers=1)
     assert result.summary["catch_rate"] == 1.0
     assert result.agent_deterministic
-    # real time needs p95 <= 20 ms; a loaded CI machine gets a wide margin here (benchmarks/ measures it)
-    assert result.summary["latency_ms"]["p50"] < 20.0
+    # Real time (p95 <= 20 ms per control step) is measured by benchmarks/belief_mpc_latency.py, not
+    # here: a timed assertion in a unit test fails on a loaded machine and proves nothing on an idle one.
 
 
 def test_agent_is_deterministic_and_resets_between_episodes():
