@@ -404,6 +404,36 @@ def test_agent_tracks_both_balls_in_the_two_ball_env():
     assert info["balls_caught"] >= 1
 
 
+def test_gaze_is_executed_through_the_human_plant():
+    """Issue 11: gaze held for the human first-saccade latency, then the plan's chosen ball is pursued
+    through the plant, with catch-up saccades landing on it (the ball near the fovea most of the time),
+    and the throw is caught."""
+    env = make_env("EyeCatch-v0")
+    agent = make_agent("belief_mpc", "EyeCatch-v0", 9)
+    obs, info = env.reset(seed=3)
+    agent.reset()
+    done, onsets, ecc, landed = False, [], [], []
+    prev_sacc = False
+    while not done:
+        action, _ = agent.predict(obs)
+        obs, _, terminated, truncated, info = env.step(action)
+        done = terminated or truncated
+        rel = info["ball_pos"] - info["eye_pos"]
+        e = math.degrees(math.acos(np.clip(rel @ info["gaze_dir"] / np.linalg.norm(rel), -1.0, 1.0)))
+        if info["saccade_onset"]:
+            onsets.append(info["time"])
+        if prev_sacc and not info["in_saccade"]:
+            landed.append(e)
+        prev_sacc = bool(info["in_saccade"])
+        if 0.25 <= info["time"] and np.linalg.norm(rel) > 1.0:  # before the hand's reach
+            ecc.append(e)
+    assert info["is_success"]
+    assert onsets and onsets[0] >= 0.18 - 1e-9  # human saccadic latency
+    assert len(onsets) >= 2  # catch-up saccades, not one pursuit
+    assert np.median(landed) < 3.0  # saccades land on the ball (aimed at the landing point)
+    assert np.mean(np.array(ecc) < 5.0) > 0.6
+
+
 def test_sequential_eyecatch_is_the_heuristic_on_one_ball():
     env = make_env("EyeCatch-v0")
     seq, plain = SequentialEyecatch.for_env("EyeCatch-v0"), EyecatchAgent.for_env("EyeCatch-v0")

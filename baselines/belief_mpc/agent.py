@@ -102,6 +102,7 @@ class BeliefMPCParams:
     w_tsk_proactive: float = 10.0
     w_dist: float = 1.0
     proactive_lead_s: float = 0.75  # Eom: the proactive phase starts 0.5-1 s before the arrival
+    commit_proactive: bool = True  # the hand's target ball is kept once in its proactive phase
     hold_path_std_m: float = 0.3  # a ball whose believed position is less certain than this (std, m)
     # is planned for where it is now, not along its extrapolated path (its velocity is unknown)
     # Interception (Eyecatch 4.3, as the heuristic).
@@ -308,6 +309,12 @@ class BeliefMPCAgent:
             when = intercepts[j][1]
             if when < t_arr:
                 target, t_arr = j, when
+        # A proactive reach is not abandoned for another ball (modelling choice): a peripheral first
+        # estimate of the second ball can be confident and wrong by metres, and switching the hand to
+        # its phantom arrival lost the first ball.
+        prev = self.target_ball
+        if p.commit_proactive and prev in intercepts and prev != target and intercepts[prev][1] <= p.proactive_lead_s:
+            target, t_arr = prev, intercepts[prev][1]
         self.target_ball = target
         self._lap("interception")
 
