@@ -3,8 +3,12 @@
 The agent sees observations only. Each 20 ms control step:
 
 1. **Perception** (section 3.2): a Kalman filter with a gravity internal model fuses the eye's
-   noisy eye-frame samples, each weighted by the vision model's covariance A Sigma^2 A^T (Eq. 1-14);
-   an abnormal Mahalanobis innovation resets the prior (bounces).
+   noisy eye-frame samples, each weighted by the vision model's covariance A Sigma^2 A^T (Eq. 1-14).
+   That covariance depends on the true distance and line of sight, which the brain does not know:
+   it is evaluated at the prior's expected distance (sqrt of mean distance^2 + depth variance) along
+   the sample's own retinal direction mixed with the prior's (``_noise_point``). The first prior is
+   the thrower's hand on the initial line of sight. Two abnormal Mahalanobis innovations in a row
+   reset the prior (bounces); a single one is an outlier and is dropped.
 2. **Gaze** (section 4.1): the eye is sent to the predicted ball. The first saccade is suppressed
    (gaze held: no saccade, no pursuit) for a human saccadic latency (0.18 s) and then until the
    estimated retinal (eye-frame Y-Z) error of the ball where the saccade would land is below a
@@ -19,7 +23,8 @@ The agent sees observations only. Each 20 ms control step:
    velocity of the head, which is identical to that of the eye, is then added": the head's plan
    follows the eye's measured pursuit, so pursuit does not drive the eye into its range limits.
 4. **Hand** (section 4.3): a superposition of ~400 ms minimum-jerk submovements (Eq. 15-16), one per
-   visuomotor update (every ~200 ms, re-synchronised to each saccade onset), each aimed from the
+   visuomotor update (every ~200 ms, re-synchronised to each saccade onset; every 60 ms once the last,
+   grasping submovement has started: online correction), each aimed from the
    previous destination (not the current position) to the new one, peak speed <= 2 m/s:
    * reactive phase: the destination is the *ready pose*, fixed in the eye frame at the preferred
      distance, 45 deg to the lower right of the line of sight (Eq. 19);
