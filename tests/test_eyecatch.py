@@ -64,7 +64,8 @@ def test_gravity_model_is_exact_for_ballistic_flight():
 
 
 def test_adaptive_reset_after_a_sudden_change():
-    """A confident filter meeting an impossible innovation resets P (Eyecatch 3.2)."""
+    """A confident filter meeting impossible innovations resets P (Eyecatch 3.2): the first abnormal
+    sample is dropped as an outlier, the second in a row resets (KalmanParams.reset_after_abnormal_samples)."""
     f = BallKalmanFilter(0.02)
     rot, eye = np.eye(3), np.zeros(3)
     R = np.eye(6) * 1e-4
@@ -78,9 +79,33 @@ def test_adaptive_reset_after_a_sudden_change():
     f.predict()
     bounced = f.F @ x + f.b
     bounced[4] = 4.0  # the lateral velocity flipped sign off a wall
+    before = f.x.copy()
+    maha = f.update(bounced, R, rot, eye)
+    assert maha > f.params.reset_mahalanobis and f.resets == 0 and f.rejected == 1
+    np.testing.assert_array_equal(f.x, before)  # an outlier is not fused
+    f.predict()
+    bounced = f.F @ bounced + f.b
     maha = f.update(bounced, R, rot, eye)
     assert maha > f.params.reset_mahalanobis and f.resets == 1
     assert abs(f.x[4] - 4.0) < 0.1  # the post-reset estimate follows the new course
+
+
+def test_single_outlier_is_dropped_and_the_run_restarts():
+    """One abnormal innovation between normal ones neither resets nor moves the estimate."""
+    f = BallKalmanFilter(0.02)
+    rot, eye = np.eye(3), np.zeros(3)
+    R = np.eye(6) * 1e-4
+    x = np.array([3.0, 0.0, 1.5, -4.0, 0.0, 3.0])
+    for k in range(40):
+        if k:
+            f.predict()
+            x = f.F @ x + f.b
+        z = x.copy()
+        if k in (20, 30):
+            z[1] += 5.0  # an isolated wild sample
+        f.update(z, R, rot, eye)
+    assert f.resets == 0 and f.rejected == 2
+    assert np.linalg.norm(f.x[:3] - x[:3]) < 0.01
 
 
 def test_submovements_superpose_from_the_previous_destination():
@@ -159,8 +184,8 @@ def test_first_saccade_waits_for_a_human_latency_and_the_criterion():
     assert t.t[t.saccade_onset][0] - t.dt == pytest.approx(0.4, abs=1e-6)
     env = gym.make("EyeCatchPaperPoorVision-v0")
     firsts = []
-    for seed in range(6):
-        agent = make_agent("eyecatch", "EyeCatchPaperPoorVision-v0", 9)
+    for seed in range(6):  # without the thrower prior (which alone can meet the criterion at 0.18 s)
+        agent = make_agent("eyecatch:thrower_prior=False", "EyeCatchPaperPoorVision-v0", 9)
         t = run_episode(env, agent, seed, "EyeCatchPaperPoorVision-v0", "eyecatch")
         firsts.append(t.t[t.saccade_onset][0] - t.dt)
     assert max(firsts) > 0.18 + 0.02  # the criterion, not only the latency, held some back
@@ -234,3 +259,46 @@ def test_catch_up_saccades_before_the_apex_pursuit_after():
     assert 0.18 <= np.nanmean(intervals) <= 0.3
     assert np.nanmean(sync) >= 0.7
     assert np.nanmean(share) >= 0.5
+
+
+def test_thrower_prior_on_the_line_of_sight():
+    """The filter's first prior: the thrower's hand on the initial line of sight at 4.5 +- 1 m."""
+    agent = make_agent("eyecatch", "EyeCatch-v0", 9)
+    rot = np.eye(3)
+    eye = np.array([0.1, -0.2, 1.2])
+    agent._set_thrower_prior(rot, eye)
+    np.testing.assert_allclose(agent.filter.x[:3], eye + [4.5, 0.0, 0.0])
+    np.testing.assert_allclose(np.diag(agent.filter.P)[:3], [1.0, 0.09, 0.09])
+    assert agent.filter.initialised
+
+
+def test_noise_is_evaluated_at_the_expected_distance_on_the_retinal_direction():
+    """Eq. 1-3 need the true distance and line of sight: the agent evaluates the sample's noise at
+    sqrt(E[d^2]) of its prior (mean distance^2 + depth variance) along the sample's own direction
+    (mixed with the prior's by their angular variances); a sample behind the eye keeps its ray."""
+    agent = make_agent("eyecatch", "EyeCatch-v0", 9)
+    rot, eye = np.eye(3), np.zeros(3)
+    agent.filter.x = np.array([3.0, 0.0, 0.0, 0.0, 0.0, 0.0])
+    agent.filter.P = np.diag([4.0, 1e-6, 1e-6, 1.0, 1.0, 1.0])  # depth std 2 m, lateral 1 mm
+    agent.filter.initialised = True
+    point = agent._noise_point(np.array([0.5, 0.0, 0.0]), rot, eye)  # a sample far too near
+    np.testing.assert_allclose(point, [np.sqrt(9.0 + 4.0), 0.0, 0.0], atol=1e-9)
+    behind = agent._noise_point(np.array([-0.4, 0.001, 0.0]), rot, eye)
+    assert behind[0] > 0  # depth noise put it behind the eye: same ray, in front
+    agent.filter.reset()  # no prior yet: the sample's direction, the initial P's depth variance
+    point = agent._noise_point(np.array([2.0, 2.0, 0.0]), rot, eye)
+    np.testing.assert_allclose(point / np.linalg.norm(point), [2 ** -0.5, 2 ** -0.5, 0.0], atol=1e-9)
+    assert np.linalg.norm(point) == pytest.approx(10.0)
+
+
+def test_last_submovements_replan_online():
+    """Once the last (grasping) submovement starts, the hand target is re-planned every
+    final_update_period_s instead of every visuomotor update (200 ms)."""
+    env = gym.make("EyeCatch-v0")
+    agent = make_agent("eyecatch", "EyeCatch-v0", 9)
+    run_episode(env, agent, 0, "EyeCatch-v0", "eyecatch")
+    grasp = next(t for t, e in agent.events if e == "grasp")
+    late = np.array([t for t, e in agent.events if e == "update" and t >= grasp - 1e-9])
+    assert late.size >= 3
+    # every final_update_period_s, or sooner when a saccade onset re-synchronises the update
+    assert np.all(np.diff(late) <= agent.params.final_update_period_s + 1e-6)

@@ -3,8 +3,12 @@
 The agent sees observations only. Each 20 ms control step:
 
 1. **Perception** (section 3.2): a Kalman filter with a gravity internal model fuses the eye's
-   noisy eye-frame samples, each weighted by the vision model's covariance A Sigma^2 A^T (Eq. 1-14);
-   an abnormal Mahalanobis innovation resets the prior (bounces).
+   noisy eye-frame samples, each weighted by the vision model's covariance A Sigma^2 A^T (Eq. 1-14).
+   That covariance depends on the true distance and line of sight, which the brain does not know:
+   it is evaluated at the prior's expected distance (sqrt of mean distance^2 + depth variance) along
+   the sample's own retinal direction mixed with the prior's (``_noise_point``). The first prior is
+   the thrower's hand on the initial line of sight. Two abnormal Mahalanobis innovations in a row
+   reset the prior (bounces); a single one is an outlier and is dropped.
 2. **Gaze** (section 4.1): the eye is sent to the predicted ball. The first saccade is suppressed
    (gaze held: no saccade, no pursuit) for a human saccadic latency (0.18 s) and then until the
    estimated retinal (eye-frame Y-Z) error of the ball where the saccade would land is below a
@@ -19,7 +23,8 @@ The agent sees observations only. Each 20 ms control step:
    velocity of the head, which is identical to that of the eye, is then added": the head's plan
    follows the eye's measured pursuit, so pursuit does not drive the eye into its range limits.
 4. **Hand** (section 4.3): a superposition of ~400 ms minimum-jerk submovements (Eq. 15-16), one per
-   visuomotor update (every ~200 ms, re-synchronised to each saccade onset), each aimed from the
+   visuomotor update (every ~200 ms, re-synchronised to each saccade onset; every 60 ms once the last,
+   grasping submovement has started: online correction), each aimed from the
    previous destination (not the current position) to the new one, peak speed <= 2 m/s:
    * reactive phase: the destination is the *ready pose*, fixed in the eye frame at the preferred
      distance, 45 deg to the lower right of the line of sight (Eq. 19);
@@ -67,6 +72,14 @@ class EyecatchParams:
     # Perception (Eyecatch 3.2).
     reset_mahalanobis: float = KalmanParams().reset_mahalanobis  # Eyecatch 3.2 adaptive reset: the
     # filter's one threshold (see KalmanParams), named here so a spec can override it
+    reset_after_abnormal_samples: float = KalmanParams().reset_after_abnormal_samples  # see KalmanParams
+    thrower_prior: bool = True  # the filter's prior at the first sample is the thrower's hand, which
+    # the eye fixates at the release (the env's reset gaze) and saw before the throw, at a typical
+    # throwing distance (modelling choice; the paper starts from x = 0 with a large P, Eq. 8-14,
+    # whose mean then pulls the depth toward the eye when depth noise is x10)
+    thrower_distance_m: float = 4.5  # modelling choice: middle of a 3-6 m throw (ThrowDistribution)
+    thrower_distance_std_m: float = 1.0  # modelling choice: ~ the std of a 3-6 m uniform range (0.87)
+    thrower_lateral_std_m: float = 0.3  # modelling choice: ~4 deg at 4.5 m (the reset gaze jitter is 2 deg)
     # Gaze (Eyecatch 4.1).
     first_saccade_min_latency_s: float = 0.18  # the first saccade's decision signal needs this long to
     # reach its criterion: human saccadic latency 180-200 ms (REFERENCES.md, Eyecatch's criterion is
@@ -84,6 +97,11 @@ class EyecatchParams:
     gaze_action_range_deg: float = 60.0  # the env's gaze_action_range_deg
     # Visuomotor update (Eyecatch 4.1: ~200 ms, the recharge time of saccades).
     update_period_s: float = 0.2
+    final_update_period_s: float = 0.06  # once the last (grasping) submovement has started, the hand
+    # target is re-planned this often: online correction of the interception in its last 400 ms
+    # (modelling choice: humans correct an interceptive hand movement ~100 ms after a target change,
+    # continuously rather than every 200 ms; the paper's update is every ~200 ms throughout). On 100
+    # PaperPoorVision throws: 0.2 s 29 %, 0.1 s 41 %, 0.06 s 53 %, 0.02 s 56 % (docs/reproductions/eyecatch.md)
     # Head (Eyecatch 4.2, Eq. 17-18).
     head_dead_zone_deg: float = 20.0  # 0.349 rad in Eq. 17
     head_submovement_s: float = 0.4  # peak velocity 4-8/s x amplitude -> ~400 ms
@@ -192,7 +210,8 @@ class EyecatchAgent:
         p = self.params
         self.dt = float(dt)
         self.vision = VisionParams(noise_scale=p.vision_noise_scale, foveated=p.foveated)
-        self.kalman_params = kalman or KalmanParams(reset_mahalanobis=p.reset_mahalanobis)
+        self.kalman_params = kalman or KalmanParams(reset_mahalanobis=p.reset_mahalanobis,
+                                                    reset_after_abnormal_samples=p.reset_after_abnormal_samples)
         self.delay_steps = int(round(p.visual_delay_s / self.dt))
         self.filter = BallKalmanFilter(self.dt, self.kalman_params)
         self.gaze_range = p.gaze_action_range_deg * DEG
@@ -210,6 +229,7 @@ class EyecatchAgent:
     def reset(self) -> None:
         """Forget the episode (called by the evaluator, and on ``episode_start``)."""
         self.filter.reset()
+        self.thrower_prior_used = False
         self.t = 0.0
         self.started = False
         self.first_saccade_released = False
@@ -286,9 +306,9 @@ class EyecatchAgent:
             self.next_update = t  # a saccade just started: update with it
         if math.isinf(self.next_update) and self.first_saccade_released:
             self.next_update = t
-        if t >= self.next_update - 1e-9:
+        if t >= self.next_update - 0.5 * self.dt:  # (observed times are float32)
             self._visuomotor_update(t, obs, rot, eye, delay)
-            self.next_update = t + p.update_period_s
+            self.next_update = t + (p.final_update_period_s if self.grasp else p.update_period_s)
 
         return self._action(self.hand.position(t + p.hand_lead_s), obs, gaze=gaze,
                             head=self.head.position(t + self.dt), fixation=float(np.linalg.norm(ball_now - eye)))
@@ -330,30 +350,25 @@ class EyecatchAgent:
     def _fuse(self, obs: np.ndarray) -> None:
         rot, eye = self.pose_history[0] if self.delay_steps else self.pose_history[-1]
         z = np.concatenate([obs[_S["ball_pos"]], obs[_S["ball_vel"]]])
+        if self.params.thrower_prior and not self.filter.initialised and not self.thrower_prior_used:
+            self._set_thrower_prior(rot, eye)
         # A visible ball is in front of the eye: a prior behind it (poor vision can put it there) is
         # impossible, so the filter starts over.
         if self.filter.initialised and float(rot[:, 0] @ (self.filter.x[:3] - eye)) <= 0.0:
             self.filter.reset()
             self.events.append((self.t, "reset"))
-        # The noise covariance depends on where the ball is (distance, eccentricity) and on its
-        # retinal speed; the brain only has estimates of those. It takes the direction and velocity
-        # from its prior once it has one (a sample's direction is unreliable when its depth error is
-        # comparable to the distance, as with poor vision), and the larger of the prior's and the
-        # sample's distance: overestimating the noise only slows learning, underestimating it locks
-        # in a wrong estimate.
-        pos, vel = z[:3], z[3:]
-        if self.filter.initialised:
-            sample_dist = math.sqrt(float(pos @ pos))
-            prior = rot.T @ (self.filter.x[:3] - eye)
-            prior_dist = math.sqrt(float(prior @ prior))
-            pos = prior * (max(prior_dist, sample_dist) / max(prior_dist, 1e-9))
-            vel = rot.T @ self.filter.x[3:]
+        # The noise covariance (Eq. 1-3) depends on where the ball is (distance, eccentricity) and on
+        # its retinal speed; the brain only has estimates of those (``_noise_point``): the prior's
+        # expected distance and the sample's own retinal direction. Velocity: the prior's.
         eye_turn = np.zeros(3)
         if self.prev_gaze is not None:
             eye_turn = rot.T @ (np.cross(self.prev_gaze, rot[:, 0]) / self.dt)  # the eye's own rotation
-        # Retinal speed (Weber velocity noise): the larger of the prior's and the sample's, for the
-        # same reason as the distance.
-        speed = max(self._retinal_speed(pos, vel, eye_turn), self._retinal_speed(pos, z[3:], eye_turn))
+        vel = rot.T @ self.filter.x[3:] if self.filter.initialised else z[3:]
+        # Retinal speed (Weber velocity noise, slip): the larger of the prior's and the sample's (an
+        # underestimated noise locks in a wrong estimate; an overestimated one only slows learning).
+        near = rot.T @ (self.filter.x[:3] - eye) if self.filter.initialised else z[:3]
+        speed = max(self._retinal_speed(near, vel, eye_turn), self._retinal_speed(near, z[3:], eye_turn))
+        pos = self._noise_point(z[:3], rot, eye, speed)
         R_meas = foveation.covariance(pos, speed, self.vision)
         before = self.filter.resets
         self.filter.update(z, R_meas, rot, eye)
@@ -361,6 +376,52 @@ class EyecatchAgent:
             self.events.append((self.t, "reset"))
             if self.proactive:  # the prediction is void: back to the reactive phase
                 self.proactive = False
+
+    def _set_thrower_prior(self, rot: np.ndarray, eye: np.ndarray) -> None:
+        """The filter's prior at the first sample: the ball leaves the thrower's hand, which the eye
+        fixates at the start (and saw before the throw), at a typical throwing distance."""
+        p = self.params
+        g = rot[:, 0]
+        x = np.zeros(6)
+        x[:3] = eye + g * p.thrower_distance_m
+        lat = np.eye(3) - np.outer(g, g)
+        P = np.zeros((6, 6))
+        P[:3, :3] = np.outer(g, g) * p.thrower_distance_std_m**2 + lat * p.thrower_lateral_std_m**2
+        P[3:, 3:] = np.eye(3) * self.kalman_params.initial_velocity_var_m2_s2
+        self.filter.x, self.filter.P, self.filter.initialised = x, P, True
+        self.thrower_prior_used = True
+
+    def _noise_point(self, sample: np.ndarray, rot: np.ndarray, eye: np.ndarray, speed: float = 0.0) -> np.ndarray:
+        """Where (eye frame) a new sample's noise covariance A Sigma^2 A^T is evaluated (Eq. 1-3).
+
+        Every std of Eq. 2 is proportional to the true distance d, and A rotates onto the true line
+        of sight; the brain knows neither. Distance: sqrt(E[d^2]) under the filter's prior, with d^2
+        = |x_p - r|^2 + the prior's depth variance (R grows as d^2: the prior's expected noise; an
+        uncertain depth is not taken for a near ball). Line of sight: the inverse-variance mean of
+        the sample's own direction (its retinal location: depth noise lies along the true line of
+        sight and does not turn it) and the prior's.
+        """
+        mean = rot.T @ (self.filter.x[:3] - eye)
+        P = rot.T @ self.filter.P[:3, :3] @ rot
+        ds = math.sqrt(float(sample @ sample))
+        u_s = sample / max(ds, 1e-9)
+        if u_s[0] < 0.0:  # depth noise put the sample behind the eye: the ray is the same
+            u_s = -u_s
+        dm = math.sqrt(float(mean @ mean))
+        direction = u_s
+        if self.filter.initialised and dm > 1e-6:
+            u_p = mean / dm
+            depth_var = float(u_p @ P @ u_p)
+            d_noise = math.sqrt(dm * dm + depth_var)
+            lateral = foveation.standard_deviations(d_noise, foveation.eccentricity(u_s), speed, self.vision)[1]
+            var_s = (lateral / max(ds, 1e-9)) ** 2
+            var_p = max(float(np.trace(P)) - depth_var, 0.0) / 2.0 / (dm * dm + depth_var)
+            w = u_s / max(var_s, 1e-18) + u_p / max(var_p, 1e-18)
+            direction = w / max(float(np.linalg.norm(w)), 1e-12)
+
+        else:
+            d_noise = math.sqrt(dm * dm + float(u_s @ P @ u_s))
+        return direction * d_noise
 
     @staticmethod
     def _retinal_speed(pos: np.ndarray, vel: np.ndarray, eye_turn: np.ndarray) -> float:

@@ -38,6 +38,11 @@ class KalmanParams:
     # has p = 4.6e-7, about one false reset in 40,000 throws of 50 samples (the paper gives no value:
     # our choice of p). The one threshold of the Eyecatch agent (EyecatchParams.reset_mahalanobis); on
     # 200 EyeCatchBounce-v0 throws it catches 43 % against 38.5 % with 100
+    reset_after_abnormal_samples: float = 2  # the reset needs this many abnormal innovations in a
+    # row; a single one is an outlier and its sample is dropped (standard innovation gating). A bounce
+    # changes every later innovation, so it still resets, one sample (20 ms) later. Modelling choice:
+    # with x10 noise single outliers reset the filter several times a throw; on 200 throws
+    # EyeCatchBounce-v0 catches 53.5 % with 2 (and re-weighted samples) against 43 % before
     reset_when_position_std_below_m: float = 0.25  # only a confident filter resets (Eyecatch 3.2:
     # the failure the reset cures is "especially when the error covariance is small")
     process_noise_acc_m_s2: float = 0.5  # white acceleration noise. The paper has none; without it
@@ -69,6 +74,8 @@ class BallKalmanFilter:
         self.P = self._initial_covariance()
         self.initialised = False  # no measurement yet
         self.resets = 0
+        self.rejected = 0
+        self.abnormal_run = 0
         self.last_mahalanobis = float("nan")
         self.last_S = None
 
@@ -98,19 +105,31 @@ class BallKalmanFilter:
         S = H @ self.P @ H.T + R_meas  # Eq. 11
         maha = float(y @ np.linalg.solve(S, y))
         confident = float(np.trace(self.P[:3, :3])) < 3.0 * self.params.reset_when_position_std_below_m**2
-        if self.initialised and confident and maha > self.params.reset_mahalanobis:
+        abnormal = self.initialised and confident and maha > self.params.reset_mahalanobis
+        self.abnormal_run = self.abnormal_run + 1 if abnormal else 0
+        if abnormal and self.abnormal_run < self.params.reset_after_abnormal_samples:
+            self.rejected += 1  # one abnormal sample: an outlier, not (yet) a change of course
+            self.last_mahalanobis = maha
+            return maha
+        if abnormal:
             # Abnormal innovation: forget the prior covariance (the ball changed its course).
             self.P = self._initial_covariance()
             self.resets += 1
+            self.abnormal_run = 0
             S = H @ self.P @ H.T + R_meas
-        K = np.linalg.solve(S.T, (self.P @ H.T).T).T  # Eq. 12: P H^T S^-1
-        self.x = self.x + K @ y  # Eq. 13
-        self.P = (np.eye(6) - K @ H) @ self.P  # Eq. 14
-        self.P = 0.5 * (self.P + self.P.T)
+        self.x, self.P = self.correct(self.x, self.P, y, S, H)
         self.initialised = True
         self.last_mahalanobis = maha
         self.last_S = S
         return maha
+
+    @staticmethod
+    def correct(x, P, y, S, H):
+        """Eq. 12-14: the posterior of (x, P) given innovation ``y`` with covariance ``S``."""
+        K = np.linalg.solve(S.T, (P @ H.T).T).T  # Eq. 12: P H^T S^-1
+        x = x + K @ y  # Eq. 13
+        P = (np.eye(6) - K @ H) @ P  # Eq. 14
+        return x, 0.5 * (P + P.T)
 
     def extrapolate(self, horizon_s: float) -> tuple[np.ndarray, np.ndarray]:
         """Mean position and velocity ``horizon_s`` ahead under the internal model (exact)."""
