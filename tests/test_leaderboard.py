@@ -31,8 +31,8 @@ from visuomotor_gym.metrics.stats import wilson_interval
 
 REPO = Path(__file__).resolve().parents[1]
 COMMITTED = REPO / "leaderboard"
-KEY = "eyecatch-v2__EyeCatch-v0"  # current (not superseded) entries
-POOR = "eyecatch-v2__EyeCatchPoorVision-v0"
+KEY = "eyecatch-v3__EyeCatch-v0"  # current (not superseded) entries
+POOR = "eyecatch-v3__EyeCatchPoorVision-v0"
 
 
 # ---------------------------------------------------------------- helpers
@@ -808,6 +808,6 @@ def test_check_never_unpickles(monkeypatch):
     monkeypatch.setattr(pickle, "loads", forbidden)
     monkeypatch.setattr(torch, "load", forbidden)
     report = check_leaderboard(COMMITTED, base=None, rescore=True, seeds=[0, 1], only={
-        "ppo-intercept-v2__EyeCatch-v0", "ppo-intercept-v2__EyeCatchOracle-v0"}, pages=False)
+        "ppo-intercept-v3__EyeCatch-v0", "ppo-intercept-v3__EyeCatchOracle-v0"}, pages=False)
     assert report.ok, "\n".join(messages(report))
     assert report.rescored_episodes == 4
