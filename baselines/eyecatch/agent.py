@@ -100,8 +100,9 @@ class EyecatchParams:
     final_update_period_s: float = 0.06  # once the last (grasping) submovement has started, the hand
     # target is re-planned this often: online correction of the interception in its last 400 ms
     # (modelling choice: humans correct an interceptive hand movement ~100 ms after a target change,
-    # continuously rather than every 200 ms; the paper's update is every ~200 ms throughout). On 100
-    # PaperPoorVision throws: 0.2 s 29 %, 0.1 s 41 %, 0.06 s 53 %, 0.02 s 56 % (docs/reproductions/eyecatch.md)
+    # continuously rather than every 200 ms; the paper's update is every ~200 ms throughout). 200
+    # PaperPoorVision throws: 0.2 s 29.5 % against 53 % (100 throws of an earlier revision: 0.1 s 41 %,
+    # 0.06 s 53 %, 0.02 s 56 %; docs/reproductions/eyecatch.md)
     # Head (Eyecatch 4.2, Eq. 17-18).
     head_dead_zone_deg: float = 20.0  # 0.349 rad in Eq. 17
     head_submovement_s: float = 0.4  # peak velocity 4-8/s x amplitude -> ~400 ms
