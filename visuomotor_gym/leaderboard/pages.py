@@ -105,7 +105,7 @@ def _rows(lb: Leaderboard) -> tuple[list[Row], list[Row]]:
         return (rung, row.env_id, -row.rate, row.name)
 
     rows.sort(key=order)
-    _attach_gaze_gains(rows)
+    rows = _with_gaze_gains(rows)
     return [r for r in rows if r.entry.superseded is None], [
         r for r in rows if r.entry.superseded is not None
     ]
@@ -116,15 +116,20 @@ def twin_agents(agent: str) -> tuple[str, ...]:
     return (f"gaze_blind:{agent}",) + (("fixed_gaze",) if agent == "eyecatch" else ())
 
 
-def _attach_gaze_gains(rows: list[Row]) -> None:
-    """Each current entry's gaze gain: its success rate minus that of a current entry of its gaze-blind
-    twin on the same env id and seeds (both re-scored entries); None when there is no such twin."""
+def _with_gaze_gains(rows: list[Row]) -> list[Row]:
+    """Each current entry with its gaze gain: its success rate minus that of a current entry of its
+    gaze-blind twin on the same env id and seeds (both re-scored entries); None when there is no twin."""
+    import dataclasses
+
     current = [r for r in rows if r.entry.superseded is None]
-    for r in current:
+    out = []
+    for r in rows:
         twins = [t for t in current if t.env_id == r.env_id and t.agent in twin_agents(r.agent)
                  and t.seeds == r.seeds and t.episodes == r.episodes]
-        if twins:
-            r.gain = r.rate - max(twins, key=lambda t: t.date).rate
+        if twins and r.entry.superseded is None:
+            r = dataclasses.replace(r, gain=r.rate - max(twins, key=lambda t: t.date).rate)
+        out.append(r)
+    return out
 
 
 # ------------------------------------------------------------------------------ formatting
