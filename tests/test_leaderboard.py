@@ -172,6 +172,8 @@ def test_consistently_tampered_counts_are_refused_by_the_episode_records(lb):
     obj["caught"] = forged
     obj["catch_rate"] = forged / 200
     obj["catch_rate_ci95"] = list(wilson_interval(forged, 200))
+    obj["success_rate"] = forged / 200  # on a catch id success is the catch: forged together
+    obj["success_rate_ci95"] = list(wilson_interval(forged, 200))
     write_results(results_path(lb, POOR), obj)
     rerecord_results_hash(lb, POOR)
     report = check(lb)
@@ -642,14 +644,18 @@ def test_page_renders_in_a_headless_browser(tmp_path):
     for ident, (w, h) in probe["plots"].items():
         assert w > 300 and h > 100, ident  # laid out, not collapsed
     assert len(probe["points"]) == n and all(w > 0 and h > 0 for w, h in probe["points"])
-    assert probe["cells"] == n * 8 and probe["bars"] == n
+    # the realism heat map: per current entry the overall score and one cell per component column (the
+    # union of every family's components)
+    components = {c for e in board.valid_entries if e.superseded is None for c in e.results["gaze_realism"]["components"]}
+    assert probe["cells"] == n * (1 + len(components)) and probe["bars"] == n
 
     # A screenshot of the unmodified page: the right size, and the plots' colours are on it.
-    png = browser.screenshot(COMMITTED / "index.html", tmp_path / "page.png", width=1200, height=1600)
+    # tall enough to reach the realism heat map below the entry table
+    png = browser.screenshot(COMMITTED / "index.html", tmp_path / "page.png", width=1200, height=2600)
     Image = pytest.importorskip("PIL.Image")
 
     image = Image.open(png).convert("RGB")
-    assert image.size == (1200, 1600)
+    assert image.size == (1200, 2600)
     colors = image.getcolors(maxcolors=1 << 20)
     count = {c: k for k, c in colors}
 
