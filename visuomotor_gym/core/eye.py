@@ -204,8 +204,13 @@ class Eye:
         """Append the :data:`EYE_BLOCKS` (proprioception: an efference copy of the eye pose)."""
         plant = self.plant
         ex, ey, ez = self.pos_list
-        values += frame.to_local(ex, ey, ez)
-        values += frame.axes_local(self.rot_flat)
+        if frame.fixed:  # world axes: the position relative to the origin, the rotation as it is
+            ox, oy, oz = frame.origin_list
+            values += (ex - ox, ey - oy, ez - oz)
+            values += self.rot_flat
+        else:
+            values += frame.to_local(ex, ey, ez)
+            values += frame.axes_local(self.rot_flat)
         values += self.in_head
         values += (
             self.fixation,

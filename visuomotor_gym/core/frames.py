@@ -20,6 +20,8 @@ SEAT_ORIGIN = np.array([0.0, 0.0, 0.5])
 class FixedFrame:
     """A frame fixed in the world, axes parallel to the world's."""
 
+    fixed = True
+
     def __init__(self, origin) -> None:
         self.origin = np.array(origin, dtype=float)
         self.origin_list = self.origin.tolist()
@@ -35,6 +37,8 @@ class FixedFrame:
 class RootFrame:
     """A frame carried by a root body: its origin, and its heading (yaw about world z) only, so
     "down" stays down for a walker whose pelvis pitches and rolls."""
+
+    fixed = False
 
     def __init__(self, body_id: int) -> None:
         self.body_id = int(body_id)

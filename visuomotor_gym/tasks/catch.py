@@ -235,6 +235,9 @@ class CatchTask:
             return False
         if not self.body.grasp_may_close(data, self.grasp_closed_fraction):
             return False
+        if self.n_balls == 1:  # the ladder's common case, without a generator (this runs every step)
+            ball = self.balls[0]
+            return ball.status is BallStatus.FLYING and self._ball_near_hand(data, ball)
         return any(self._ball_near_hand(data, b) for b in self.balls if b.status is BallStatus.FLYING)
 
     def _ball_near_hand(self, d: mujoco.MjData, ball: Ball) -> bool:
@@ -244,6 +247,8 @@ class CatchTask:
 
     def check_substep(self, data: mujoco.MjData) -> bool:
         """Catch test of every ball in flight (current kinematics); True if one was caught."""
+        if self.n_balls == 1:
+            return self.balls[0].status is BallStatus.FLYING and self._catch_now(data, 0)
         return any(self._catch_now(data, k) for k in range(self.n_balls) if self.balls[k].status is BallStatus.FLYING)
 
     def _catch_now(self, d: mujoco.MjData, k: int) -> bool:
