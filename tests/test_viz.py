@@ -280,3 +280,29 @@ def test_commands_are_wired_into_vmgym(tmp_path, capsys):
         pytest.skip("visuomotor_gym.viz.commands.register is not called from visuomotor_gym/cli.py yet")
     assert cli.main(["plot", "--agent", "oracle", "--env", ENV_ID, "--out", str(tmp_path)]) == 0
     assert (tmp_path / f"{ENV_ID}_oracle_seed0.png").exists()
+
+
+def test_outcome_speaks_each_familys_words():
+    """A catch episode is 'caught'/'missed'; another family's is 'succeeded'/'failed'."""
+    caught = synthetic_trace(caught=True)
+    caught.env_id = "EyeCatch-v0"
+    assert plots.outcome(caught).startswith("caught at")
+    walk = synthetic_trace(caught=True)
+    walk.env_id = "ObstacleWalk-v0"
+    walk.task.pop("missed")  # the walk family has no 'missed' field
+    assert plots.outcome(walk).startswith("succeeded at")
+    walk.success = False
+    assert plots.outcome(walk) == "failed"
+
+
+def test_record_refuses_a_camera_the_env_does_not_have(tmp_path):
+    import subprocess
+    import sys
+
+    proc = subprocess.run(
+        [sys.executable, "-m", "visuomotor_gym.cli", "record", "--agent", "zero", "--env", "ObstacleWalk-v0",
+         "--camera", "over_shoulder", "--out", str(tmp_path / "w.mp4")],
+        capture_output=True, text=True, timeout=300,
+    )
+    assert proc.returncode == 2 and "render_camera='over_shoulder' is not one of" in proc.stderr
+    assert "Traceback" not in proc.stderr

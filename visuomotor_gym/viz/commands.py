@@ -138,7 +138,10 @@ def register(subparsers) -> None:
                    help="width of each camera image (with --camera both the video is twice as wide)")
     p.add_argument("--height", type=int, default=360)
     p.add_argument("--fps", type=int, default=25, help="frames per second (50 = real time; default 25)")
-    p.add_argument("--camera", default="both", choices=("both", "scene", "eye", "over_shoulder"))
+    p.add_argument("--camera", default="both",
+                   help="the env's render_camera: both (scene beside eye, every family), scene, eye, or a "
+                        "family's own (catch/reach: over_shoulder; walk: side, follow; ...); the env refuses "
+                        "an unknown one and lists its cameras")
     p.add_argument("--no-overlay", action="store_true", help="no text label on the frames")
     p.add_argument("--force", action="store_true", help="replace --out if it exists")
     p.set_defaults(func=cmd_record)

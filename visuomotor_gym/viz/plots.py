@@ -188,13 +188,19 @@ def apex_time(trace: EpisodeTrace) -> float:
 
 
 def outcome(trace: EpisodeTrace) -> str:
-    """One word (and the catch time): how the episode ended."""
-    if trace.caught:
-        return f"caught at {trace.catch_time:.2f} s"
+    """One word (and the time of success): how the episode ended, in its family's words."""
+    from visuomotor_gym.registration import family_of
+
+    try:
+        catching = family_of(str(trace.env_id)) == "catch"
+    except ValueError:  # a synthetic or unregistered trace: the catch family's words
+        catching = True
+    if trace.success:
+        return f"{'caught' if catching else 'succeeded'} at {float(trace.t[-1]):.2f} s"
     if trace.diverged:
         return "physics diverged"
-    if trace.missed:
-        return "missed"
+    if getattr(trace, "missed", False) if catching else not trace.truncated:
+        return "missed" if catching else "failed"
     if trace.truncated:
         return "truncated (time limit)"
     return "ended"
