@@ -11,6 +11,7 @@ from types import SimpleNamespace
 import gymnasium as gym
 import numpy as np
 import pytest
+from family_checks import rollout, run_env_checkers
 
 import visuomotor_gym  # noqa: F401  (registers the ids)
 from visuomotor_gym.agents import make_agent
@@ -26,17 +27,6 @@ from visuomotor_gym.tasks.obstacle_dodge import (
 )
 
 DODGE_IDS = FAMILIES["dodge"]
-
-
-def rollout(env, seed, actions):
-    obs, info = env.reset(seed=seed)
-    out = [obs.copy()]
-    for a in actions:
-        obs, r, term, trunc, info = env.step(a)
-        out.append(np.append(obs, r))
-        if term or trunc:
-            break
-    return out
 
 
 def test_the_five_rungs_are_registered_in_the_dodge_family():
@@ -58,12 +48,7 @@ def test_every_rung_runs_from_the_registry_on_the_same_crowd(env_id):
 
 
 def test_gymnasium_and_sb3_checkers():
-    from gymnasium.utils.env_checker import check_env as gym_check
-    from stable_baselines3.common.env_checker import check_env as sb3_check
-
-    gym_check(ObstacleDodgeEnv(), skip_render_check=True)
-    sb3_check(ObstacleDodgeEnv(), warn=True)
-    gym_check(ObstacleDodgeEnv(obs_mode="dict"), skip_render_check=True)
+    run_env_checkers(ObstacleDodgeEnv)
 
 
 def test_layout_docstring_and_spaces_agree():

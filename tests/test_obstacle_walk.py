@@ -3,12 +3,12 @@ true state, every rung from the registry, the iwao baseline against its gaze-bli
 
 from __future__ import annotations
 
-import pickle
 from types import SimpleNamespace
 
 import gymnasium as gym
 import numpy as np
 import pytest
+from family_checks import assert_reproducible_and_picklable, run_env_checkers
 
 import visuomotor_gym  # noqa: F401  (registers the ids)
 from visuomotor_gym.agents import make_agent
@@ -17,17 +17,6 @@ from visuomotor_gym.registration import ENV_SPECS, FAMILIES
 from visuomotor_gym.tasks.obstacle_walk import K_SLOTS, CourseDistribution, sample_course
 
 WALK_IDS = FAMILIES["walk"]
-
-
-def rollout(env, seed, actions):
-    obs, info = env.reset(seed=seed)
-    out = [obs.copy()]
-    for a in actions:
-        obs, r, term, trunc, info = env.step(a)
-        out.append(np.append(obs, r))
-        if term or trunc:
-            break
-    return out
 
 
 def test_the_five_rungs_are_registered_in_the_walk_family():
@@ -50,12 +39,7 @@ def test_every_rung_runs_from_the_registry_on_the_same_course(env_id):
 
 
 def test_gymnasium_and_sb3_checkers():
-    from gymnasium.utils.env_checker import check_env as gym_check
-    from stable_baselines3.common.env_checker import check_env as sb3_check
-
-    gym_check(ObstacleWalkEnv(), skip_render_check=True)
-    sb3_check(ObstacleWalkEnv(), warn=True)
-    gym_check(ObstacleWalkEnv(obs_mode="dict"), skip_render_check=True)
+    run_env_checkers(ObstacleWalkEnv)
 
 
 def test_layout_docstring_and_spaces_agree():
@@ -69,18 +53,7 @@ def test_layout_docstring_and_spaces_agree():
 def test_same_seed_same_episode_and_pickling_mid_episode():
     rng = np.random.default_rng(0)
     actions = rng.uniform(-1, 1, (60, 8)).astype(np.float32)
-    a = rollout(ObstacleWalkEnv(), 3, actions)
-    b = rollout(ObstacleWalkEnv(), 3, actions)
-    assert len(a) == len(b) and all(np.array_equal(x, y) for x, y in zip(a, b))
-    env = ObstacleWalkEnv()
-    env.reset(seed=3)
-    for act in actions[:20]:
-        env.step(act)
-    clone = pickle.loads(pickle.dumps(env))
-    for act in actions[20:40]:
-        o1, r1, t1, _, _ = env.step(act)
-        o2, r2, t2, _, _ = clone.step(act)
-        assert np.array_equal(o1, o2) and r1 == r2 and t1 == t2
+    assert_reproducible_and_picklable(ObstacleWalkEnv, actions)
 
 
 def test_bad_input_gives_clear_errors():

@@ -33,6 +33,11 @@ class FixedFrame:
         ox, oy, oz = self.origin_list
         return x - ox, y - oy, z - oz
 
+    @staticmethod
+    def axes_local(flat: list) -> list:
+        """A row-major 3x3 rotation (world) in the frame's axes: the world's axes, so itself."""
+        return flat
+
 
 class RootFrame:
     """A frame carried by a root body: its origin, and its heading (yaw about world z) only, so
@@ -56,20 +61,9 @@ class RootFrame:
         dx, dy = x - ox, y - oy
         return self._cos * dx + self._sin * dy, -self._sin * dx + self._cos * dy, z - oz
 
-
-def _identity_axes(flat: list) -> list:
-    return flat
-
-
-FixedFrame.axes_local = staticmethod(_identity_axes)  # world axes are the frame's axes
-
-
-def _root_axes(self: RootFrame, flat: list) -> list:
-    """A row-major 3x3 rotation (world) expressed in the frame's axes: Rz(-yaw) @ R."""
-    c, s = self._cos, self._sin
-    r0, r1, r2, r3, r4, r5, r6, r7, r8 = flat
-    return [c * r0 + s * r3, c * r1 + s * r4, c * r2 + s * r5,
-            -s * r0 + c * r3, -s * r1 + c * r4, -s * r2 + c * r5, r6, r7, r8]
-
-
-RootFrame.axes_local = _root_axes
+    def axes_local(self, flat: list) -> list:
+        """A row-major 3x3 rotation (world) expressed in the frame's axes: Rz(-yaw) @ R."""
+        c, s = self._cos, self._sin
+        r0, r1, r2, r3, r4, r5, r6, r7, r8 = flat
+        return [c * r0 + s * r3, c * r1 + s * r4, c * r2 + s * r5,
+                -s * r0 + c * r3, -s * r1 + c * r4, -s * r2 + c * r5, r6, r7, r8]

@@ -42,14 +42,11 @@ def to_json_safe(obj):
 def episode_success(trace) -> bool:
     """Whether an episode met its task's goal, for any task family.
 
-    A trace that carries its own ``success`` flag (a task module that is not catching) is taken at
-    its word; a catch trace succeeds when the ball was caught (for two balls: every ball, as
-    ``caught`` already means there), so for the catch family ``success_rate == catch_rate``.
+    An :class:`~visuomotor_gym.bench.trace.EpisodeTrace` carries ``success`` (``info["is_success"]``;
+    for catching, every ball caught), so for the catch family ``success_rate == catch_rate``; a
+    trace-like object without it succeeds when ``caught``.
     """
     success = getattr(trace, "success", None)
-    extras = getattr(trace, "extras", None)
-    if success is None and isinstance(extras, dict):
-        success = extras.get("success")
     return bool(trace.caught if success is None else success)
 
 
