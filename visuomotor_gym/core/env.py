@@ -330,6 +330,10 @@ class VisuomotorEnv(gym.Env):
 
     def _observe(self, saccading: bool) -> np.ndarray:
         d = self.data
+        # A moving body frame (a walker's pelvis) and the task's own per-step bookkeeping (which
+        # obstacles fill the observation's slots) are brought up to date before any block is written.
+        self.frame.update(d)
+        self.task.before_observe(d)
         samples = self.retina.sample(d, self.task.targets, self.eye, saccading, self.np_random)
         values: list = []
         self.task.observe_leading(values, samples)

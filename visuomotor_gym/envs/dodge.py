@@ -178,10 +178,6 @@ class ObstacleDodgeEnv(VisuomotorEnv):
         self._assemble_eye(body=body, task=task, obs_mode=obs_mode, width=width, height=height)
         self.gait = body.gait
 
-    def _observe(self, saccading: bool):
-        self.frame.update(self.data)  # the pelvis frame moves: bring it up to date before the blocks
-        return super()._observe(saccading)
-
     @property
     def crowd(self):
         """This episode's pedestrians (:class:`~visuomotor_gym.tasks.obstacle_dodge.Crowd`; true state)."""

@@ -192,13 +192,6 @@ class ObstacleWalkEnv(VisuomotorEnv):
         self._assemble_eye(body=body, task=task, obs_mode=obs_mode, width=width, height=height)
         self.gait = body.gait
 
-    def _observe(self, saccading: bool):
-        # The pelvis frame moves: bring it (and the task's obstacle slots) up to date before the
-        # eye, head and body write their blocks in it.
-        self.frame.update(self.data)
-        self.task.update_slots(self.data)
-        return super()._observe(saccading)
-
     @property
     def course(self):
         """This episode's course (:class:`~visuomotor_gym.tasks.obstacle_walk.Course`; true state)."""

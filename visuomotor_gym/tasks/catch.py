@@ -283,6 +283,9 @@ class CatchTask:
         d.eq_active[ball.weld] = 1
 
     # --- observation --------------------------------------------------------------------------
+    def before_observe(self, data: mujoco.MjData) -> None:
+        """Nothing to bring up to date before the observation blocks (the core's hook)."""
+
     def observe_leading(self, values: list, samples: list) -> None:
         """The first ball's percept blocks (:data:`BALL_PERCEPT_BLOCKS`)."""
         pos, vel, visible = samples[0]

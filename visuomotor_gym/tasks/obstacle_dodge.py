@@ -255,6 +255,9 @@ class ObstacleDodgeTask:
         return False
 
     # --- observation --------------------------------------------------------------------------
+    def before_observe(self, data: mujoco.MjData) -> None:
+        """Nothing to bring up to date before the observation blocks (the core's hook)."""
+
     def observe_leading(self, values: list, samples: list) -> None:
         for k in range(K_SLOTS):
             p, v, visible = samples[k]

@@ -188,7 +188,7 @@ class ObstacleWalkTask:
         return self.gait.check_contacts(data)
 
     # --- observation --------------------------------------------------------------------------
-    def update_slots(self, data: mujoco.MjData) -> None:
+    def before_observe(self, data: mujoco.MjData) -> None:
         """Advance the first slot past obstacles the pelvis has left behind (before the retina samples)."""
         obs = self.course.obstacles
         x = float(data.qpos[0])

@@ -191,6 +191,9 @@ class ReachTask:
         return False
 
     # --- observation --------------------------------------------------------------------------
+    def before_observe(self, data: mujoco.MjData) -> None:
+        """Nothing to bring up to date before the observation blocks (the core's hook)."""
+
     def observe_leading(self, values: list, samples: list) -> None:
         pos, _vel, visible = samples[0]
         self.visible = visible

@@ -252,7 +252,7 @@ class SteppingStonesTask:
         return new
 
     # --- observation --------------------------------------------------------------------------
-    def update_slots(self, data: mujoco.MjData) -> None:
+    def before_observe(self, data: mujoco.MjData) -> None:
         """Sample only the slots' stones (the others cannot reach the observation)."""
         if self._slots_for != self.next_stone:
             n = self.next_stone
