@@ -111,7 +111,7 @@ class Eye:
         elevation of the current eye frame, in action units) and move vergence toward the fixation
         action (log-mapped onto the fixation range, rate-limited in diopters)."""
         u = unit_from_angles(g_az * self.gaze_action_range, g_el * self.gaze_action_range)  # eye frame
-        target = np.array(rotate(self.rot_flat, *u))  # world
+        target = rotate(self.rot_flat, *u)  # world, a tuple (the plant takes one as it is)
         plant_step = self.plant.step(target, dt, n_substeps, rng)
         lo, hi = self._log_fix
         fix_target = math.exp(lo + (g_fix + 1.0) * 0.5 * (hi - lo))

@@ -57,6 +57,7 @@ import numpy as np
 from visuomotor_gym.geometry import angle_between, cross, unit_from_angles
 
 DEG = math.pi / 180.0
+_ZERO = (0.0, 0.0, 0.0)  # "no pursuit drive" (compared by identity in the hot loop)
 SACCADE_HISTORY = 256  # saccades kept without record=True: far more than an episode holds (<= 5 per second)
 
 
@@ -245,7 +246,7 @@ class OculomotorPlant:
         self.pursuit_omega = (0.0, 0.0, 0.0)
         self._drive_queue: list[tuple[float, float, float, float]] = []
         self._drive = (0.0, 0.0, 0.0)
-        self._goal = (0.0, 0.0, 0.0)  # the pursuit velocity goal of the current drive (cached)
+        self._goal = _ZERO  # the pursuit velocity goal of the current drive (cached)
         self._last_sample = (0.0, 0.0, 0.0)
         self._prev_request: tuple[float, float, float] | None = None
         self._suppressed = False
@@ -259,7 +260,7 @@ class OculomotorPlant:
     def angular_velocity(self) -> np.ndarray:
         """Angular velocity of the gaze (world, rad/s) at the end of the last step (computed when asked)."""
         a, b, k = self._omega
-        return (cross(a, b) if a is not None else b) * k
+        return (cross(a, b) if a is not None else np.array(b)) * k
 
     @property
     def ready_for_saccade(self) -> bool:
@@ -293,7 +294,7 @@ class OculomotorPlant:
         wx, wy, wz = self._drive
         speed = math.sqrt(wx * wx + wy * wy + wz * wz)
         if speed < 1e-12:
-            self._goal = (0.0, 0.0, 0.0)
+            self._goal = _ZERO
         else:
             k = self.params.pursuit_velocity(speed / DEG) * DEG / speed
             self._goal = (wx * k, wy * k, wz * k)
@@ -306,13 +307,14 @@ class OculomotorPlant:
         n_substeps: int,
         rng: np.random.Generator | None = None,
     ) -> PlantStep:
-        """Advance one control step of ``dt`` seconds toward the unit world direction ``target``.
+        """Advance one control step of ``dt`` seconds toward the world direction ``target`` (an array
+        or a 3-tuple of floats; normalised here).
 
         ``rng`` draws the optional saccade endpoint noise (only used when that noise is > 0).
         """
         p = self.params
         t0 = self.time
-        tx, ty, tz = np.asarray(target, dtype=float).tolist()
+        tx, ty, tz = target if type(target) is tuple else np.asarray(target, dtype=float).tolist()
         n = math.sqrt(tx * tx + ty * ty + tz * tz)
         request = (tx / n, ty / n, tz / n)
         started = deferred = False
@@ -346,22 +348,38 @@ class OculomotorPlant:
         sac = self.saccade
         points = [] if self.record else None
         in_saccade_last = False
+        queue = self._drive_queue
+        due = queue[0][0] if queue else math.inf  # when the next target-motion sample drives the eye
+        goal = self._goal
+        # A substep with no pursuit drive and an eye at rest (exact zeros) changes nothing: the
+        # velocity update adds 0 and the rotation has no axis. Such substeps are skipped (the same
+        # numbers as running them; this is the plant's hot loop).
+        still = goal is _ZERO and vx == 0.0 and vy == 0.0 and vz == 0.0
         for i in range(1, n_substeps + 1):
             t = t0 + h * i
-            # Pursuit velocity: toward the delayed, gain-scaled target motion, acceleration-bounded.
-            ux, uy, uz = self._pursuit_goal(t - h)  # the drive at the start of the substep
-            ex, ey, ez = ux - vx, uy - vy, uz - vz
-            e = math.sqrt(ex * ex + ey * ey + ez * ez)
-            if e > a_max:
-                ex, ey, ez = ex * a_max / e, ey * a_max / e, ez * a_max / e
-            vx, vy, vz = vx + ex, vy + ey, vz + ez
+            if due <= (t - h) + 1e-9:  # a new drive at the start of the substep (see _pursuit_goal)
+                goal = self._pursuit_goal(t - h)
+                due = queue[0][0] if queue else math.inf
+                still = goal is _ZERO and vx == 0.0 and vy == 0.0 and vz == 0.0
+            if not still:
+                # Pursuit velocity: toward the delayed, gain-scaled target motion, acceleration-bounded.
+                ux, uy, uz = goal
+                ex, ey, ez = ux - vx, uy - vy, uz - vz
+                e = math.sqrt(ex * ex + ey * ey + ez * ez)
+                if e > a_max:
+                    ex, ey, ez = ex * a_max / e, ey * a_max / e, ez * a_max / e
+                vx, vy, vz = vx + ex, vy + ey, vz + ez
+                # v + (0 - v) is +0.0 exactly: once at rest with no drive, the eye stays still
+                still = goal is _ZERO and vx == 0.0 and vy == 0.0 and vz == 0.0
             if sac is not None:  # ballistic: the saccade alone moves the eye until it lands
                 u = min(max((t - sac.onset) / sac.duration, 0.0), 1.0)
-                gx, gy, gz = sac.direction(minimum_jerk(u))
                 in_saccade_last = u < 1.0
+                # Only the last point of the step (or the landing) is kept unless the trace is recorded.
+                if u >= 1.0 or i == n_substeps or points is not None:
+                    gx, gy, gz = sac.direction(minimum_jerk(u))
                 if u >= 1.0:
                     sac = None
-            else:
+            elif not still:
                 in_saccade_last = False
                 # Rotate the gaze by the pursuit velocity's component across it (Rodrigues).
                 d = vx * gx + vy * gy + vz * gz
@@ -375,6 +393,8 @@ class OculomotorPlant:
                     gx, gy, gz = c * gx + s * cx, c * gy + s * cy, c * gz + s * cz
                     m = math.sqrt(gx * gx + gy * gy + gz * gz)
                     gx, gy, gz = gx / m, gy / m, gz / m
+            else:
+                in_saccade_last = False
             if points is not None:
                 points.append(np.array([gx, gy, gz]))
         if self.saccade is not None:
@@ -386,7 +406,7 @@ class OculomotorPlant:
                 self.saccade = None
         if self.saccade is None:
             d = vx * gx + vy * gy + vz * gz
-            self._omega = (None, np.array([vx - d * gx, vy - d * gy, vz - d * gz]), 1.0)
+            self._omega = (None, (vx - d * gx, vy - d * gy, vz - d * gz), 1.0)
         self.pursuit_omega = (vx, vy, vz)
         self._suppressed = saccading
         self.gaze = np.array([gx, gy, gz])
