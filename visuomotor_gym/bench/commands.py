@@ -96,6 +96,13 @@ def summary_rows(results: dict) -> list[tuple[str, str]]:
         ]
     for name, comp in gaze["components"].items():
         rows.append((f"  {name}", f"score {_fmt(comp.get('score'))}  (value {_fmt(comp.get('value'))})"))
+    hand_path = results.get("hand_path")
+    if hand_path:  # single-ball catch ids (metrics.catch_handpath): beside the gaze realism, not in it
+        rows.append(("hand path", f"{hand_path['verdict'] or 'n/a'}  score {_fmt(hand_path['score'])}  "
+                                  f"({hand_path['episodes']} transports vs Faraway's reach model)"))
+        for name, comp in hand_path["components"].items():
+            score = "not scored" if comp.get("score") is None else f"score {_fmt(comp['score'])}"
+            rows.append((f"  {name}", f"{score}  (value {_fmt(comp.get('value'))})"))
     rows += [
         ("latency (ms)", f"p50 {_fmt(lat['p50'])}  p95 {_fmt(lat['p95'])}  max {_fmt(lat['max'])}"),
         ("real time", f"{_fmt(results['real_time'])}  "

@@ -88,6 +88,8 @@ def build_results(eval_result, command: str | None, twin_result=None) -> dict:
         },
         "provenance": provenance(command),
     }
+    if "hand_path" in s:  # single-ball catch ids: hand paths against Faraway's model (metrics.catch_handpath)
+        obj["hand_path"] = s["hand_path"]
     if twin_result is not None:
         obj["gaze_gain"] = gaze_gain_block(eval_result, twin_result)
     # Round-trip through JSON so the object holds plain JSON types only (no numpy scalars).

@@ -76,7 +76,11 @@ def summarize(traces: Sequence) -> dict:
     * ``reaction_times_s``: ``{"first_saccade": {"mean", "median"}, "hand_onset": {"mean", "median"}}``;
     * ``miss_distance_m``: ``{"mean", "median"}`` closest ball-to-catch-site distance over the episodes
       that were not caught (diverged ones excluded);
-    * ``time_to_catch_s``: ``{"mean", "median"}`` over caught episodes.
+    * ``time_to_catch_s``: ``{"mean", "median"}`` over caught episodes;
+    * ``hand_path`` (single-ball catch ids only): the hand's transport to the interception point against
+      Faraway's reach model, ``{"score", "verdict", "episodes", "components"}``
+      (:func:`~visuomotor_gym.metrics.catch_handpath.catch_hand_path`), reported beside ``gaze_realism``
+      and not part of its score.
 
     Diverged episodes end on a physics reset, so their last state is not the agent's doing: they are
     left out of the behavioural measures (realism, reaction times, miss distance) but count in the
@@ -112,6 +116,11 @@ def summarize(traces: Sequence) -> dict:
         "miss_distance_m": mean_median([miss_distance(tr) for tr in failed]),
         "time_to_catch_s": mean_median([time_to_catch(tr) for tr in valid if tr.caught]),
     }
+    if family == "catch":  # beside gaze_realism, not in its score (metrics.catch_handpath)
+        from visuomotor_gym.metrics.catch_handpath import catch_hand_path, measures_hand_path
+
+        if measures_hand_path(traces[0]):
+            out["hand_path"] = catch_hand_path(valid)
     return to_json_safe(out)
 
 
