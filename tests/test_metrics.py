@@ -497,3 +497,175 @@ def test_summarize_on_a_simulated_episode():
     assert s["episodes"] == 1
     score = s["gaze_realism"]["score"]
     assert score is None or 0.0 <= score <= 1.0
+
+
+# --- catch hand paths against Faraway's reach model (metrics.catch_handpath) ------------------------------
+HAND_REST = np.array([0.2, -0.25, 0.9])
+# Interception points of a catching hand (to the front, right, above, low): a set of transports, so the
+# medians are over paths of several directions and lengths (0.19 to 0.42 m).
+CATCH_POINTS = ((0.45, -0.1, 1.25), (0.35, -0.4, 1.1), (0.55, -0.2, 0.95), (0.3, 0.05, 1.3), (0.5, -0.45, 1.2))
+
+
+def transport_trace(path_kind: str, catch_point, *, start=0.2, duration=0.6, caught=True, gaze=None):
+    """A trace whose catch site rests at HAND_REST, moves to ``catch_point`` from ``start`` over ``duration``
+    (s) along ``path_kind`` ("faraway": handpath.faraway_path; "straight": straight with minimum-jerk
+    timing; "revised": first towards a point 20 cm off, then on to the catch point), then waits there."""
+    from visuomotor_gym import handpath
+
+    t = np.round(np.arange(0.0, FLIGHT + 1e-9, DT), 10)
+    end = np.asarray(catch_point, dtype=float)
+    k0, k1 = int(round(start / DT)), int(round((start + duration) / DT))
+    n = k1 - k0 + 1
+    if path_kind == "faraway":
+        move = handpath.faraway_path(HAND_REST, end, n)
+    elif path_kind == "straight":
+        move = handpath.minimum_jerk_path(HAND_REST, end, n)
+    elif path_kind == "revised":
+        wrong = end + np.array([0.0, 0.2, -0.05])
+        half = n // 2
+        move = np.vstack([handpath.minimum_jerk_path(HAND_REST, wrong, half),
+                          handpath.minimum_jerk_path(wrong, end, n - half + 1)[1:]])
+    else:
+        raise ValueError(path_kind)
+    hand = np.vstack([np.tile(HAND_REST, (k0, 1)), move, np.tile(end, (len(t) - k1 - 1, 1))])
+    return make_trace(hand=hand, gaze=gaze, caught=caught)
+
+
+def catch_paths(kind, **kw):
+    return [transport_trace(kind, p, **kw) for p in CATCH_POINTS]
+
+
+def test_catch_hand_path_of_faraway_transports_is_human_like():
+    from visuomotor_gym.metrics import catch_handpath as C
+    from visuomotor_gym import handpath
+
+    out = C.catch_hand_path(catch_paths("faraway"))
+    comps = out["components"]
+    assert out["verdict"] == "human-like" and out["episodes"] == len(CATCH_POINTS)
+    assert comps["faraway_distance_cm"]["value"] < 1.0  # onset/offset detection trims a few mm only
+    assert comps["curvature_index"]["value"] == pytest.approx(1.0, abs=0.1)
+    assert comps["peak_speed_time"]["value"] == pytest.approx(handpath.beta_peak_time(), abs=0.05)
+    for name in ("faraway_distance_cm", "curvature_index", "peak_speed_time"):
+        assert comps[name]["score"] == 1.0
+    assert comps["gaze_hand_lead_s"]["score"] != comps["gaze_hand_lead_s"]["score"]  # NaN: not scored
+
+
+def test_catch_hand_path_of_straight_transports_is_straight_line_like():
+    from visuomotor_gym.metrics import catch_handpath as C
+
+    out = C.catch_hand_path(catch_paths("straight"))
+    comps = out["components"]
+    assert out["verdict"] == "straight-line-like"
+    assert abs(comps["curvature_index"]["value"]) < 0.01
+    # A straight path is close to Faraway's (~4-6.4 cm at 56.7 cm: docs/reproductions/faraway.md): the
+    # distance alone would call it human-like; the curvature index tells them apart.
+    assert 3.0 < comps["faraway_distance_cm"]["value"] < C.HUMAN_LIKE_MAX_CM
+    assert comps["curvature_index"]["score"] < 0.7
+    assert comps["peak_speed_time"]["value"] == pytest.approx(0.5, abs=0.05)  # minimum jerk peaks mid-way
+
+
+def test_catch_hand_path_of_revised_transports_is_unlike_a_single_reach():
+    from visuomotor_gym.metrics import catch_handpath as C
+
+    out = C.catch_hand_path(catch_paths("revised"))
+    assert out["verdict"] == "unlike a single reach"
+    assert out["components"]["faraway_distance_cm"]["value"] > C.UNLIKE_REACH_MIN_CM
+    assert out["components"]["faraway_distance_cm"]["score"] < 0.01
+
+
+def test_catch_transport_segment_leaves_out_the_wait_and_ends_a_miss_at_the_closest_approach():
+    from visuomotor_gym.metrics import catch_handpath as C
+
+    tr = transport_trace("faraway", CATCH_POINTS[0], start=0.2, duration=0.5)
+    onset, arrival, end = C.catch_reach_segment(tr)
+    assert end == len(tr.t) - 1  # caught: the last step
+    assert 10 <= onset <= 12 and 32 <= arrival <= 35  # the move spans rows 10..35; the wait is left out
+    # not caught: the transport heads for the hand's position at the ball's closest approach
+    missed = transport_trace("faraway", CATCH_POINTS[0], caught=False)
+    gap = np.linalg.norm(missed.ball_pos - missed.hand_pos, axis=1)
+    assert C.catch_reach_segment(missed)[2] == int(np.argmin(gap))
+
+
+def test_catch_hand_path_missing_data_gives_undefined_values_not_errors():
+    from visuomotor_gym.metrics import catch_handpath as C
+
+    still = make_trace()  # the hand never moves
+    assert C.catch_reach_segment(still) is None
+    assert all(math.isnan(v) for v in C.catch_hand_path_measures(still).values())
+    nan_hand = transport_trace("faraway", CATCH_POINTS[0])
+    nan_hand.task["hand_pos"] = nan_hand.hand_pos.copy()
+    nan_hand.task["hand_pos"][5] = np.nan
+    no_hand = transport_trace("faraway", CATCH_POINTS[0])
+    del no_hand.task["hand_pos"]
+    short = transport_trace("faraway", HAND_REST + [0.03, 0.0, 0.0])  # 3 cm: not a reach
+    for tr in (nan_hand, no_hand, short):
+        assert all(math.isnan(v) for v in C.catch_hand_path_measures(tr).values())
+    out = C.catch_hand_path([still, nan_hand, no_hand, short])
+    assert out["episodes"] == 0 and out["verdict"] is None and math.isnan(out["score"])
+    assert all(c["episodes"] == 0 and math.isnan(c["value"]) for c in out["components"].values())
+    assert C.catch_hand_path([])["verdict"] is None
+    # summarize: a catch id reports the block (None where undefined), JSON-safe; a two-ball id does not
+    s = M.summarize([still])
+    json.dumps(s, allow_nan=False)
+    assert s["hand_path"]["verdict"] is None and s["hand_path"]["score"] is None
+    two = transport_trace("faraway", CATCH_POINTS[0])
+    two.env_id = "EyeCatchTwoBalls-v0"
+    assert "hand_path" not in M.summarize([two])
+
+
+def test_catch_hand_path_gaze_hand_lead():
+    from visuomotor_gym.metrics import catch_handpath as C
+
+    tracking = C.catch_hand_path_measures(transport_trace("faraway", CATCH_POINTS[0], gaze="ball"))
+    assert math.isnan(tracking["gaze_hand_lead_s"]) and tracking["gaze_ahead_share"] == 0.0
+    # gaze jumps to the interception point at t = 0.3 s and stays: it leads the hand's arrival
+    t = np.round(np.arange(0.0, FLIGHT + 1e-9, DT), 10)
+    gaze = np.tile(unit(RELEASE - EYE), (len(t), 1))
+    gaze[t >= 0.3 - 1e-9] = unit(np.asarray(CATCH_POINTS[0]) - EYE)
+    tr = transport_trace("faraway", CATCH_POINTS[0], gaze=gaze)
+    _, arrival, _ = C.catch_reach_segment(tr)
+    m = C.catch_hand_path_measures(tr)
+    assert m["gaze_hand_lead_s"] == pytest.approx(t[arrival] - 0.3)
+    assert m["gaze_ahead_share"] == 1.0
+
+
+def test_catch_hand_path_is_deterministic_and_order_free():
+    from visuomotor_gym.metrics import catch_handpath as C
+
+    traces = catch_paths("faraway") + catch_paths("revised")
+    a = json.dumps(M.to_json_safe(C.catch_hand_path(traces)), sort_keys=True)
+    b = json.dumps(M.to_json_safe(C.catch_hand_path(list(reversed(traces)))), sort_keys=True)
+    assert a == b == json.dumps(M.to_json_safe(C.catch_hand_path(traces)), sort_keys=True)
+
+
+def test_catch_hand_path_reference_is_sourced_and_leaves_gaze_realism_alone():
+    from visuomotor_gym.metrics import catch_handpath as C
+
+    for name, entry in C.CATCH_HANDPATH_REFERENCE.items():
+        assert entry["source"] and entry["unit"] and entry["notes"], name
+        if entry.get("scored", True):
+            assert entry["low"] <= entry["value"] <= entry["high"] and entry["tolerance"] > 0, name
+        else:
+            assert "not scored" in entry["source"].lower(), name
+    # the catch family's gaze realism keeps its own components and score
+    traces = catch_paths("faraway")
+    s = M.summarize(traces)
+    assert set(s["gaze_realism"]["components"]) == set(COMPONENTS)
+    assert s["gaze_realism"] == M.to_json_safe(M.gaze_realism(traces))
+
+
+def test_catch_hand_path_in_the_results_of_a_simulated_run():
+    from visuomotor_gym.bench.evaluate import evaluate
+    from visuomotor_gym.bench.results import ResultsError, build_results, validate_results
+
+    res = evaluate("eyecatch", "EyeCatch-v0", episodes=2, seed=0)
+    obj = build_results(res, command="vmgym bench --agent eyecatch --env EyeCatch-v0 --episodes 2")
+    hp = obj["hand_path"]
+    assert hp["episodes"] == 2 and hp["verdict"] is not None
+    assert hp == M.to_json_safe(res.summary["hand_path"])
+    again = evaluate("eyecatch", "EyeCatch-v0", episodes=2, seed=0)
+    assert again.summary["hand_path"] == res.summary["hand_path"]  # deterministic
+    bad = json.loads(json.dumps(obj))
+    bad["hand_path"]["verdict"] = "great"
+    with pytest.raises(ResultsError, match="hand_path"):
+        validate_results(bad)

@@ -15,10 +15,13 @@ follows the ball in small corrections until the ball arrives. So the compared se
 * it is headed for the interception point actually used: the catch site's position at the catch (the
   last step of a caught episode) or, when the ball was not caught, at the ball's closest approach to the
   catch site (the miss);
-* it ends at the hand's **arrival** there: the first step from which the catch site stays within
-  ``ARRIVAL_RADIUS_M`` of that point until the catch / closest approach. The dwell after arrival (waiting,
-  millimetre corrections, following the ball into the palm) is left out because it is not part of a reach:
-  kept, it adds nothing spatially but pushes the relative time of the peak speed towards 0.
+* it ends at the hand's **arrival** there: once the catch site stays within ``ARRIVAL_RADIUS_M`` of that
+  point until the catch / closest approach, the first step no faster than ``HAND_ONSET_SPEED_M_S`` (the
+  movement's offset, the onset rule reversed), or the catch / closest approach if the hand never slows
+  down. The dwell after arrival (waiting, millimetre corrections) is left out because it is not part of a
+  reach: kept, it adds almost nothing spatially but pushes the relative time of the peak speed towards 0.
+  The radius keeps a pause between two submovements far from the interception point from ending the
+  transport early; the speed rule keeps the slow final approach of a reach inside it.
 
 ``faraway_path`` is drawn between the segment's own ends (its first and last catch-site positions), so
 the distance measures what the transport did on its way; every revision of the interception point, every
@@ -61,8 +64,9 @@ from visuomotor_gym.metrics.realism import load_reference, score_component
 
 HAND_ONSET_SPEED_M_S = 0.1  # as metrics.hand.HAND_ONSET_SPEED_M_S and the reach family
 MIN_REACH_M = 0.05  # shorter transports are not reaches (modelling choice, as metrics.reach_realism)
-# The hand has arrived when it stays this close to the interception point: half the 6 cm catch volume
-# (EyeCatch-v0's catch_radius), so the ball can be caught from there. Modelling choice.
+# The hand is near the interception point when it stays this close to it: half the 6 cm catch volume
+# (EyeCatch-v0's catch_radius), so the ball can be caught from there; it has arrived when it then slows
+# below HAND_ONSET_SPEED_M_S. Modelling choice.
 ARRIVAL_RADIUS_M = 0.03
 GAZE_ON_TARGET_DEG = 5.0  # "on the interception point": as metrics.reach_realism.GAZE_ON_OBJECT_DEG (our choice)
 
@@ -169,7 +173,9 @@ def catch_reach_segment(trace) -> tuple[int, int, int] | None:
     if end <= onset:
         return None
     away = np.flatnonzero(np.linalg.norm(hand[onset : end + 1] - hand[end], axis=1) > ARRIVAL_RADIUS_M)
-    arrival = onset + (int(away[-1]) + 1 if away.size else 0)
+    near = onset + (int(away[-1]) + 1 if away.size else 0)  # from here on, within the radius
+    slow = np.flatnonzero(speed[near:end] <= HAND_ONSET_SPEED_M_S)  # the movement's offset, once near
+    arrival = near + int(slow[0]) if slow.size else end
     if arrival - onset < 2:
         return None
     return onset, arrival, end
