@@ -57,10 +57,11 @@ def rotate_t(r, x: float, y: float, z: float) -> tuple[float, float, float]:
     return r0 * x + r3 * y + r6 * z, r1 * x + r4 * y + r7 * z, r2 * x + r5 * y + r8 * z
 
 
-def solve3(m: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """Solve the 3x3 system ``m x = v`` by Cramer's rule (for well-conditioned, e.g. damped, ``m``)."""
-    (a, b, c), (d, e, f), (g, h, i) = m.tolist()
-    x, y, z = v.tolist()
+def solve3(m, v) -> np.ndarray:
+    """Solve the 3x3 system ``m x = v`` by Cramer's rule (for well-conditioned, e.g. damped, ``m``).
+    ``m`` and ``v`` are arrays or nested sequences of floats."""
+    (a, b, c), (d, e, f), (g, h, i) = m.tolist() if isinstance(m, np.ndarray) else m
+    x, y, z = v.tolist() if isinstance(v, np.ndarray) else v
     ei_fh, fg_di, dh_eg = e * i - f * h, f * g - d * i, d * h - e * g
     det = a * ei_fh + b * fg_di + c * dh_eg
     return np.array(

@@ -68,8 +68,9 @@ class HandController:
         weights = np.ones(len(joint_ranges))
         weights[:n_torso] = self.params.torso_weight
         self.weights = weights
+        self._weights_rows = np.tile(weights, (3, 1))
         self._jacp = np.zeros((3, model.nv))
-        self._damping_eye = np.eye(3) * self.params.damping**2
+        self._damping2 = self.params.damping**2  # lambda^2 on the diagonal
         self.reference = np.zeros(3)
 
     def reset(self, hand_pos: np.ndarray) -> None:
@@ -98,16 +99,25 @@ class HandController:
         p = self.params
         mujoco.mj_jacSite(self.model, data, self._jacp, None, self.site_id)
         # A contiguous copy, and ndarray.dot rather than @: on these 3x10 shapes numpy's per-call
-        # overhead is most of the cost (this runs every control step).
+        # overhead is most of the cost (this runs every control step). The 3-vector and 3x3 steps are
+        # scalar arithmetic, the same operations numpy would do element by element.
         jac = np.ascontiguousarray(self._jacp[:, self.dof_ids])
         posture = p.posture_gain * (self.nominal - setpoint)
         # Error of the hand the setpoints would give, minus what the posture step already moves.
-        error = self.reference - data.site_xpos[self.site_id] - jac.dot(setpoint - data.qpos[self.qpos_ids] + posture)
-        jw = jac * self.weights  # J W
-        # W (JW)^T (JW (JW)^T + l^2 I)^-1 e
-        dq = self.weights * solve3(jw.dot(jw.T) + self._damping_eye, error).dot(jw) + posture
+        j0, j1, j2 = jac.dot(setpoint - data.qpos[self.qpos_ids] + posture).tolist()
+        r0, r1, r2 = self.reference.tolist()
+        s0, s1, s2 = data.site_xpos[self.site_id].tolist()
+        error = ((r0 - s0) - j0, (r1 - s1) - j1, (r2 - s2) - j2)
+        jw = jac * self._weights_rows  # J W (the weights tiled to J's shape: no broadcasting)
+        # W (JW)^T (JW (JW)^T + l^2 I)^-1 e; "+ 0.0" off the diagonal as the identity matrix's zeros add
+        (a, b, c), (d, e, f), (g, h, i) = jw.dot(jw.T).tolist()
+        l2 = self._damping2
+        system = ((a + l2, b + 0.0, c + 0.0), (d + 0.0, e + l2, f + 0.0), (g + 0.0, h + 0.0, i + l2))
+        dq = self.weights * solve3(system, error).dot(jw) + posture
         values = dq.tolist()
         step = max(max(values), -min(values))
         if step > p.max_joint_step_rad:
             dq *= p.max_joint_step_rad / step
-        return np.minimum(np.maximum(setpoint + dq, self.lower), self.upper)
+        dq += setpoint
+        np.maximum(dq, self.lower, out=dq)
+        return np.minimum(dq, self.upper, out=dq)

@@ -372,7 +372,11 @@ class OculomotorPlant:
                 # v + (0 - v) is +0.0 exactly: once at rest with no drive, the eye stays still
                 still = goal is _ZERO and vx == 0.0 and vy == 0.0 and vz == 0.0
             if sac is not None:  # ballistic: the saccade alone moves the eye until it lands
-                u = min(max((t - sac.onset) / sac.duration, 0.0), 1.0)
+                u = (t - sac.onset) / sac.duration  # clamped to [0, 1] (as min(max(u, 0), 1))
+                if u >= 1.0:
+                    u = 1.0
+                elif u < 0.0:
+                    u = 0.0
                 in_saccade_last = u < 1.0
                 # Only the last point of the step (or the landing) is kept unless the trace is recorded.
                 if u >= 1.0 or i == n_substeps or points is not None:
