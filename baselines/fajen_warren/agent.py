@@ -81,6 +81,9 @@ class FajenWarrenParams:
     speed_latency_s: float = 0.7
     speed_cost: float = 0.15
     speed_margin_m: float = 1.2  # closest distances beyond this are all equally safe
+    evade_courses_deg: tuple = (-18.0, -9.0, 0.0, 9.0, 18.0)  # candidate courses off the path (gait's limit ~18 deg)
+    course_cost: float = 0.3  # m of predicted distance per rad away from the steering dynamics' phi
+    lateral_speed_m_s: float = 0.36  # the gait's widest sideways progress (tests/test_obstacle_dodge.py)
     # Perception and gaze (modelling choices, see the module docstring).
     accel_std: float = 1.0  # m/s^2, white acceleration noise of the constant-velocity model
     min_dwell_s: float = 0.1
@@ -150,6 +153,7 @@ class FajenWarrenAgent:
         self.filters = [PedestrianFilter() for _ in range(K_SLOTS)]
         self.phi = 0.0
         self.phi_dot = 0.0
+        self.command = None  # the last (course, speed) commanded by _evade
         self.started = False
         self.poses: list = []
         self.target = None  # ("ped", k) or ("search", side)
@@ -190,9 +194,9 @@ class FajenWarrenAgent:
         threats = self._threats(odo)
         self._steer(odo, goal, threats)
         v0 = _S["pelvis"].start
-        speed = self._speed(odo, (ol[v0 + 1], ol[v0 + 2]))
+        course, speed = self._evade(odo, (ol[v0 + 1], ol[v0 + 2]))
         action = np.zeros(7, dtype=np.float32)
-        action[0:2] = DodgeBody.action_from_locomotion(self.phi - odo[2], speed)
+        action[0:2] = DodgeBody.action_from_locomotion(course - odo[2], speed)
         if not p.gaze_blind:
             action[2:7] = self._look(pose, threats, t)
         return action
@@ -265,30 +269,50 @@ class FajenWarrenAgent:
             self.phi = odo[2] + math.copysign(lim, self.phi - odo[2])
             self.phi_dot = 0.0
 
-    def _speed(self, odo, vel_local) -> float:
-        """The candidate speed whose predicted closest distance to every known pedestrian is largest
-        (capped at ``speed_margin_m``), less ``speed_cost`` per m/s away from the nominal speed. The
-        walker keeps its present velocity for ``speed_latency_s``, then walks at the candidate speed
-        along phi."""
+    def _evade(self, odo, vel_local) -> tuple[float, float]:
+        """The course and speed to command: among the candidate courses (the steering dynamics' phi and
+        ``evade_courses_deg`` off the path) and ``speeds``, the pair whose predicted closest distance to
+        every known pedestrian is largest (capped at ``speed_margin_m``), less ``speed_cost`` per m/s away
+        from the nominal speed and ``course_cost`` per rad away from phi. The walker is predicted to keep
+        its present velocity for ``speed_latency_s`` (a footstep is latched at mid-stance), then to walk
+        at the candidate speed along the candidate course, its sideways speed capped at
+        ``lateral_speed_m_s`` (the gait's widest steps); pedestrians keep their estimated velocity. With
+        no pedestrian predicted within the margin, phi at the nominal speed wins (zero cost): the
+        steering dynamics alone."""
         p = self.params
         known = [f for f in self.filters if f.known]
         if not known:
-            return p.speed
+            self.command = None
+            return self.phi, p.speed
         c, s = math.cos(odo[2]), math.sin(odo[2])
         v_now = np.array([c * vel_local[0] - s * vel_local[1], s * vel_local[0] + c * vel_local[1]])
         tau = np.arange(0.0, p.horizon_s, 0.1)
         lat = np.minimum(tau, p.speed_latency_s)
         rest = np.maximum(tau - p.speed_latency_s, 0.0)
         base = np.array(odo[:2])[None, :] + lat[:, None] * v_now[None, :]  # (T, 2)
-        direction = np.array([math.cos(self.phi), math.sin(self.phi)])
+        courses = np.array([self.phi] + [odo[2] + a * DEG for a in p.evade_courses_deg])
         speeds = np.array(p.speeds)
-        walker = base[None, :, :] + speeds[:, None, None] * rest[None, :, None] * direction[None, None, :]  # (S, T, 2)
+        cc, ss = np.meshgrid(courses, speeds, indexing="ij")  # (C, S)
+        cc, ss = cc.ravel(), ss.ravel()
+        # velocity along each candidate course, the sideways part (path frame) capped by the gait
+        vx, vy = ss * np.cos(cc - odo[2]), ss * np.sin(cc - odo[2])
+        vy = np.clip(vy, -p.lateral_speed_m_s, p.lateral_speed_m_s)
+        vel = np.stack([c * vx - s * vy, s * vx + c * vy], axis=-1)  # (M, 2)
+        walker = base[None, :, :] + rest[None, :, None] * vel[:, None, :]  # (M, T, 2)
         peds = np.array([f.x for f in known])  # (N, 4)
         ped = peds[:, None, :2] + tau[None, :, None] * peds[:, None, 2:]  # (N, T, 2)
-        dist = np.linalg.norm(walker[:, None, :, :] - ped[None, :, :, :], axis=-1)  # (S, N, T)
+        dist = np.linalg.norm(walker[:, None, :, :] - ped[None, :, :, :], axis=-1)  # (M, N, T)
         closest = np.minimum(dist.min(axis=2).min(axis=1), p.speed_margin_m)
-        score = closest - p.speed_cost * np.abs(speeds - p.speed)
-        return float(speeds[int(np.argmax(score))])
+        # Costs from the nominal course and speed; while no candidate clears the margin (a threat), from
+        # the previous command instead, so that a dodge under way is kept rather than undone when no
+        # change can show before the closest approach any more (modelling choice).
+        threat = bool(closest.max() < p.speed_margin_m)
+        ref_c, ref_s = (self.command if threat and self.command is not None else (self.phi, p.speed))
+        dphi = np.abs((cc - ref_c + math.pi) % (2.0 * math.pi) - math.pi)
+        score = closest - p.speed_cost * np.abs(ss - ref_s) - p.course_cost * dphi
+        best = int(np.argmax(score))
+        self.command = (float(cc[best]), float(ss[best]))
+        return self.command
 
     # --- gaze ---------------------------------------------------------------------------------
     def _choose(self, threats, t: float):
