@@ -141,3 +141,112 @@ def test_belief_intercept_base_catches_with_exact_vision_and_maps_residuals():
     assert plain.env_action(a) is a
     with pytest.raises(ValueError, match="hand_action must be one of"):
         BeliefFeatures("EyeCatch-v0", "relative")
+
+
+# ---------------------------------------------------------------- the gated gaze action (issue 15)
+
+
+def test_gated_gaze_maps_the_look_gate_to_the_belief_request_and_zero_to_held_gaze():
+    """gaze_action='gated': a tenth action value, the look gate. Gate > 0 sends the gaze request to the
+    believed ball (the Eyecatch 4.1 request) plus the residual; gate <= 0 (the zero action) requests the
+    residual alone around the line of sight (0: gaze held); before the filter's first sample the gate
+    does nothing. The hand block stays the intercept residual."""
+    import gymnasium as gym
+
+    from visuomotor_gym.baselines.ppo.belief import BeliefFeatures
+
+    env = gym.make("EyeCatch-v0")
+    obs, _ = env.reset(seed=5)
+    feats = BeliefFeatures("EyeCatch-v0", "intercept", gaze_action="gated", gaze_residual_deg=3.0)
+    assert feats.action_dim == 10 and feats.size == 10 + 4 + 3
+    x = feats(obs)
+    assert x.shape == (57 + 17,)
+    zero = np.zeros(10, np.float32)
+    if feats.look_gaze is None:  # nothing seen yet: the gate cannot look anywhere
+        look = zero.copy()
+        look[9] = 1.0
+        np.testing.assert_array_equal(feats.env_action(look)[4:6], [0.0, 0.0])
+    for _ in range(60):  # until the ball is seen and believed somewhere off the line of sight
+        obs, *_ = env.step(feats.env_action(zero))
+        feats(obs)
+        if feats.look_gaze is not None and np.hypot(*feats.look_gaze) > np.radians(1.0):
+            break
+    az, el = feats.look_gaze
+    assert np.hypot(az, el) > np.radians(1.0)
+    held = feats.env_action(zero)
+    assert held.shape == (9,)
+    np.testing.assert_array_equal(held[4:6], [0.0, 0.0])
+    gate = zero.copy()
+    gate[9] = 0.3
+    np.testing.assert_allclose(feats.env_action(gate)[4:6], np.array([az, el]) / np.radians(60.0), atol=1e-6)
+    gate[4] = 1.0  # + the full residual in azimuth
+    np.testing.assert_allclose(feats.env_action(gate)[4], (az + np.radians(3.0)) / np.radians(60.0), atol=1e-6)
+    off = gate.copy()
+    off[9] = -0.2  # gate off: the residual alone
+    np.testing.assert_allclose(feats.env_action(off)[4:6], [np.radians(3.0) / np.radians(60.0), 0.0], atol=1e-6)
+    np.testing.assert_array_equal(feats.env_action(gate)[:4], held[:4])  # hand and grasp unchanged
+    with pytest.raises(ValueError, match="shape"):
+        feats.env_action(np.zeros(9, np.float32))
+    with pytest.raises(ValueError, match="needs hand_action='intercept'"):
+        BeliefFeatures("EyeCatch-v0", "absolute", gaze_action="gated")
+    with pytest.raises(ValueError, match="gaze_action must be one of"):
+        BeliefFeatures("EyeCatch-v0", "intercept", gaze_action="look")
+
+
+def test_gated_base_looks_only_with_the_gate_on():
+    """The structure's fixed bases: gate 0 (the zero action) never saccades; gate on saccades to and
+    pursues the believed ball, so the ball is much nearer the line of sight."""
+    import sys
+
+    sys.path.insert(0, str(Path(__file__).parents[1] / "docs" / "baselines"))
+    from ppo_gated import measure
+
+    held = measure("belief_intercept:gaze_action=gated", "EyeCatch-v0", 2)
+    look = measure("belief_intercept:gaze_action=gated,look=true", "EyeCatch-v0", 2)
+    assert held["saccades_per_throw"] == 0
+    assert look["saccades_per_throw"] >= 1
+    assert look["ball_within_5deg"] > held["ball_within_5deg"] + 0.1
+
+
+@pytest.fixture(scope="module")
+def gated_run(tmp_path_factory):
+    out = tmp_path_factory.mktemp("ppo_gated")
+    return train.main(["--env", "EyeCatch-v0", "--gaze-action", "gated", "--timesteps", "256", "--out", str(out),
+                       "--run-name", "g", "--no-progress-bar", "--set", "n_envs=2", "n_steps=128", "batch_size=128",
+                       "eval_freq=100000", "eval_episodes=1", "checkpoint_freq=100000"])
+
+
+def test_gated_policy_trains_packs_loads_and_its_twin_holds_gaze(gated_run, tmp_path):
+    """A tiny gated run: 10 actions, meta says gated; the pickle-free file gives the zip's env actions;
+    ``gaze_blind:ppo:<file>`` holds gaze and head and leaves the rest."""
+    from visuomotor_gym.baselines.ppo.agent import PPOAgent, pack_npz, read_npz
+
+    meta = json.loads((gated_run / "ppo_meta.json").read_text())
+    assert meta["gaze_action"] == "gated" and meta["gaze_residual_deg"] == 3.0
+    assert len(meta["obs_mean"]) == 57 + 17
+    data = pack_npz(gated_run)
+    record, _ = read_npz(data)
+    assert record["network"]["action_dim"] == 10 and record["meta"]["gaze_action"] == "gated"
+    npz = tmp_path / "gated.npz"
+    npz.write_bytes(data)
+    a = evaluate(f"ppo:{gated_run}", "EyeCatch-v0", 2, 0, workers=1)
+    b = evaluate(f"ppo:{npz}", "EyeCatch-v0", 2, 0, workers=1)
+    for x, y in zip(a.traces, b.traces):
+        assert x.action.shape[1] == 9
+        np.testing.assert_array_equal(x.action, y.action)
+    twin = evaluate(f"gaze_blind:ppo:{npz}", "EyeCatch-v0", 1, 0, workers=1).traces[0]
+    assert np.all(twin.action[1:, 4:6] == 0) and np.all(twin.action[1:, 7:9] == 0)
+    assert twin.saccade_onset.sum() == 0
+    agent = PPOAgent(npz)
+    assert agent.features.action_dim == 10 and agent.features.gaze_action == "gated"
+
+
+def test_old_policies_load_with_free_gaze():
+    """A policy saved before the gated gaze (no gaze_action in its meta) keeps the 9-value free gaze."""
+    from visuomotor_gym.baselines.ppo.agent import PPOAgent
+
+    path = Path(__file__).parents[1] / "leaderboard" / "agents" / "ppo-intercept-v3__EyeCatch-v0.npz"
+    agent = PPOAgent(path)
+    assert "gaze_action" not in agent.meta
+    assert agent.features.gaze_action == "free" and agent.features.action_dim == 9
+    assert agent.actor.low.shape == (9,)

@@ -448,7 +448,9 @@ class PPOAgent:
             from visuomotor_gym.baselines.ppo.belief import BeliefFeatures
 
             self.features = BeliefFeatures(self.env_id, self.meta.get("hand_action", "absolute"),
-                                           float(self.meta.get("intercept_residual_m", 0.15)))
+                                           float(self.meta.get("intercept_residual_m", 0.15)),
+                                           self.meta.get("gaze_action", "free"),
+                                           float(self.meta.get("gaze_residual_deg", 3.0)))
         self.mean = np.asarray(self.meta["obs_mean"]) if "obs_mean" in self.meta else None
         self.std = np.sqrt(np.asarray(self.meta["obs_var"]) + self.meta.get("epsilon", 1e-8)) if self.mean is not None else None
         self.clip = float(self.meta.get("clip_obs", 10.0))
@@ -456,6 +458,7 @@ class PPOAgent:
 
     def reset(self) -> None:
         self.lstm_state = None
+        self.last_policy_action = None
         if self.features is not None:
             self.features.reset()
 
@@ -477,6 +480,7 @@ class PPOAgent:
         else:
             action, _ = self.model.predict(obs, deterministic=True)
         action = np.clip(np.asarray(action, dtype=np.float32), -1.0, 1.0)  # as SB3 does in training
+        self.last_policy_action = action  # the policy's own action (look gate included), for analysis
         if self.features is not None:
             action = self.features.env_action(action)
         return action, state

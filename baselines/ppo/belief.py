@@ -15,6 +15,20 @@ target in the workspace. Gaze, fixation, head and grasp stay the policy's own. T
 policy learning (Silver et al. 2018, Johannink et al. 2019): the belief does the ballistic
 extrapolation, the policy learns where to look, when to grasp and how to correct the hand.
 
+With ``gaze_action="gated"`` (issue 15) it also appends where the belief's ball is on the retina
+(azimuth, elevation, rad) and the log angular std of that estimate (3 values), and the policy gets a
+tenth action value, the **look gate**, and a gaze block that is a *residual* (± ``gaze_residual_deg``):
+
+* gate > 0: the gaze request is the Eyecatch 4.1 request (the belief's ball at the next step, or where
+  it will be when a saccade lands when one can start) plus the residual: the plant turns the moving
+  request into pursuit and catch-up saccades;
+* gate <= 0 (the zero action): the request is the residual alone around the current line of sight
+  (0 holds gaze fixed in the world, as the gaze-blind twin does).
+
+So *how* to look at the believed ball is given by the structure; *whether and when* to look (the
+gate), the head, the residual gaze, grasp and the hand residual are the policy's. Before the filter
+has a sample, the gate does nothing (there is no believed ball to look at).
+
 The same object is used by the training wrapper and by the evaluation-time agent, so both see
 identical inputs and produce identical env actions.
 """
@@ -33,7 +47,10 @@ from visuomotor_gym.envs.observation import ObservationLayout
 
 N_BELIEF = 10
 N_INTERCEPT = 4
+N_GAZE = 3
 HAND_ACTIONS = ("absolute", "intercept")
+GAZE_ACTIONS = ("free", "gated")
+ENV_ACTION_DIM = 9
 _S = ObservationLayout().slices
 
 
@@ -44,22 +61,34 @@ class BeliefFeatures:
     policy action (residual hand block) to the env's action.
     """
 
-    def __init__(self, env_id: str, hand_action: str = "absolute", residual_m: float = 0.15):
+    def __init__(self, env_id: str, hand_action: str = "absolute", residual_m: float = 0.15,
+                 gaze_action: str = "free", gaze_residual_deg: float = 3.0):
         if hand_action not in HAND_ACTIONS:
             raise ValueError(f"hand_action must be one of {HAND_ACTIONS}, got {hand_action!r}")
         if not (math.isfinite(residual_m) and residual_m > 0):
             raise ValueError(f"residual_m must be a positive number of metres, got {residual_m!r}")
+        if gaze_action not in GAZE_ACTIONS:
+            raise ValueError(f"gaze_action must be one of {GAZE_ACTIONS}, got {gaze_action!r}")
+        if gaze_action == "gated" and hand_action != "intercept":
+            raise ValueError("gaze_action='gated' needs hand_action='intercept'")
+        if not (math.isfinite(gaze_residual_deg) and gaze_residual_deg >= 0):
+            raise ValueError(f"gaze_residual_deg must be a number of degrees >= 0, got {gaze_residual_deg!r}")
         # The Eyecatch agent owns the filter plumbing (delay, covariance from the prior, resets);
         # only its perception half and its interception geometry are used.
         self._agent = EyecatchAgent.for_env(env_id)
         self.hand_action = hand_action
         self.residual_m = float(residual_m)
-        self.size = N_BELIEF + (N_INTERCEPT if hand_action == "intercept" else 0)
+        self.gaze_action = gaze_action
+        self.gaze_residual = math.radians(float(gaze_residual_deg))
+        self.size = N_BELIEF + (N_INTERCEPT if hand_action == "intercept" else 0) + (N_GAZE if gaze_action == "gated" else 0)
+        # the policy's action: the env's 9 values, plus the look gate with gaze_action="gated"
+        self.action_dim = ENV_ACTION_DIM + (1 if gaze_action == "gated" else 0)
         self.reset()
 
     def reset(self) -> None:
         self._agent.reset()
         self.intercept_point = None  # world point the residual hand action is relative to
+        self.look_gaze = None  # (azimuth, elevation) rad of the gated gaze's look request; None: nothing to look at
 
     def __call__(self, obs: np.ndarray) -> np.ndarray:
         obs64 = np.asarray(obs, dtype=float)
@@ -78,6 +107,15 @@ class BeliefFeatures:
             self.intercept_point = point
             extra[N_BELIEF : N_BELIEF + 3] = point - SEAT_ORIGIN
             extra[N_BELIEF + 3] = seconds
+        if self.gaze_action == "gated":
+            k = N_BELIEF + N_INTERCEPT
+            self.look_gaze = self._look(obs64)
+            if self.look_gaze is not None:
+                extra[k : k + 2] = self.look_gaze
+                std = self._agent._retinal_std(self._agent.delay_steps * self._agent.dt)
+                extra[k + 2] = math.log(min(max(std, 1e-6), 10.0))
+            else:
+                extra[k + 2] = math.log(10.0)
         return np.concatenate([np.asarray(obs, dtype=np.float32), extra.astype(np.float32)])
 
     def _intercept(self, obs: np.ndarray) -> tuple[np.ndarray, float]:
@@ -89,15 +127,41 @@ class BeliefFeatures:
         point, seconds = agent._interception(eye, agent.delay_steps * agent.dt)
         return agent._within_reach(point), seconds
 
+    def _look(self, obs: np.ndarray) -> tuple[float, float] | None:
+        """The Eyecatch 4.1 gaze request toward the believed ball (retinal azimuth, elevation, rad):
+        the ball predicted at the next step (the plant pursues the request's motion), or, when a
+        saccade can start and the ball is beyond the saccade threshold, where it will be when the
+        saccade lands. None before the filter has a sample."""
+        agent, p = self._agent, self._agent.params
+        if not agent.filter.initialised:
+            return None
+        rot = obs[_S["eye_rot"]].reshape(3, 3)
+        eye = obs[_S["eye_pos"]] + SEAT_ORIGIN
+        delay = agent.delay_steps * agent.dt
+        to_ball = rot.T @ (agent.filter.extrapolate(delay)[0] - eye)
+        error = math.atan2(math.hypot(to_ball[1], to_ball[2]), to_ball[0])
+        in_saccade = obs[_S["saccade"]][0] > 0.5
+        ready = not in_saccade and obs[_S["saccade"]][1] >= p.saccade_refractory_s - 1e-9
+        lead = p.saccade_lead_s if (ready and error > p.saccade_threshold_deg * math.pi / 180.0) else agent.dt
+        return agent._retinal_angles(rot, eye, agent.filter.extrapolate(delay + lead)[0])
+
     def env_action(self, action: np.ndarray) -> np.ndarray:
-        """The env action for a policy action (identity unless ``hand_action="intercept"``)."""
+        """The env action (9 values) for a policy action (identity unless ``hand_action="intercept"``)."""
         if self.hand_action != "intercept":
             return action
         if self.intercept_point is None:
             raise RuntimeError("call the features on an observation before mapping an action")
-        out = np.array(action, dtype=np.float32, copy=True)
+        action = np.asarray(action)
+        if action.shape != (self.action_dim,):
+            raise ValueError(f"expected a policy action of shape ({self.action_dim},), got {action.shape}")
+        out = np.array(action[:ENV_ACTION_DIM], dtype=np.float32, copy=True)
         residual = np.clip(np.asarray(action[:3], dtype=float), -1.0, 1.0) * self.residual_m
         out[:3] = hand_target_action(self.intercept_point + residual)
+        if self.gaze_action == "gated":
+            gaze = np.clip(np.asarray(action[4:6], dtype=float), -1.0, 1.0) * self.gaze_residual
+            if float(action[ENV_ACTION_DIM]) > 0.0 and self.look_gaze is not None:
+                gaze = gaze + np.asarray(self.look_gaze)
+            out[4:6] = np.clip(gaze / self._agent.gaze_range, -1.0, 1.0)
         return out
 
 
@@ -106,11 +170,14 @@ class BeliefObservation(gym.Wrapper):
     ``hand_action="intercept"``, reading the hand block of actions as a residual around the belief's
     interception point)."""
 
-    def __init__(self, env: gym.Env, env_id: str, hand_action: str = "absolute", residual_m: float = 0.15):
+    def __init__(self, env: gym.Env, env_id: str, hand_action: str = "absolute", residual_m: float = 0.15,
+                 gaze_action: str = "free", gaze_residual_deg: float = 3.0):
         super().__init__(env)
-        self.features = BeliefFeatures(env_id, hand_action, residual_m)
+        self.features = BeliefFeatures(env_id, hand_action, residual_m, gaze_action, gaze_residual_deg)
         low = np.full(env.observation_space.shape[0] + self.features.size, -np.inf, dtype=np.float32)
         self.observation_space = gym.spaces.Box(low, -low, dtype=np.float32)
+        if self.features.action_dim != env.action_space.shape[0]:
+            self.action_space = gym.spaces.Box(-1.0, 1.0, (self.features.action_dim,), dtype=np.float32)
 
     def reset(self, **kwargs):
         self.features.reset()
@@ -128,10 +195,17 @@ class InterceptBase:
 
     It measures how much of a ``hand_action="intercept"`` policy's catch rate the structure alone
     gives (``vmgym bench --agent belief_intercept``).
+
+    With ``gaze_action="gated"`` it is the base of the gated-gaze structure: ``look=False`` (the
+    zero action: gate 0, gaze held) or ``look=True`` (gate on all the time: the Eyecatch 4.1 request
+    toward the believed ball from the first sample on); head straight ahead, grasp closed either way.
     """
 
-    def __init__(self, env_id: str, residual_m: float = 0.15):
-        self.features = BeliefFeatures(env_id, "intercept", residual_m)
+    def __init__(self, env_id: str, residual_m: float = 0.15, gaze_action: str = "free", look: bool = False,
+                 grasp: float = 1.0):
+        self.features = BeliefFeatures(env_id, "intercept", residual_m, gaze_action)
+        self.look = bool(look)
+        self.grasp = float(grasp)
 
     def reset(self) -> None:
         self.features.reset()
@@ -140,6 +214,8 @@ class InterceptBase:
         if episode_start is not None and bool(np.asarray(episode_start).reshape(-1)[0]):
             self.reset()
         self.features(observation)
-        action = np.zeros(9, dtype=np.float32)
-        action[3] = 1.0  # grasp closed
+        action = np.zeros(self.features.action_dim, dtype=np.float32)
+        action[3] = self.grasp  # grasp closed by default
+        if self.features.gaze_action == "gated" and self.look:
+            action[ENV_ACTION_DIM] = 1.0
         return self.features.env_action(action), state

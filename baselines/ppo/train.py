@@ -54,6 +54,9 @@ class Args:
     hand_action: str = ""
     """'absolute' (hand target anywhere in the workspace) or 'intercept' (residual around the
     belief's interception point); overrides the config"""
+    gaze_action: str = ""
+    """'free' (the gaze block is the policy's own) or 'gated' (a look gate: gate > 0 sends the eye to the
+    belief's ball, Eyecatch 4.1, plus a small gaze residual; needs hand_action=intercept); overrides the config"""
     hyperparams: str = ""
     """YAML file of hyperparameters (default: the packaged hyperparams.yml)"""
     set: list = field(default_factory=list)
@@ -125,8 +128,16 @@ def load_config(args: Args) -> dict:
         config["belief"] = args.belief.lower() in ("yes", "true", "1")
     if args.hand_action:
         config["hand_action"] = args.hand_action
+    if args.gaze_action:
+        config["gaze_action"] = args.gaze_action
     config.setdefault("hand_action", "absolute")
     config.setdefault("intercept_residual_m", 0.15)
+    config.setdefault("gaze_action", "free")
+    config.setdefault("gaze_residual_deg", 3.0)
+    if config["gaze_action"] not in ("free", "gated"):
+        raise SystemExit(f"gaze_action must be 'free' or 'gated', got {config['gaze_action']!r}")
+    if config["gaze_action"] == "gated" and config["hand_action"] != "intercept":
+        raise SystemExit("gaze_action=gated needs hand_action=intercept (and the belief features)")
     if config["hand_action"] not in ("absolute", "intercept"):
         raise SystemExit(f"hand_action must be 'absolute' or 'intercept', got {config['hand_action']!r}")
     if config["hand_action"] == "intercept" and not config["belief"]:
@@ -155,7 +166,8 @@ class InterceptShaping:
 
 
 def make_env_fn(env_id: str, env_kwargs: dict, belief: bool, seed: int, intercept_shaping: float = 0.0,
-                hand_action: str = "absolute", residual_m: float = 0.15):
+                hand_action: str = "absolute", residual_m: float = 0.15, gaze_action: str = "free",
+                gaze_residual_deg: float = 3.0):
     """A thunk for SB3's vec envs: the env, optional shaping and belief features (and the
     belief-relative hand action), a Monitor."""
 
@@ -171,7 +183,7 @@ def make_env_fn(env_id: str, env_kwargs: dict, belief: bool, seed: int, intercep
         if belief:
             from visuomotor_gym.baselines.ppo.belief import BeliefObservation
 
-            env = BeliefObservation(env, env_id, hand_action, residual_m)
+            env = BeliefObservation(env, env_id, hand_action, residual_m, gaze_action, gaze_residual_deg)
         env = Monitor(env, info_keywords=("is_success",))
         env.reset(seed=seed)
         return env
@@ -193,6 +205,9 @@ def run_meta(model, train_env, config: dict, args: Args, wall_s: float) -> dict:
         "train_wall_s": round(wall_s, 1),
         "seed": args.seed,
     }
+    if config.get("gaze_action", "free") != "free":  # old metas have no key: free gaze
+        meta["gaze_action"] = config["gaze_action"]
+        meta["gaze_residual_deg"] = float(config["gaze_residual_deg"])
     if isinstance(train_env, VecNormalize) and config["normalize_obs"]:
         meta["obs_mean"] = train_env.obs_rms.mean.tolist()
         meta["obs_var"] = train_env.obs_rms.var.tolist()
@@ -224,7 +239,8 @@ def main(argv=None) -> Path:
 
     # 1. Environments: shaped reward for training, the registered env for evaluation.
     n_envs = int(config["n_envs"])
-    hand = {"hand_action": config["hand_action"], "residual_m": float(config["intercept_residual_m"])}
+    hand = {"hand_action": config["hand_action"], "residual_m": float(config["intercept_residual_m"]),
+            "gaze_action": config["gaze_action"], "gaze_residual_deg": float(config["gaze_residual_deg"])}
     train_env = DummyVecEnv([make_env_fn(args.env, config["env_kwargs"], config["belief"], args.seed + i,
                                          float(config.get("intercept_shaping", 0.0)), **hand) for i in range(n_envs)])
     eval_env = DummyVecEnv([make_env_fn(args.env, {}, config["belief"], 10_000 + args.seed, **hand)])
