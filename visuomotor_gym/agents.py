@@ -305,6 +305,12 @@ def _eyecatch(env_id, action_dim, seed, **kw):
 
 
 def _belief_mpc(env_id, action_dim, seed, **kw):
+    from visuomotor_gym.registration import family_of
+
+    if family_of(env_id) == "stones":  # Eom's belief MPC over the next footholds (issue 13)
+        from visuomotor_gym.baselines.belief_mpc.stones import StonesBeliefMPCAgent
+
+        return StonesBeliefMPCAgent.for_env(env_id, **kw)  # for_env gives it the env's VisionParams
     from visuomotor_gym.baselines.belief_mpc import BeliefMPCAgent
 
     return _with_env_vision(BeliefMPCAgent.for_env(env_id, **kw), env_id, kw)
