@@ -98,10 +98,17 @@ def plane_variance(distance, eccentricity, slip, depression_sin, vision: VisionP
 @dataclass(frozen=True)
 class ScheduleSet:
     """Every fixation schedule of one planning problem: ``targets`` (C, N) the stone (index into the
-    candidate list) fixated in each node, ``switch`` (C, N) whether a saccade starts in that node."""
+    candidate list) fixated in each node, ``switch`` (C, N) whether a saccade starts in that node; and
+    the flat indices the vectorised rollout gathers with (``rows`` (N, C): node k's row ``k m + target``
+    of an (N m, J) table; the switches' node, schedule, previous and new stone)."""
 
     targets: np.ndarray
     switch: np.ndarray
+    rows: np.ndarray
+    sw_node: np.ndarray
+    sw_sched: np.ndarray
+    sw_prev: np.ndarray
+    sw_new: np.ndarray
 
 
 @functools.lru_cache(maxsize=256)
@@ -130,7 +137,16 @@ def schedules(m: int, n: int, current: int, earliest: int, gap: int, max_switche
         if first_switch and current >= 0 and earliest > 0:
             continue
         extend([a], [first_switch], 0 if first_switch else -gap, max_switches)
-    return ScheduleSet(np.array(rows, dtype=np.int64), np.array(sw, dtype=bool))
+    T = np.array(rows, dtype=np.int64)
+    SW = np.array(sw, dtype=bool)
+    prev = np.empty_like(T)
+    prev[:, 1:] = T[:, :-1]
+    prev[:, 0] = current
+    c_idx, k_idx = np.nonzero(SW)
+    flat = (np.arange(n)[:, None] * m + T.T).copy()  # (N, C)
+    for a in (T, SW, flat, c_idx, k_idx):
+        a.setflags(write=False)
+    return ScheduleSet(T, SW, flat, k_idx, c_idx, prev[c_idx, k_idx], T[c_idx, k_idx])
 
 
 def saccade_duration_s(amplitude_rad):
@@ -176,47 +192,50 @@ def plan_gaze(stones_xy: np.ndarray, sp0: np.ndarray, eye0: np.ndarray, eye_vel:
     slip = np.linalg.norm(du[:, None, :, :] - du[:, :, None, :], axis=3)  # (N, F, J)
     dep = -u[..., 2]
     r = plane_variance(d[:, None, :], theta, slip, dep[:, None, :], vision)  # (N, F, J)
-    # saccade blindness in a switch node: the amplitude from the previous stone (or the gaze now)
-    amp_ff = theta  # (N, F_prev, F_new)
+    # saccade blindness in a switch node: the amplitude from the previous stone (theta) or the gaze now
     amp_0 = np.arccos(np.clip(u[0] @ gaze0, -1.0, 1.0))  # (M,) from the gaze now
     per_node = max(1, int(round(h / dt)))
 
     earliest = int(math.ceil(max(earliest_s, 0.0) / h - 1e-9))
     gap = max(1, int(math.ceil(refractory_s / h - 1e-9)))
     S = schedules(m, n, current, earliest, gap, max_switches)
-    T, SW = S.targets, S.switch
-    C = T.shape[0]
-    prev = np.empty_like(T)
-    prev[:, 1:] = T[:, :-1]
-    prev[:, 0] = current
-    node_idx = np.broadcast_to(np.arange(n), T.shape)
-    amp = np.where(prev >= 0, amp_ff[node_idx, np.maximum(prev, 0), T], amp_0[T])
-    blind = np.where(SW, np.ceil(saccade_duration_s(amp) / dt - 1e-9), 0.0)
-    samples = np.maximum(per_node - blind, 0.0)  # (C, N)
-    R = r[node_idx, T]  # (C, N, J)
-    info = samples[..., None] / R  # (C, N, J); 0 where not seen
+    C = S.targets.shape[0]
+    # samples per node: all of them, less the saccade's blindness in a switch node
+    samples = np.full((n, C), float(per_node))
+    if S.sw_node.size:
+        k, prev, new = S.sw_node, S.sw_prev, S.sw_new
+        amp = np.where(prev >= 0, theta[k, np.maximum(prev, 0), new], amp_0[new])
+        blind = np.ceil(saccade_duration_s(amp) / dt - 1e-9)
+        samples[k, S.sw_sched] = np.maximum(per_node - blind, 0.0)
+    inv_r = (1.0 / r).reshape(n * m, m)  # 0 where not seen
+    info = np.take(inv_r, S.rows, axis=0)  # (N, C, J)
+    info *= samples[..., None]
 
     # nodes whose samples count before each commitment (a node that has begun counts: 0.1 s resolution)
     commit_node = np.where(np.isfinite(commit_s), np.ceil(np.asarray(commit_s) / h - 1e-9), np.inf)
-    sp = np.broadcast_to(np.asarray(sp0, dtype=float), (C, m)).copy()
+    sp = np.empty((C, m))
+    sp[:] = np.asarray(sp0, dtype=float)
     cost = np.zeros(C)
+    tmp = np.empty((C, m))
     for k in range(n):
-        live = commit_node > k  # stones still to be committed during node k
-        a = sp + q_node
-        sp = a / (1.0 + a * info[:, k, :])
-        cost += w_uct * np.sum(np.where(live, sp * sp, 0.0), axis=1)
+        live = np.where(commit_node > k, w_uct, 0.0)  # stones still to be committed during node k
+        sp += q_node
+        np.multiply(sp, info[k], out=tmp)
+        tmp += 1.0
+        sp /= tmp
+        cost += (sp * sp) @ live
         at = commit_node == k + 1
-        if np.any(at):
-            cost += w_tsk * 2.0 * np.sum(np.where(at, sp, 0.0), axis=1)
+        if at.any():
+            cost += sp @ np.where(at, 2.0 * w_tsk, 0.0)
     best = int(np.argmin(cost))
     # the chosen schedule's covariance, for the log
     traj = np.empty((n + 1, m))
     s = np.asarray(sp0, dtype=float).copy()
     traj[0] = s
     for k in range(n):
-        s = (s + q_node) / (1.0 + (s + q_node) * info[best, k])
+        s = (s + q_node) / (1.0 + (s + q_node) * info[k, best])
         traj[k + 1] = s
-    return GazePlan(targets=T[best], cost=float(cost[best]), costs=cost, schedule_set=S, sp=traj)
+    return GazePlan(targets=S.targets[best], cost=float(cost[best]), costs=cost, schedule_set=S, sp=traj)
 
 
 __all__ = ["GazePlan", "ScheduleSet", "plan_gaze", "plane_variance", "saccade_duration_s", "schedules",
