@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, fields, replace
+from dataclasses import asdict, dataclass, fields, replace
 
 import numpy as np
 
@@ -93,6 +93,30 @@ class StonesBeliefMPCParams(LookaheadParams):
             raise ValueError(f"n_tracked must be in [1, {K_SLOTS}] and max_switches a whole number")
 
 
+def stones_vision(env_id: str) -> VisionParams:
+    """The ``VisionParams`` of a registered stones env's eye, as the env builds them: the walk family's
+    defaults (``WALK_VISION``: the 20 deg field) under the id's ``vision_params`` fields, scaled by its
+    noise scale, unfoveated off the foveated rung. (``registration.env_vision_params`` starts from
+    the catch family's 60 deg field; the planner's ``r`` needs the real field.)"""
+    import gymnasium as gym
+
+    from visuomotor_gym.envs.walk import WALK_VISION
+
+    kw = gym.spec(env_id).kwargs or {}
+    given = kw.get("vision_params")
+    if isinstance(given, VisionParams):
+        params = given
+    else:
+        params = VisionParams(**{**asdict(WALK_VISION), **(given or {})})
+    mode = kw.get("vision", "foveated")
+    params = params.scaled(0.0 if mode == "oracle" else float(kw.get("vision_noise_scale", 1.0)))
+    if mode != "foveated":
+        params = replace(params, foveated=False)
+    ref = env_vision_params(env_id)  # every other constant as the registry gives it
+    assert (ref.noise_scale, ref.foveated) == (params.noise_scale, params.foveated)
+    return params
+
+
 class StonesBeliefMPCAgent(LookaheadAgent):
     """See the module docstring. ``predict(obs) -> (action, state)`` on flat SteppingStones observations."""
 
@@ -112,7 +136,7 @@ class StonesBeliefMPCAgent(LookaheadAgent):
         unknown = sorted(set(overrides) - known)
         if unknown:
             raise TypeError(f"unknown belief_mpc parameter(s) for the stones family {unknown}; known: {sorted(known)}")
-        return cls(replace(base, **overrides), vision=env_vision_params(env_id))
+        return cls(replace(base, **overrides), vision=stones_vision(env_id))
 
     def reset(self) -> None:
         super().reset()

@@ -1,0 +1,157 @@
+"""belief_mpc on SteppingStones-v0 (issue 13): Eom's static-object belief, the gaze plan, a real episode."""
+
+from __future__ import annotations
+
+import math
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import visuomotor_gym  # noqa: F401
+from visuomotor_gym.agents import make_agent
+from visuomotor_gym.baselines.belief_mpc.belief import covariance_step
+from visuomotor_gym.baselines.belief_mpc.stone_belief import plan_gaze, plane_variance, schedules, static_sigma_step
+from visuomotor_gym.baselines.belief_mpc.stones import StonesBeliefMPCAgent, StonesBeliefMPCParams
+from visuomotor_gym.vision.foveation import DEG, VisionParams
+
+ENV = "SteppingStones-v0"
+VISION = VisionParams(field_of_view_deg=20.0)  # the walk family's field
+
+
+# --- the belief ---------------------------------------------------------------------------------
+def test_static_sigma_step_is_the_scalar_kalman_update_and_eoms_eq4_with_h_0():
+    sp, q = 0.02, 1e-4
+    for r in (1e-6, 1e-3, 0.5):
+        a = sp + q
+        expected = a * r / (a + r)  # scalar Kalman: prior a, measurement variance r
+        assert static_sigma_step(sp, r, q) == pytest.approx(expected, rel=1e-12)
+        eom = covariance_step(np.array([sp, 0.0, 0.0]), np.array(r), 0.0, q)  # Appendix A, F = I
+        assert eom[0] == pytest.approx(expected, rel=1e-12) and eom[2] == 0.0
+    assert static_sigma_step(sp, math.inf, q) == pytest.approx(sp + q)  # not seen: prediction only
+
+
+def test_covariance_shrinks_with_foveal_samples_and_stays_large_in_the_periphery():
+    d, dep, slip = 2.5, 0.6, 0.0
+    fovea = float(plane_variance(d, 0.0, slip, dep, VISION))
+    periph = float(plane_variance(d, 12 * DEG, slip, dep, VISION))
+    outside = float(plane_variance(d, 25 * DEG, slip, dep, VISION))
+    assert fovea < periph / 20.0 and math.isinf(outside)
+    sp_f = sp_p = sp_o = 0.03
+    for _ in range(10):
+        sp_f = static_sigma_step(sp_f, fovea, 0.0)
+        sp_p = static_sigma_step(sp_p, periph, 0.0)
+        sp_o = static_sigma_step(sp_o, outside, 0.0)
+    # information adds up: 1/sp_n = 1/sp_0 + n/r
+    assert 1.0 / sp_f == pytest.approx(1.0 / 0.03 + 10.0 / fovea, rel=1e-9)
+    assert sp_f < sp_p < sp_o == 0.03
+    # retinal slip blurs (the env's lateral std x slip / knee above 2.5 deg/s)
+    assert float(plane_variance(d, 0.0, 40 * DEG, dep, VISION)) > 50 * fovea
+
+
+# --- the gaze plan ------------------------------------------------------------------------------
+# far apart sideways (> 20 deg between any two, seen from the eye): a stone is seen only when fixated
+STONES = np.array([[2.2, 1.2], [3.35, -1.0], [4.6, 0.8]])
+EYE = np.array([1.0, 0.0, 1.6])
+VEL = np.array([1.3, 0.0, 0.0])
+GAZE = np.array([0.75, 0.0, -0.66]) / np.linalg.norm([0.75, 0.0, -0.66])
+
+
+def _plan(sp0, commit, current=-1):
+    return plan_gaze(STONES, np.asarray(sp0, float), EYE, VEL, GAZE, np.asarray(commit, float), current, 0.0, VISION,
+                     h=0.1, n=12, dt=0.02, q_node=9e-5, w_uct=1.0, w_tsk=10.0, plane_z=-0.005, refractory_s=0.2)
+
+
+@pytest.mark.parametrize("most", [0, 1, 2])
+def test_gaze_goes_to_the_most_uncertain_stone(most):
+    sp0 = np.full(3, 1e-4)
+    sp0[most] = 2e-2
+    plan = _plan(sp0, [np.inf] * 3)
+    assert plan.targets[0] == most
+    assert plan.sp[-1, most] < 1e-3  # the plan shrinks it
+
+
+def test_the_stones_of_the_gaze_test_are_outside_each_others_field():
+    for t in np.linspace(0.0, 1.2, 7):  # the eye walks on through the window
+        eye = EYE + t * VEL
+        rel = np.column_stack([STONES - eye[:2], np.full(3, -0.005 - eye[2])])
+        u = rel / np.linalg.norm(rel, axis=1)[:, None]
+        ang = np.degrees(np.arccos(np.clip(u @ u.T, -1, 1)))
+        assert ang[np.triu_indices(3, 1)].min() > 20.0
+
+
+def test_a_gaze_that_sees_two_stones_can_beat_fixating_the_uncertain_one():
+    """Eom's summed uncertainty: with two stones 11 deg apart, fixating the near-certain far one
+    keeps the uncertain near one in the periphery, and both shrink (not a rule: the cost decides)."""
+    stones = np.array([[2.6, 0.1], [3.35, -0.1]])
+    plan = plan_gaze(stones, np.array([2e-2, 1e-4]), EYE, VEL, GAZE, np.array([np.inf, np.inf]), -1, 0.0, VISION,
+                     h=0.1, n=12, dt=0.02, q_node=9e-5, w_uct=1.0, w_tsk=10.0, plane_z=-0.005, refractory_s=0.2)
+    assert plan.sp[-1, 0] < 1e-3 and plan.sp[-1, 1] < 1e-3
+
+
+def test_a_soon_committed_stone_wins_over_an_equally_uncertain_later_one():
+    sp0 = [1e-3, 1e-3, 1e-3]
+    assert _plan(sp0, [np.inf, 0.3, np.inf]).targets[0] == 1
+    assert _plan(sp0, [np.inf, np.inf, 0.3]).targets[0] == 2
+    # a committed foothold's stone leaves the cost: its uncertainty after the commitment changes nothing
+    late = _plan(sp0, [0.05, np.inf, np.inf])
+    assert late.targets[0] != 0
+
+
+def test_schedules_respect_the_saccade_refractory_period():
+    S = schedules(3, 12, 0, 2, 2, 2)
+    for row, sw in zip(S.targets, S.switch):
+        ks = np.flatnonzero(sw)
+        assert row[0] == 0 and (ks.size == 0 or ks[0] >= 2)  # the plant cannot start one before node 2
+        assert np.all(np.diff(ks) >= 2) and ks.size <= 2
+        changes = np.flatnonzero(np.diff(row)) + 1
+        assert np.array_equal(changes, ks)
+
+
+# --- the agent on the env -----------------------------------------------------------------------
+def _run(spec, seed, steps):
+    env = gym.make(ENV)
+    agent = make_agent(spec, ENV, env.action_space.shape[0], seed=seed)
+    obs, _ = env.reset(seed=seed)
+    actions, info = [], {}
+    for _ in range(steps):
+        a, _ = agent.predict(obs)
+        actions.append(np.asarray(a).copy())
+        obs, _, term, trunc, info = env.step(a)
+        if term or trunc:
+            break
+    env.close()
+    return agent, np.array(actions), info
+
+
+def test_dispatch_on_the_family():
+    env = gym.make(ENV)
+    agent = make_agent("belief_mpc", ENV, env.action_space.shape[0])
+    env.close()
+    assert isinstance(agent, StonesBeliefMPCAgent)
+    assert agent.vision.field_of_view_deg == 20.0  # the env's own vision constants
+    with pytest.raises(TypeError):
+        make_agent("belief_mpc:no_such=1", ENV, 8)
+    assert make_agent("belief_mpc:w_tsk=0", ENV, 8).params.w_tsk == 0.0
+    with pytest.raises(ValueError):
+        StonesBeliefMPCParams(window_s=0.1)
+
+
+def test_short_episode_looks_down_lands_on_stones_and_shrinks_the_belief():
+    agent, actions, info = _run("belief_mpc", 3, 200)  # 4 s: the slab and the first stones
+    assert not info["fell"] and info["stones_landed"] >= 2
+    assert np.all(np.abs(actions) <= 1.0)
+    assert np.any(actions[:, 4] < -0.05)  # the eye is sent down toward the stones
+    fixated = {e["fixate"] for e in agent.plan_log}
+    assert len(fixated) >= 4
+    for i in range(4):  # every stone looked at: its compact covariance far below the course prior
+        assert agent.sigma[i] < agent.params.prior_var_m2 / 20.0
+    assert max(agent.solve_ms) < 1e3
+
+
+def test_determinism_and_the_gaze_blind_twin():
+    _, a1, _ = _run("belief_mpc", 5, 80)
+    _, a2, _ = _run("belief_mpc", 5, 80)
+    assert np.array_equal(a1, a2)
+    _, b, _ = _run("gaze_blind:belief_mpc", 5, 80)
+    assert np.all(b[:, 3:5] == 0.0) and np.all(b[:, 6:8] == 0.0)
