@@ -34,11 +34,15 @@ numbers to catching is our **modelling choice** (no human hand-path data for cat
 Per episode (:func:`catch_hand_path_measures`, NaN where undefined): the distance to Faraway's path
 (max at equal relative arc length, scaled to the paper's 56.7 cm median reach), the curvature index (0 =
 straight, 1 = Faraway's mean curvature), the peak catch-site speed in the segment and its relative time,
-and the gaze-hand lead: the hand's arrival minus the first time the line of sight came within
-``GAZE_ON_TARGET_DEG`` of the interception point (the reach family's definition with the object replaced
-by where the hand goes; positive = the eye was there first). Undefined when the hand never moves, when
-the trace has no hand or ball path (two-ball traces are not measured: their episode holds two catches),
-or when the transport is shorter than ``MIN_REACH_M`` or than 2 control steps.
+the transport's length (start to end), and the gaze-hand lead: the hand's arrival minus the first time,
+before the catch / closest approach, that the line of sight came within ``GAZE_ON_TARGET_DEG`` of the
+interception point. That is the reach family's definition with the object replaced by where the hand
+goes (gaze leads the hand to where it will act: Land et al. 1999, Johansson et al. 2001, for reaching);
+positive = the eye was there first. It is undefined for a catcher that only tracks the ball, so
+``gaze_ahead_share`` (1 when the gaze reached the interception point before the hand did, else 0) says
+in how many transports it happened. Nothing is measured when the hand never moves, when the trace has no
+finite hand or ball path, for two-ball ids (an episode holds two catches and its trace records only the
+first ball), or when the transport is shorter than ``MIN_REACH_M`` or than 2 control steps.
 
 Per set (:func:`catch_hand_path`): medians over the episodes that define each component (as the reach
 family: only medians over many reaches separate straight from human-like paths), scored with
