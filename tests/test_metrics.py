@@ -514,7 +514,7 @@ def transport_trace(path_kind: str, catch_point, *, start=0.2, duration=0.6, cau
 
     t = np.round(np.arange(0.0, FLIGHT + 1e-9, DT), 10)
     end = np.asarray(catch_point, dtype=float)
-    k0, k1 = int(round(start / DT)), int(round((start + duration) / DT))
+    k0, k1 = round(start / DT), round((start + duration) / DT)
     n = k1 - k0 + 1
     if path_kind == "faraway":
         move = handpath.faraway_path(HAND_REST, end, n)
@@ -536,8 +536,8 @@ def catch_paths(kind, **kw):
 
 
 def test_catch_hand_path_of_faraway_transports_is_human_like():
-    from visuomotor_gym.metrics import catch_handpath as C
     from visuomotor_gym import handpath
+    from visuomotor_gym.metrics import catch_handpath as C
 
     out = C.catch_hand_path(catch_paths("faraway"))
     comps = out["components"]
@@ -656,6 +656,7 @@ def test_catch_hand_path_reference_is_sourced_and_leaves_gaze_realism_alone():
 
 def test_catch_hand_path_in_the_results_of_a_simulated_run():
     from visuomotor_gym.bench.evaluate import evaluate
+    from visuomotor_gym.bench.commands import summary_rows
     from visuomotor_gym.bench.results import ResultsError, build_results, validate_results
 
     res = evaluate("eyecatch", "EyeCatch-v0", episodes=2, seed=0)
@@ -665,6 +666,8 @@ def test_catch_hand_path_in_the_results_of_a_simulated_run():
     assert hp == M.to_json_safe(res.summary["hand_path"])
     again = evaluate("eyecatch", "EyeCatch-v0", episodes=2, seed=0)
     assert again.summary["hand_path"] == res.summary["hand_path"]  # deterministic
+    rows = dict(summary_rows(obj))  # what vmgym bench prints
+    assert rows["hand path"].startswith(hp["verdict"]) and "gaze_hand_lead_s" in "".join(rows)
     bad = json.loads(json.dumps(obj))
     bad["hand_path"]["verdict"] = "great"
     with pytest.raises(ResultsError, match="hand_path"):

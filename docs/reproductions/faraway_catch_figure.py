@@ -17,13 +17,13 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
 
-from visuomotor_gym import handpath  # noqa: E402
-from visuomotor_gym.bench.trace import load_traces  # noqa: E402
-from visuomotor_gym.geometry import angles_deg  # noqa: E402
-from visuomotor_gym.metrics import catch_handpath as C  # noqa: E402
+from visuomotor_gym import handpath
+from visuomotor_gym.bench.trace import load_traces
+from visuomotor_gym.geometry import angles_deg
+from visuomotor_gym.metrics import catch_handpath as C
 
 OUT = Path(__file__).parent / "images" / "faraway_catch_paths.png"
 

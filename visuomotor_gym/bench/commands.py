@@ -98,8 +98,8 @@ def summary_rows(results: dict) -> list[tuple[str, str]]:
         rows.append((f"  {name}", f"score {_fmt(comp.get('score'))}  (value {_fmt(comp.get('value'))})"))
     hand_path = results.get("hand_path")
     if hand_path:  # single-ball catch ids (metrics.catch_handpath): beside the gaze realism, not in it
-        rows.append(("hand path", f"{hand_path['verdict'] or 'n/a'}  score {_fmt(hand_path['score'])}  "
-                                  f"({hand_path['episodes']} transports vs Faraway's reach model)"))
+        verdict = f"{hand_path['verdict'] or 'n/a'}  score {_fmt(hand_path['score'])}  "
+        rows.append(("hand path", verdict + f"({hand_path['episodes']} transports vs Faraway's reach model)"))
         for name, comp in hand_path["components"].items():
             score = "not scored" if comp.get("score") is None else f"score {_fmt(comp['score'])}"
             rows.append((f"  {name}", f"{score}  (value {_fmt(comp.get('value'))})"))
