@@ -23,6 +23,7 @@ from visuomotor_gym.baselines.belief_mpc.model import GazeBeliefProblem, HandPro
 from visuomotor_gym.baselines.belief_mpc.sequential import SequentialEyecatch
 from visuomotor_gym.baselines.eyecatch import EyecatchAgent
 from visuomotor_gym.bench.evaluate import evaluate, make_env
+from visuomotor_gym.registration import POOR_VISION_SCALE
 from visuomotor_gym.vision.foveation import DEG, VisionParams
 
 NOISE = ObservationNoise.from_vision(VisionParams())
@@ -350,7 +351,7 @@ def test_params_overrides_and_validation():
     agent = make_agent("belief_mpc:alpha=0.4,window_s=1.0,gaze_cost=distance", "EyeCatch-v0", 9)
     assert isinstance(agent, BeliefMPCAgent)
     assert agent.params.alpha == 0.4 and agent.N == 25 and agent.params.gaze_cost == "distance"
-    assert make_agent("belief_mpc", "EyeCatchPoorVision-v0", 9).params.vision_noise_scale == 10.0
+    assert make_agent("belief_mpc", "EyeCatchPoorVision-v0", 9).params.vision_noise_scale == POOR_VISION_SCALE == 2.0
     with pytest.raises(TypeError, match="unknown belief_mpc parameter"):
         BeliefMPCAgent.for_env("EyeCatch-v0", nope=1)
     with pytest.raises(ValueError, match="gaze_cost"):

@@ -10,6 +10,7 @@ from visuomotor_gym.agents import make_agent
 from visuomotor_gym.baselines.eyecatch import BallKalmanFilter, EyecatchAgent, EyecatchParams, KalmanParams
 from visuomotor_gym.baselines.eyecatch.agent import _Superposition
 from visuomotor_gym.bench.trace import run_episode
+from visuomotor_gym.registration import POOR_VISION_SCALE
 from visuomotor_gym.vision import foveation
 from visuomotor_gym.vision.foveation import VisionParams
 
@@ -130,7 +131,8 @@ def test_parameters_are_named_and_validated():
 
 
 def test_for_env_matches_the_vision_of_the_env():
-    assert EyecatchAgent.for_env("EyeCatchPoorVision-v0").vision.noise_scale == 10.0
+    assert EyecatchAgent.for_env("EyeCatchPoorVision-v0").vision.noise_scale == POOR_VISION_SCALE == 2.0
+    assert EyecatchAgent.for_env("EyeCatchPaperPoorVision-v0").vision.noise_scale == 10.0
     assert EyecatchAgent.for_env("EyeCatchFullView-v0").vision.foveated is False
     assert EyecatchAgent.for_env("EyeCatchDelayed-v0").delay_steps == 5
     assert EyecatchAgent.for_env("EyeCatchOracle-v0").vision.noise_scale == 0.0
