@@ -405,6 +405,13 @@ def test_23_forged_gaze_realism_and_success(monkeypatch, pr):
     refused(check(pr), "rescore", "do not match their 6 re-scored episodes", "gaze_realism.score: results 0.99")
 
 
+def test_23b_forged_hand_path(monkeypatch, pr):
+    key = honest_new_entry(monkeypatch, pr, agent="eyecatch", name="straight")
+    assert "hand_path" in read(paths(pr, key)[0]), "a catch entry's results carry the hand-path block"
+    edit_results(pr, key, lambda o: o["hand_path"].update(verdict="human-like", score=0.99))
+    refused(check(pr), "rescore", "do not match their 6 re-scored episodes", "hand_path.score: results 0.99")
+
+
 def test_24_superseded_listing_removed_or_changed(pr, tmp_path):
     """On the committed leaderboard: superseded.json is append-only."""
     root = tmp_path / "repo"

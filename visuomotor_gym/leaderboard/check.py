@@ -77,6 +77,7 @@ RECOMPUTED_FIELDS = (
     "reaction_times_s",
     "miss_distance_m",
     "time_to_catch_s",
+    "hand_path",
 )
 
 
@@ -551,6 +552,8 @@ def summary_problems(lb: Leaderboard, entry: Entry, traces: list) -> list[Proble
     for key in RECOMPUTED_FIELDS:
         if key not in r and key.startswith("success_rate"):
             continue  # results written before success_rate existed: catch_rate (compared) is the success
+        if key == "hand_path" and key not in r:
+            continue  # optional (results written before it existed); when claimed it must be what re-scoring gives
         diffs += _differences(key, r.get(key), fresh[key], tol)
     steps = sum(int(t.steps) for t in traces)
     if r["run"]["env_steps"] != steps:
