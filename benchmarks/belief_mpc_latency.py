@@ -13,6 +13,10 @@ control step on one CPU core. This script
    derivatives, backward pass, forward line search and cost evaluation, the hand iLQR, execution).
 
     python benchmarks/belief_mpc_latency.py [--env EyeCatch-v0] [--episodes 20] [--agent belief_mpc] [--json out.json]
+
+On a stones env (``--env SteppingStones-v0``) ``belief_mpc`` is the stones agent
+(``baselines/belief_mpc/stones.py``: it plans the gaze every step; its clock's parts are perception,
+footsteps, plan, execution) and ``caught`` counts successful crossings.
 """
 
 from __future__ import annotations
