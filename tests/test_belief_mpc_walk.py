@@ -49,6 +49,13 @@ def test_covariance_shrinks_with_foveal_samples_and_stays_large_in_the_periphery
     assert float(plane_variance(d, 0.0, 40 * DEG, dep, VISION)) > 50 * fovea
 
 
+def test_unfoveated_vision_sees_everywhere_with_the_full_shape():
+    flat = VisionParams(foveated=False)
+    r = plane_variance(np.full((3, 1, 2), 2.0), np.full((3, 2, 2), 0.7), np.zeros((3, 2, 2)), np.full((3, 1, 2), 0.6), flat)
+    assert r.shape == (3, 2, 2) and np.all(np.isfinite(r))
+    assert np.allclose(r, float(plane_variance(2.0, 0.0, 0.0, 0.6, flat)))
+
+
 # --- the gaze plan ------------------------------------------------------------------------------
 # far apart sideways (> 20 deg between any two, seen from the eye): a stone is seen only when fixated
 STONES = np.array([[2.2, 1.2], [3.35, -1.0], [4.6, 0.8]])

@@ -92,7 +92,8 @@ def plane_variance(distance, eccentricity, slip, depression_sin, vision: VisionP
     r = 0.5 * s * s * (1.0 + 1.0 / (dep * dep)) + FLOOR_M2
     if vision.foveated:
         r = np.where(th <= vision.field_of_view_deg * DEG, r, np.inf)
-    return r
+    shape = np.broadcast_shapes(d.shape, th.shape, np.shape(slip), np.shape(depression_sin))
+    return np.broadcast_to(r, shape).copy() if np.shape(r) != shape else r
 
 
 @dataclass(frozen=True)
