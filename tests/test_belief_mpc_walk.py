@@ -162,3 +162,32 @@ def test_determinism_and_the_gaze_blind_twin():
     assert np.array_equal(a1, a2)
     _, b, _ = _run("gaze_blind:belief_mpc", 5, 80)
     assert np.all(b[:, 3:5] == 0.0) and np.all(b[:, 6:8] == 0.0)
+
+
+# --- ObstacleDodge-v0 (experimental) -----------------------------------------------------------
+def test_dodge_compact_step_in_information_form_is_eoms_eq4():
+    from visuomotor_gym.baselines.belief_mpc.dodge import compact_step_information
+
+    sig = np.array([[0.3, 0.5, 0.1], [2.0, 1.0, -0.2]])
+    for r in (np.array([1e-3, 0.7]), np.array([np.inf, 0.05])):
+        ref = covariance_step(sig, r, 0.1, 0.05)
+        sp, sv, spv = compact_step_information(sig[:, 0], sig[:, 1], sig[:, 2], 1.0 / r, 0.1, 0.05)
+        assert np.allclose(np.stack([sp, sv, spv], axis=1), ref, rtol=1e-12, atol=0)
+
+
+def test_dodge_dispatch_and_a_short_episode():
+    from visuomotor_gym.baselines.belief_mpc.dodge import DodgeBeliefMPCAgent
+
+    env = gym.make("ObstacleDodge-v0")
+    agent = make_agent("belief_mpc", "ObstacleDodge-v0", env.action_space.shape[0])
+    assert isinstance(agent, DodgeBeliefMPCAgent) and agent.plan_vision.field_of_view_deg == 20.0
+    obs, _ = env.reset(seed=1)
+    for _ in range(120):
+        a, _ = agent.predict(obs)
+        assert np.all(np.isfinite(a)) and np.all(np.abs(a) <= 1.0)
+        obs, _, term, trunc, info = env.step(a)
+        if term or trunc:
+            break
+    env.close()
+    kinds = {e["target"][0] for e in agent.plan_log}
+    assert "search" in kinds  # pedestrians not seen yet are searched for, as the uncertainty term asks

@@ -311,6 +311,10 @@ def _belief_mpc(env_id, action_dim, seed, **kw):
         from visuomotor_gym.baselines.belief_mpc.stones import StonesBeliefMPCAgent
 
         return StonesBeliefMPCAgent.for_env(env_id, **kw)  # for_env gives it the env's VisionParams
+    if family_of(env_id) == "dodge":  # experimental: Eom's uncertainty term on fajen_warren's locomotion
+        from visuomotor_gym.baselines.belief_mpc.dodge import DodgeBeliefMPCAgent
+
+        return DodgeBeliefMPCAgent.for_env(env_id, **kw)
     from visuomotor_gym.baselines.belief_mpc import BeliefMPCAgent
 
     return _with_env_vision(BeliefMPCAgent.for_env(env_id, **kw), env_id, kw)

@@ -1,0 +1,221 @@
+"""``belief_mpc`` on ObstacleDodge-v0 (experimental): Eom's uncertainty term chooses which pedestrian to look at.
+
+Eom et al. 2019 section 7, "Moving obstacle avoidance": the four obstacles closest to the character are
+tracked, their belief states enter the trajectory optimisation, and the gaze comes from the uncertainty
+term (the task term ``sum_j exp(-|p_root - p_j| / s_j^2)`` steers the body; with ``s_j`` the obstacle's
+radius, 0.25 m here, it is ~1e-7 at 1 m and does not pull the gaze). This agent keeps the
+``fajen_warren`` agent's perception (one constant-velocity Kalman filter per pedestrian) and locomotion
+(Fajen & Warren's steering dynamics and its evasive course/speed choice, as they are in
+``baselines/fajen_warren``), and replaces its gaze rule with a receding-horizon plan:
+
+* **Belief** (Eom section 4.3): per pedestrian the compact covariance ``sigma = (sp, sv, spv)`` of its
+  ground position and velocity, projected from the filter's 4x4 covariance at the plan's start (block
+  traces / 2, as ``belief.compact_from_covariance`` in 3-D), propagated over the window with Eom Eq. 4
+  (:func:`.belief.covariance_step`, ``h`` = the node spacing, ``Q = alpha I``) with the observation noise
+  of the catch agent (:func:`.belief.observation_variance`: the env's foveated model, the mean of the three
+  positional variances, retinal slip), ``r = inf`` beyond the 20 deg field; the means follow the filters'
+  constant velocity (Eom section 6's deterministic mean update), the eye the walker's present velocity.
+* **Not yet seen pedestrians** (no belief in Eom, who track perceived objects only): each of the
+  ``fajen_warren`` agent's search directions (40 and 70 deg to either side, 6 m away, where crossing
+  pedestrians appear) is a pseudo-object with a vague prior (``search_prior_var``), whose compact
+  covariance is reduced by looking there as if a pedestrian stood there and grows again with ``alpha``
+  (modelling choice: so that the uncertainty term also asks for the search).
+* **Plan**: piecewise-constant fixation schedules over ``window_s`` (0.1 s nodes, <= 2 switches >= 0.2 s
+  apart, a switch blind for the saccade's duration) among at most 4 objects (the closest known
+  pedestrians first, then the most uncertain search directions), the one minimising
+  ``sum_k sum_j w_uct |sigma_j(k)|^2`` (Eom's c_uct) is executed through ``fajen_warren``'s gaze request.
+
+Every other constant is ``fajen_warren``'s.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, fields, replace
+
+import numpy as np
+
+from visuomotor_gym.baselines.fajen_warren.agent import FajenWarrenAgent, FajenWarrenParams
+from visuomotor_gym.registration import env_vision
+from visuomotor_gym.vision.foveation import DEG, VisionParams
+
+from .belief import ObservationNoise, covariance_step, observation_variance
+from .stone_belief import saccade_duration_s, schedules
+
+SEEN_HEIGHT_M = 1.5  # tasks.obstacle_dodge.SEEN_HEIGHT_M: the point the eye sees on a pedestrian
+
+
+@dataclass(frozen=True)
+class DodgeBeliefMPCParams(FajenWarrenParams):
+    w_uct: float = 1.0  # Eom section 7
+    alpha_per_s: float = 0.5  # Q = alpha I, m^2 and (m/s)^2 per second (modelling choice: FW's 1 m/s^2 white
+    # acceleration gives ~1 (m/s)^2 per second on the velocity; Eom's alpha has one value for both blocks)
+    window_s: float = 1.2  # Eom section 7 (1.0 + 0.6 s sub-windows for running; 0.6-1.2 s elsewhere)
+    plan_dt_s: float = 0.1
+    max_switches: int = 1  # (modelling choice: 1 switch per window keeps the per-step plan ~10x cheaper than 2)
+    search_prior_var: float = 4.0  # (2 m)^2: where a pedestrian about to appear at a search direction stands
+    saccade_refractory_s: float = 0.2
+    saccade_threshold_deg: float = 3.0
+
+
+def walk_family_vision(env_id: str) -> VisionParams:
+    from .stones import stones_vision
+
+    return stones_vision(env_id)  # the same construction (WALK_VISION under the id's kwargs)
+
+
+def compact_step_information(sp, sv, spv, w, h: float, q: float):
+    """Eom Eq. 4 in compact form (:func:`.belief.covariance_step`) written with the information
+    ``w = 1 / r`` of the node's samples (0: nothing seen), so unseen objects need no special case:
+    ``sp' = a / (1 + a w)``, ``spv' = b / (1 + a w)``, ``sv' = c - b^2 w / (1 + a w)``."""
+    a = sp + 2.0 * h * spv + h * h * sv + q
+    b = spv + h * sv
+    c = sv + q
+    den = 1.0 + a * w
+    return a / den, c - b * b * w / den, b / den
+
+
+class DodgeBeliefMPCAgent(FajenWarrenAgent):
+    def __init__(self, params: DodgeBeliefMPCParams | None = None, vision: VisionParams | None = None) -> None:
+        self.timing: dict[str, float] = {}
+        super().__init__(params or DodgeBeliefMPCParams())
+        p = self.params
+        self.plan_vision = vision or replace(VisionParams(field_of_view_deg=20.0), noise_scale=p.vision_noise_scale,
+                                             foveated=p.foveated)
+        self.noise = ObservationNoise.from_vision(self.plan_vision)
+        self.n_nodes = max(2, int(round(p.window_s / p.plan_dt_s)))
+
+    @classmethod
+    def for_env(cls, env_id: str, **overrides) -> DodgeBeliefMPCAgent:
+        base = DodgeBeliefMPCParams(**env_vision(env_id))
+        known = {f.name for f in fields(DodgeBeliefMPCParams)}
+        unknown = sorted(set(overrides) - known)
+        if unknown:
+            raise TypeError(f"unknown belief_mpc parameter(s) for the dodge family {unknown}; known: {sorted(known)}")
+        return cls(replace(base, **overrides), vision=walk_family_vision(env_id))
+
+    def reset(self) -> None:
+        super().reset()
+        p = self.params
+        self.search_sigma = {az: np.array([p.search_prior_var, 1.0, 0.0]) for az in p.search_azimuths_deg}
+        self.plan_log: list[dict] = []
+        self.solve_ms: list[float] = []
+        self._last_t = None
+
+    # --- belief of the search directions (updated every step with the gaze the eye had) ---------------
+    def _act(self, obs: np.ndarray) -> np.ndarray:
+        self._obs = obs
+        return super()._act(obs)
+
+    def _search_points(self, eye_xy, heading):
+        p = self.params
+        return {az: (eye_xy[0] + p.search_distance_m * math.cos(heading + az * DEG),
+                     eye_xy[1] + p.search_distance_m * math.sin(heading + az * DEG)) for az in p.search_azimuths_deg}
+
+    def _choose(self, threats, t: float):
+        start = time.perf_counter()
+        p = self.params
+        eye_pos, rot, odo, pelvis_z, _ = self.poses[-1]
+        c, s = math.cos(odo[2]), math.sin(odo[2])
+        R = np.array(rot).reshape(3, 3)
+        eye = np.array([odo[0] + c * eye_pos[0] - s * eye_pos[1], odo[1] + s * eye_pos[0] + c * eye_pos[1],
+                        pelvis_z + eye_pos[2]])
+        g = R[:, 0]
+        gaze = np.array([c * g[0] - s * g[1], s * g[0] + c * g[1], g[2]])
+        dt = p.control_dt if self._last_t is None else max(t - self._last_t, 0.0)
+        self._last_t = t
+        # the search directions' pseudo-beliefs: seen when the line of sight is within the field of them
+        pts = self._search_points(eye[:2], odo[2])
+        for az, (x, y) in pts.items():
+            pos = np.array([x, y, eye[2]])
+            d = pos - eye
+            ecc = math.acos(max(-1.0, min(1.0, float(d @ gaze) / float(np.linalg.norm(d)))))
+            seen = (not self._in_saccade) and ecc <= self.plan_vision.field_of_view_deg * DEG
+            r = observation_variance(self.noise, math.atan2(gaze[1], gaze[0]), math.asin(max(-1.0, min(1.0, gaze[2]))),
+                                     pos, eye) if seen else math.inf
+            self.search_sigma[az] = covariance_step(self.search_sigma[az], np.asarray(r), dt, p.alpha_per_s * dt)
+        unseen = any(not f.known for f in self.filters)
+        # candidates: known pedestrians, closest first; then the most uncertain search directions
+        objs = []
+        for k, f in enumerate(self.filters):
+            if f.known:
+                P = f.P
+                sig = np.array([(P[0, 0] + P[1, 1]) / 2, (P[2, 2] + P[3, 3]) / 2, (P[0, 2] + P[1, 3]) / 2])
+                objs.append((float(np.hypot(f.x[0] - eye[0], f.x[1] - eye[1])), ("ped", k),
+                             np.array([f.x[0], f.x[1], SEEN_HEIGHT_M]), np.array([f.x[2], f.x[3], 0.0]), sig))
+        objs.sort(key=lambda o: o[0])
+        objs = objs[:4]
+        if unseen and len(objs) < 4:
+            extra = sorted(pts, key=lambda az: -float(np.sum(self.search_sigma[az] ** 2)))[:4 - len(objs)]
+            v = np.array([p.speed * c, p.speed * s, 0.0])
+            for az in extra:
+                objs.append((0.0, ("search", az), np.array([*pts[az], eye[2]]), v, self.search_sigma[az].copy()))
+        if not objs:
+            return None
+        keys = [o[1] for o in objs]
+        pos0 = np.stack([o[2] for o in objs])
+        vel = np.stack([o[3] for o in objs])
+        sig0 = np.stack([o[4] for o in objs])
+        # the object the line of sight is on now
+        rel = pos0 - eye
+        ang = np.arccos(np.clip(rel @ gaze / np.linalg.norm(rel, axis=1), -1.0, 1.0))
+        current = int(np.argmin(ang)) if float(ang.min()) <= p.saccade_threshold_deg * DEG else -1
+        if self._in_saccade and self.target in keys:
+            current = keys.index(self.target)
+        best = self._plan(eye, gaze, pos0, vel, sig0, current)
+        choice = keys[best]
+        if choice != self.target:
+            self.target, self.target_since = choice, t
+            if choice[0] == "search":
+                self.scanned[choice[1]] = t
+        self.plan_log.append({"t": t, "target": choice, "candidates": keys})
+        self.solve_ms.append(1e3 * (time.perf_counter() - start))
+        return self.target
+
+    def _plan(self, eye, gaze, pos0, vel, sig0, current: int) -> int:
+        p = self.params
+        n, h, m = self.n_nodes, p.plan_dt_s, len(pos0)
+        tk = (np.arange(n) + 0.5) * h
+        v_eye = np.array([p.speed * math.cos(self.phi), p.speed * math.sin(self.phi), 0.0])
+        E = eye[None, :] + tk[:, None] * v_eye  # (N, 3)
+        P = pos0[None, :, :] + tk[:, None, None] * vel[None, :, :]  # (N, M, 3)
+        rel = P - E[:, None, :]
+        d = np.linalg.norm(rel, axis=2)
+        u = rel / d[..., None]
+        theta = np.arccos(np.clip(np.einsum("nfi,nji->nfj", u, u), -1.0, 1.0))  # (N, F, J)
+        # gaze on object f: its direction; r for object j (the catch agent's noise model, slip included)
+        az = np.arctan2(u[..., 1], u[..., 0])[:, :, None]
+        el = np.arcsin(np.clip(u[..., 2], -1.0, 1.0))[:, :, None]
+        # retinal slip of j while the eye pursues f: the difference of their directions' rates
+        relv = np.broadcast_to(vel[None, :, :] - v_eye[None, None, :], u.shape)
+        du = (relv - np.sum(relv * u, axis=2)[..., None] * u) / d[..., None]
+        slip2 = np.sum((du[:, None, :, :] - du[:, :, None, :]) ** 2, axis=3)
+        r = observation_variance(self.noise, az, el, P[:, None, :, :], E[:, None, None, :], slip2=slip2)  # (N, F, J)
+        if self.plan_vision.foveated:
+            r = np.where(theta <= self.plan_vision.field_of_view_deg * DEG, r, np.inf)
+        amp_0 = np.arccos(np.clip(u[0] @ gaze, -1.0, 1.0))
+        per_node = max(1, int(round(h / p.control_dt)))
+        earliest = 0 if not self._in_saccade else int(math.ceil(p.saccade_refractory_s / h))
+        S = schedules(m, n, current, earliest, max(1, int(math.ceil(p.saccade_refractory_s / h - 1e-9))),
+                      int(p.max_switches))
+        C = S.targets.shape[0]
+        samples = np.full((n, C), float(per_node))
+        if S.sw_node.size:
+            kk, prev, new = S.sw_node, S.sw_prev, S.sw_new
+            amp = np.where(prev >= 0, theta[kk, np.maximum(prev, 0), new], amp_0[new])
+            samples[kk, S.sw_sched] = np.maximum(per_node - np.ceil(saccade_duration_s(amp) / p.control_dt - 1e-9), 0.0)
+        W = np.take((1.0 / r).reshape(n * m, m), S.rows, axis=0)  # (N, C, J) information per sample
+        W *= samples[..., None]
+        sp = np.broadcast_to(sig0[:, 0], (C, m)).copy()
+        sv = np.broadcast_to(sig0[:, 1], (C, m)).copy()
+        spv = np.broadcast_to(sig0[:, 2], (C, m)).copy()
+        cost = np.zeros(C)
+        q = p.alpha_per_s * h
+        for k in range(n):
+            sp, sv, spv = compact_step_information(sp, sv, spv, W[k], h, q)
+            cost += p.w_uct * np.sum(sp * sp + sv * sv + spv * spv, axis=1)
+        return int(S.targets[int(np.argmin(cost)), 0])
+
+
+__all__ = ["DodgeBeliefMPCAgent", "DodgeBeliefMPCParams"]
