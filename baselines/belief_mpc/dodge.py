@@ -55,6 +55,11 @@ class DodgeBeliefMPCParams(FajenWarrenParams):
     plan_dt_s: float = 0.1
     max_switches: int = 1  # (modelling choice: 1 switch per window keeps the per-step plan ~10x cheaper than 2)
     search_prior_var: float = 4.0  # (2 m)^2: where a pedestrian about to appear at a search direction stands
+    # Search directions and distance: pedestrians appear 4-6 m to a side, ~25-80 deg off the path
+    # (tasks/obstacle_dodge.py); two directions each side cover that with the 20 deg field (modelling choice).
+    search_dirs_deg: tuple = (40.0, -40.0, 70.0, -70.0)
+    search_dist_m: float = 5.0
+    look_head_share: float = 0.5  # the head takes this share of the gaze's azimuth (fajen_warren's value)
     saccade_refractory_s: float = 0.2
     saccade_threshold_deg: float = 3.0
 
@@ -98,7 +103,8 @@ class DodgeBeliefMPCAgent(FajenWarrenAgent):
     def reset(self) -> None:
         super().reset()
         p = self.params
-        self.search_sigma = {az: np.array([p.search_prior_var, 1.0, 0.0]) for az in p.search_azimuths_deg}
+        self.search_sigma = {az: np.array([p.search_prior_var, 1.0, 0.0]) for az in p.search_dirs_deg}
+        self.choice = None
         self.plan_log: list[dict] = []
         self.solve_ms: list[float] = []
         self._last_t = None
@@ -110,8 +116,8 @@ class DodgeBeliefMPCAgent(FajenWarrenAgent):
 
     def _search_points(self, eye_xy, heading):
         p = self.params
-        return {az: (eye_xy[0] + p.search_distance_m * math.cos(heading + az * DEG),
-                     eye_xy[1] + p.search_distance_m * math.sin(heading + az * DEG)) for az in p.search_azimuths_deg}
+        return {az: (eye_xy[0] + p.search_dist_m * math.cos(heading + az * DEG),
+                     eye_xy[1] + p.search_dist_m * math.sin(heading + az * DEG)) for az in p.search_dirs_deg}
 
     def _choose(self, threats, t: float):
         start = time.perf_counter()
@@ -161,17 +167,40 @@ class DodgeBeliefMPCAgent(FajenWarrenAgent):
         rel = pos0 - eye
         ang = np.arccos(np.clip(rel @ gaze / np.linalg.norm(rel, axis=1), -1.0, 1.0))
         current = int(np.argmin(ang)) if float(ang.min()) <= p.saccade_threshold_deg * DEG else -1
-        if self._in_saccade and self.target in keys:
-            current = keys.index(self.target)
+        if self._in_saccade and self.choice in keys:
+            current = keys.index(self.choice)
         best = self._plan(eye, gaze, pos0, vel, sig0, current)
-        choice = keys[best]
-        if choice != self.target:
-            self.target, self.target_since = choice, t
-            if choice[0] == "search":
-                self.scanned[choice[1]] = t
-        self.plan_log.append({"t": t, "target": choice, "candidates": keys})
+        self.choice = keys[best]
+        self.choice_point = pos0[best]
+        self.plan_log.append({"t": t, "target": self.choice, "candidates": keys})
         self.solve_ms.append(1e3 * (time.perf_counter() - start))
-        return self.target
+        return self.choice
+
+    def _look(self, pose, threats, t: float) -> list:
+        """Gaze and head actions toward the planned object (a pedestrian's believed point at 1.5 m, or a
+        search point), as ``fajen_warren``'s request: the eye to its direction, the head
+        ``look_head_share`` of its azimuth."""
+        p = self.params
+        eye_pos, rot, odo, pelvis_z, _ = pose
+        if self._choose(threats, t) is None:
+            return [0.0] * 5
+        tx, ty, tz = self.choice_point.tolist()
+        self.log.append((t, self.choice, self.phi))
+        c, s = math.cos(odo[2]), math.sin(odo[2])
+        ex, ey = odo[0] + c * eye_pos[0] - s * eye_pos[1], odo[1] + s * eye_pos[0] + c * eye_pos[1]
+        ez = pelvis_z + eye_pos[2]
+        dx, dy, dz = tx - ex, ty - ey, tz - ez
+        wx, wy = c * dx + s * dy, -s * dx + c * dy  # pelvis frame
+        n = math.sqrt(wx * wx + wy * wy + dz * dz) or 1.0
+        wx, wy, wz = wx / n, wy / n, dz / n
+        (a00, a01, a02), (a10, a11, a12), (a20, a21, a22) = rot[0:3], rot[3:6], rot[6:9]
+        e0 = a00 * wx + a10 * wy + a20 * wz  # R^T w: in the eye frame
+        e1 = a01 * wx + a11 * wy + a21 * wz
+        e2 = a02 * wx + a12 * wy + a22 * wz
+        r = self.gaze_range
+        head_yaw = p.look_head_share * math.atan2(wy, wx)
+        return [min(max(math.atan2(e1, e0) / r, -1.0), 1.0), min(max(math.atan2(e2, math.hypot(e0, e1)) / r, -1.0), 1.0),
+                0.0, min(max(head_yaw / (80.0 * DEG), -1.0), 1.0), 0.0]
 
     def _plan(self, eye, gaze, pos0, vel, sig0, current: int) -> int:
         p = self.params
