@@ -230,3 +230,50 @@ def test_dodge_realism_measures_on_synthetic_traces():
     assert r["components"]["pedestrian_fixated_share"]["value"] == 0.5
     assert math.isclose(r["components"]["fixation_latency_s"]["value"], 0.6)
     assert 0.0 <= r["score"] <= 1.0
+
+
+def _agent_with_pedestrian(x, y, vx, vy):
+    from visuomotor_gym.baselines.fajen_warren import FajenWarrenAgent
+
+    agent = FajenWarrenAgent.for_env("ObstacleDodgeOracle-v0")
+    f = agent.filters[0]
+    f.x = np.array([x, y, vx, vy], dtype=float)
+    f.P = np.eye(4) * 1e-4
+    f.t = f.t_seen = 0.0
+    return agent
+
+
+def test_fajen_warren_keeps_the_steering_course_and_nominal_speed_when_nobody_comes_near():
+    agent = _agent_with_pedestrian(8.0, 6.0, 0.0, 1.0)  # walking away from the path, far ahead
+    agent.phi = 0.05
+    course, speed = agent._evade((0.0, 0.0, 0.0), (1.3, 0.0))
+    assert course == 0.05 and speed == 1.3
+
+
+def test_fajen_warren_dodges_a_pedestrian_about_to_cross_its_path():
+    """A pedestrian 2.6 m ahead and 2.6 m to the left walks across at 1.3 m/s: the walker at 1.3 m/s would
+    meet it in 2 s. The agent changes speed or course, and the chosen pair's predicted closest distance is
+    larger than that of walking on."""
+    agent = _agent_with_pedestrian(2.6, 2.6, 0.0, -1.3)
+    course, speed = agent._evade((0.0, 0.0, 0.0), (1.3, 0.0))
+    assert (course, speed) != (0.0, 1.3)
+
+    def closest(course, speed):
+        t = np.arange(0.0, 6.0, 0.02)
+        lat = np.minimum(t, 0.7)
+        vy = np.clip(speed * math.sin(course), -0.36, 0.36)
+        vx = math.sqrt(speed * speed - vy * vy)
+        wx = 1.3 * lat + vx * (t - lat)
+        wy = vy * (t - lat)
+        return np.hypot(2.6 - wx, 2.6 - 1.3 * t - wy).min()
+
+    assert closest(0.0, 1.3) < 0.5 < closest(course, speed)
+
+
+def test_fajen_warren_holds_a_dodge_under_way_when_no_change_can_show_in_time():
+    """A pedestrian 0.6 m ahead, coming straight at the walker: no candidate clears the margin and none
+    differs before the footstep latency, so the previous command is kept rather than the nominal one."""
+    agent = _agent_with_pedestrian(0.8, 0.0, -1.0, 0.0)
+    agent.command = (-math.radians(18.0), 0.7)
+    course, speed = agent._evade((0.0, 0.0, 0.0), (0.9, 0.0))
+    assert (course, speed) == (-math.radians(18.0), 0.7)

@@ -17,19 +17,32 @@ Fajen, Warren, Temizer & Kaelbling 2003, IJCV 54:13): the direction of travel ph
 
 with the goal at angle psi_g and distance d_g and each obstacle at psi_o, d_o; the gains are the
 paper's fits (b = 3.25 /s, k_g = 7.50 /s^2, c1 = 0.40 /m, c2 = 0.40, k_o = 198 /s^2, c3 = 6.5 /rad,
-c4 = 0.8 /m; values as we recall them from the paper, not re-read here). The model is for stationary
+c4 = 0.8 /m). **Not verified against the paper's own text**: we could not read either paper here. The
+same seven values are what secondary sources quote for the published fit (a public steering-model
+visualisation's ``default_params`` b=3.25, k_g=7.5, c_1=0.4, c_2=0.4, k_o=198, c_3=6.5, c_4=0.8; notes on
+Fajen & Warren 2003 quoting them with the fits' 0.980 / 0.975 of the path variance); see
+docs/reproductions/dodge.md. The model is for stationary
 obstacles at constant speed; for a moving pedestrian the obstacle term acts on where the pedestrian
 will be at the moment of closest approach (so the walker steers away from the meeting point, behind a
 crossing pedestrian), and only for pedestrians whose predicted closest distance is below
 ``avoid_distance_m`` = 1 m (Olivier et al. 2012, Gait & Posture 36:399: walkers adapt only below a
-minimal predicted distance of ~1 m). Both adaptations are modelling choices. Speed stays at the nominal
-1.3 m/s, as in the model.
+minimal predicted distance of ~1 m). Both adaptations are modelling choices.
+
+**Course and speed** (:meth:`FajenWarrenAgent._evade`; modelling choice beside the constant-speed model):
+the steering dynamics' phi at the nominal 1.3 m/s is the default command. Each step the agent predicts,
+for phi and for courses 18, 9 and 0 deg either side of the path, each at the speeds 0.7-1.9 m/s, the
+closest distance to every known pedestrian (the walker keeps its present velocity for the ~0.7 s a
+footstep command needs to show, measured on the gait; pedestrians keep their estimated velocity), capped
+at ``speed_margin_m`` = 1.2 m, less ``speed_cost`` per m/s and ``course_cost`` per rad of change; the
+best pair is commanded. While no candidate clears the margin, the change is counted from the previous
+command, so a dodge under way is held rather than undone once no change can show in time. (Humans
+adapt both speed and course to a crossing pedestrian: Olivier et al. 2012.)
 
 **Gaze** (:meth:`FajenWarrenAgent._choose`): the agent fixates the pedestrian with the highest collision
 risk, where risk is the staleness of its estimate (time since it was last seen) weighted up for a
 pedestrian whose predicted closest distance is below 1 m soon (Olivier et al. 2012), and down for one
-that has passed; a fixation is held at least ``min_dwell_s`` = 0.3 s (about one human fixation while
-walking; modelling choice). Pedestrians not yet seen are searched for: the agent looks alternately
+that has passed; a fixation is held at least ``min_dwell_s`` = 0.1 s counted from the end of the
+saccade that brought it (modelling choice; shorter than a typical human fixation, 0.2-0.3 s). Pedestrians not yet seen are searched for: the agent looks alternately
 ``search_azimuth_deg`` = 45 deg to either side (where pedestrians 4-6 m to the side appear), each side
 an urgency that grows with the time since it was last scanned.
 
