@@ -159,7 +159,10 @@ class ObstacleMemory:
         # where the perceived ray meets the plane 0.15 m above the floor (mid-range of the obstacles).
         prior = corner.prior()
         if prior is not None:
-            lx, ly, lz = prior[0] - eye_w[0], prior[1] - eye_w[1], prior[2] - eye_w[2]
+            # (As Python floats: the same values as the estimate's numpy ones, and the arithmetic below,
+            # down to the information sums, stays in plain floats, which are faster than numpy scalars.)
+            px, py, pz = prior.tolist()
+            lx, ly, lz = px - eye_w[0], py - eye_w[1], pz - eye_w[2]
             d_ref = math.sqrt(lx * lx + ly * ly + lz * lz)
             u = (lx / d_ref, ly / d_ref, lz / d_ref)
         else:

@@ -12,6 +12,7 @@ be walked around). The toe clearance of the swing is the highest obstacle under 
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -56,6 +57,12 @@ class FootstepPlanner:
         self.laterals = np.arange(g.lateral_range_m[0], g.lateral_range_m[1] + 1e-9, 0.05)
         self.lengths2 = np.arange(0.35, g.step_range_m[1] + 1e-9, 0.1)
         self.laterals2 = np.arange(-0.3, 0.3 + 1e-9, 0.1)
+        # The candidates' grid and the parts of the costs that do not depend on the footholds (the same
+        # operations as in the formulas of ``plan``, done once).
+        self._L, self._A = np.meshgrid(self.lengths, self.laterals, indexing="ij")
+        self._cost_length = self.p.w_length * np.abs(self._L - g.nominal_step_m)
+        self._cost_lateral = self.p.w_lateral * np.abs(self._A)
+        self._cost_length2 = np.abs(g.nominal_step_m - self.lengths2) * self.p.w_length
 
     def _next_v(self, v_prev, lateral, side: int):
         """Lateral position of a foothold of ``side`` (0 left) from the previous one (the gait's rule)."""
@@ -96,7 +103,7 @@ class FootstepPlanner:
         """The pelvis's lateral target: 0 (the path's centre line) unless an obstacle ahead is too long
         to step over; then beside it, on the side nearer the pelvis's lateral position ``y_now``."""
         p = self.p
-        for o, zone, gf, gb in zip(obstacles, arr, gap[0], gap[1]):
+        for o, zone, gf, gb in zip(obstacles, arr.tolist(), gap[0].tolist(), gap[1].tolist()):
             if zone[1] < u_last - 0.3 or zone[0] > u_last + p.look_ahead_m:
                 continue
             if (zone[1] - zone[0]) + TOE_M + HEEL_M + gf + gb <= p.max_step_over_m:
@@ -110,43 +117,90 @@ class FootstepPlanner:
     def plan(self, footholds, obstacles) -> tuple[float, float, float]:
         """(length, lateral, clearance) of the next footstep. ``footholds``: the last three latched ones
         as (u, v, side) in the path frame, oldest first (the new foothold's foot swings from the oldest);
-        ``obstacles``: :class:`~.perception.ObstacleEstimate` list."""
+        ``obstacles``: :class:`~.perception.ObstacleEstimate` list.
+
+        The candidates (length i, lateral j) form a separable grid: a candidate's u depends on i only
+        (``u1``), its v on j only (``v1``), and so do the next foothold's on (i, k) and (j, l). The keep-out
+        and stride tests (:meth:`_clear`, :meth:`_stride_ok`) are made on those small arrays, with the
+        same comparisons on the same values, and combined per zone by a product of 0/1 matrices (a zone
+        blocks a foothold when both its x and its y test hit); the costs are the same operations on the
+        same values as the plain broadcast over (i, j[, k, l], zone), so the same footstep."""
         g, p = self.g, self.p
         (u_a, v_a, _), (u_b, v_b, side_b) = footholds[-2], footholds[-1]
         u_from, v_from = u_a, v_a  # the new foothold's foot swings from the one before the last
         side = 1 - int(side_b)
         arr, gap = self._zones(obstacles)
         y_goal = self.corridor(u_b, 0.5 * (v_a + v_b), obstacles, arr, gap)
-        L, A = np.meshgrid(self.lengths, self.laterals, indexing="ij")
-        U = u_b + L
-        V = self._next_v(v_b, A, side)
-        ok = self._clear(U, V, arr, gap) & self._stride_ok(u_b, U, L, arr)
+        L, A = self._L, self._A
+        u1 = u_b + self.lengths  # U[i, j] = u1[i]
+        v1 = self._next_v(v_b, self.laterals, side)  # V[i, j] = v1[j]
+        ok = self._ok_first(u_b, u1, v1, arr, gap)
         # One step of look-ahead: the other foot must find a clear foothold after this one.
-        L2, A2 = np.meshgrid(self.lengths2, self.laterals2, indexing="ij")
-        U2 = U[..., None, None] + L2
-        V2 = self._next_v(V[..., None, None], A2, 1 - side)
-        ok2 = self._clear(U2, V2, arr, gap) & self._stride_ok(U[..., None, None], U2, L2, arr)
-        cost2 = np.where(ok2, g.nominal_step_m - L2, np.inf)
-        cost2 = np.abs(cost2) * p.w_length + p.w_corridor * np.abs(0.5 * (V[..., None, None] + V2) - y_goal)
-        best2 = cost2.reshape(*U.shape, -1).min(axis=-1)
-        cost = (p.w_length * np.abs(L - g.nominal_step_m) + p.w_corridor * np.abs(0.5 * (V + v_b) - y_goal)
-                + p.w_lateral * np.abs(A) + best2)
+        best2 = self._best_next(u1, v1, arr, gap, side, y_goal)
+        cost = (self._cost_length + p.w_corridor * np.abs(0.5 * (v1 + v_b) - y_goal) + self._cost_lateral + best2)
         cost = np.where(ok & np.isfinite(best2), cost, np.inf)
         if not np.isfinite(cost).any():  # nothing is clear: the footholds that are clear now, else nominal
-            cost = np.where(ok, p.w_length * np.abs(L - g.nominal_step_m), np.inf)
+            cost = np.where(ok, self._cost_length, np.inf)
             if not np.isfinite(cost).any():
                 cost = np.abs(L - g.nominal_step_m) + np.abs(A)
         i, j = np.unravel_index(int(np.argmin(cost)), cost.shape)
         length, lateral = float(L[i, j]), float(A[i, j])
-        u_to, v_to = float(U[i, j]), float(V[i, j])
+        u_to, v_to = float(u1[i]), float(v1[j])
         return length, lateral, self.clearance(u_from, v_from, u_to, v_to, arr)
+
+    def _ok_first(self, u_b: float, u1, v1, arr, gap) -> np.ndarray:
+        """(i, j) array: candidate (u1[i], v1[j]) clear of every zone (:meth:`_clear`) and no long stride
+        from ``u_b`` over a tall one (:meth:`_stride_ok`)."""
+        if len(arr) == 0:
+            return np.ones((len(u1), len(v1)), dtype=bool)
+        p = self.p
+        front, back = gap
+        x_hit = (u1[:, None] + TOE_M + front > arr[:, 0]) & (u1[:, None] - HEEL_M - back < arr[:, 1])  # (i, zone)
+        y_hit = (v1[:, None] + HALF_WIDTH_M > arr[:, 2]) & (v1[:, None] - HALF_WIDTH_M < arr[:, 3])  # (j, zone)
+        clear = (x_hit.astype(float) @ y_hit.astype(float).T) == 0.0  # counts of zones hit by both (exact)
+        tall = arr[:, 4] > p.tall_m
+        over = tall & (arr[:, 0] > np.asarray(u_b)[..., None]) & (arr[:, 1] < u1[:, None])  # (i, zone)
+        stride = ~(over.any(axis=-1) & (self.lengths > p.max_stride_over_tall_m))  # (i,)
+        return clear & stride[:, None]
+
+    def _best_next(self, u1, v1, arr, gap, side: int, y_goal: float) -> np.ndarray:
+        """(i, j) array: for each candidate foothold (u1[i], v1[j]) the cost of the cheapest clear foothold
+        of the other foot after it (length k, lateral l of ``lengths2``, ``laterals2``), inf when there
+        is none: ``|nominal - L2| w_length + w_corridor |(v + v2) / 2 - y_goal|`` where clear."""
+        g, p = self.g, self.p
+        l2 = self.lengths2
+        u2 = u1[:, None] + l2  # (i, k): U2[i, j, k, l]
+        v2 = self._next_v(v1[:, None], self.laterals2, 1 - side)  # (j, l): V2[i, j, k, l]
+        (ni, nk), (nj, nl) = u2.shape, v2.shape
+        if len(arr) == 0:
+            ok2 = np.ones((ni, nj, nk, nl), dtype=bool)
+        else:
+            front, back = gap
+            x_hit = (u2[..., None] + TOE_M + front > arr[:, 0]) & (u2[..., None] - HEEL_M - back < arr[:, 1])
+            y_hit = (v2[..., None] + HALF_WIDTH_M > arr[:, 2]) & (v2[..., None] - HALF_WIDTH_M < arr[:, 3])
+            hits = x_hit.reshape(ni * nk, -1).astype(float) @ y_hit.reshape(nj * nl, -1).astype(float).T
+            clear = (hits == 0.0).reshape(ni, nk, nj, nl).transpose(0, 2, 1, 3)
+            # _stride_ok(U, U2, L2): no long stride over a tall zone between the two footholds.
+            tall = arr[:, 4] > p.tall_m
+            over = tall & (arr[:, 0] > u1[:, None, None]) & (arr[:, 1] < u2[..., None])  # (i, k, zone)
+            stride = ~(over.any(axis=-1) & (l2 > p.max_stride_over_tall_m))  # (i, k)
+            ok2 = clear & stride[:, None, :, None]
+        corridor = p.w_corridor * np.abs(0.5 * (v1[:, None] + v2) - y_goal)  # (j, l)
+        if math.inf * p.w_length == math.inf:
+            # Where not clear, |inf| w_length + corridor is inf (or NaN with a NaN corridor, which, like
+            # inf, the caller treats as no foothold): the clear entries' costs are (j, k, l) sums.
+            cost2 = np.where(ok2, self._cost_length2[None, :, None] + corridor[:, None, :], np.inf)
+        else:
+            cost2 = np.where(ok2, g.nominal_step_m - l2[:, None], np.inf)
+            cost2 = np.abs(cost2) * p.w_length + corridor[None, :, None, :]
+        return cost2.reshape(ni, nj, -1).min(axis=-1)
 
     def clearance(self, u0: float, v0: float, u1: float, v1: float, arr) -> float:
         """Toe clearance of a swing from (u0, v0) to (u1, v1): the highest zone under it plus a margin."""
         g, p = self.g, self.p
         lo, hi = min(v0, v1) - HALF_WIDTH_M, max(v0, v1) + HALF_WIDTH_M
         c = g.nominal_clearance_m
-        for x0, x1, y0, y1, h in arr:
+        for x0, x1, y0, y1, h in arr.tolist():
             if x1 > u0 - HEEL_M and x0 < u1 + TOE_M and y1 > lo and y0 < hi:
                 c = max(c, h + p.clearance_margin_m)
         return float(min(c, g.clearance_range_m[1]))

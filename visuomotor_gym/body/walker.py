@@ -45,6 +45,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from math import acos, atan2, cos, sin, sqrt
 
 import mujoco
 import numpy as np
@@ -53,6 +54,7 @@ from visuomotor_gym.body import walker_names as wn
 
 DEG = math.pi / 180.0
 LEFT, RIGHT = 0, 1
+_INTEGRATION = mujoco.mjtState.mjSTATE_INTEGRATION
 
 
 @dataclass(frozen=True)
@@ -205,11 +207,30 @@ class ObstaclePool:
 
     def near(self, x: float, y: float, radius: float) -> bool:
         """Whether any placed obstacle's footprint comes within ``radius`` of (x, y)."""
+        r2 = radius * radius
+        # A box more than ``reach`` away along x cannot pass the test below (dx > radius (1 + 1e-9)
+        # makes the rounded dx * dx exceed the rounded radius * radius), so skipping it changes no answer.
+        reach = radius * (1.0 + 1e-9) if radius > 1e-100 else math.inf
         for box in self.boxes:
             if box is not None:
-                dx = max(box[0] - x, 0.0, x - box[1])
-                dy = max(box[2] - y, 0.0, y - box[3])
-                if dx * dx + dy * dy <= radius * radius:
+                x0, x1 = box[0], box[1]
+                if x0 - x > reach or x - x1 > reach:
+                    continue
+                # dx = max(x0 - x, 0.0, x - x1) and dy alike, as conditional expressions (the same
+                # comparisons as the builtin's, in the same order).
+                dx = x0 - x
+                if 0.0 > dx:
+                    dx = 0.0
+                t = x - x1
+                if t > dx:
+                    dx = t
+                dy = box[2] - y
+                if 0.0 > dy:
+                    dy = 0.0
+                t = y - box[3]
+                if t > dy:
+                    dy = t
+                if dx * dx + dy * dy <= r2:
                     return True
         return False
 
@@ -307,6 +328,9 @@ class WalkerGait:
         self.pool = ObstaclePool(m)
         self._ob_geom = self.pool.index_of_geom
         self._n_ctrl_ticks = 0
+        self._dt_seen, self._dt_ticks = None, 0  # advance(): the last dt and its physics steps
+        self._watch_state, self._scratch, self._watching = None, None, False  # watched substeps
+        self._cache_constants()
         self.reset_plan(0.0, 0.0, 0.0)
 
     # ------------------------------------------------------------------ plan
@@ -335,6 +359,7 @@ class WalkerGait:
         self.misstepped = False
         self._touching: set = set()  # (side, part, obstacle) in contact at the last check
         self._reported: set = set()  # (kind, side, foothold, obstacle) already reported
+        self._watching = False  # no watched substeps pending
 
     @staticmethod
     def side_of(j: int) -> int:
@@ -404,38 +429,93 @@ class WalkerGait:
         # ankle = pivot + R(pitch) (-pivot_x, h_ankle), R rotating x toward z (toe up positive)
         return pu - pivot_x * c - self.h_ankle * s, -pivot_x * s + self.h_ankle * c
 
-    def _stance_foot(self, j: int, s_tick: int) -> FootPlan:
+    # The per-step path below (``_stance``, ``_swing``, ``_targets``, ``advance``) is written out in
+    # scalar Python on tuples, with the gait's constants computed once (``_cache_constants``) and
+    # ``min``/``max`` written as the comparisons the builtins make: every floating-point operation is
+    # the one of the plain formulas (``_foot_from_pivot``, ``_smooth``, the FootPlan fields, the numpy
+    # clip), in the same order, so the targets are bit-identical to them; only Python overhead is gone.
+    def _cache_constants(self) -> None:
         p = self.p
-        u, v = self.u[j], self.v[j]
+        self._heel_rad = p.heel_strike_deg * DEG
+        self._neg_toe_rad = -p.toe_off_deg * DEG
+        self._neg_toe_deg, self._heel_deg = -p.toe_off_deg, p.heel_strike_deg
+        self._toe_span = self.T + self.T_ds - self.T_ho  # ticks from heel-off to toe-off
+        self._swing_ticks = self.T - self.T_ds
+        # The swing's start and end ankle positions relative to their footholds (_foot_from_pivot with
+        # the toe-off and heel-strike pitches): u - pivot_x cos - h_ankle sin, the two products fixed.
+        t0, t1 = -p.toe_off_deg * DEG, p.heel_strike_deg * DEG
+        self._a0c, self._a0s = self.l_toe * math.cos(t0), self.h_ankle * math.sin(t0)
+        self._a1c, self._a1s = -self.l_heel * math.cos(t1), self.h_ankle * math.sin(t1)
+        self._move0, self._move_span = p.swing_move[0], p.swing_move[1] - p.swing_move[0]
+        self._fall_span = 1.0 - p.swing_fall
+        self._two_pi = 2.0 * math.pi
+        self._half_bob = 0.5 * p.bob_m
+        self._d_max2 = self.d_max * self.d_max
+        self._L1sq, self._L2sq, self._L12x2 = self.L1 * self.L1, self.L2 * self.L2, 2.0 * self.L1 * self.L2
+        self._arm_rad = p.arm_swing_deg * DEG
+        # The clip of the targets to the joints' ranges: each leg's five joints in target order, and
+        # the other limited joints (a min/max against an infinite bound is the identity).
+        lo, hi = self._lo, self._hi
+        self._leg_bounds = tuple(tuple((lo[i], hi[i]) for i in range(4 + 5 * side, 9 + 5 * side)) for side in (LEFT, RIGHT))
+        self._other_clip = [(i, lo[i], hi[i]) for i in (0, 1, 2, 3, 14, 15)
+                            if lo[i] != -math.inf or hi[i] != math.inf]
+
+    def _stance(self, j: int, s_tick: int) -> tuple:
+        """:meth:`_stance_foot` as a tuple (u, v, z, pitch, stance, sole_h)."""
+        u = self.u[j]
         if s_tick < self.T_ds:  # heel rocker
-            pitch = p.heel_strike_deg * DEG * (1.0 - _smooth(s_tick / self.T_ds))
-            au, az = self._foot_from_pivot(u - self.l_heel, -self.l_heel, pitch)
-        elif s_tick < self.T_ho:
-            pitch, au, az = 0.0, u, self.h_ankle
-        else:  # toe rocker until toe-off
-            pitch = -p.toe_off_deg * DEG * _smooth((s_tick - self.T_ho) / (self.T + self.T_ds - self.T_ho))
-            au, az = self._foot_from_pivot(u + self.l_toe, self.l_toe, pitch)
-        return FootPlan(au, v, az, pitch, True, -1.0)
+            s = s_tick / self.T_ds  # _smooth(s) inline
+            sm = 0.0 if s <= 0.0 else 1.0 if s >= 1.0 else s * s * s * (10.0 + s * (-15.0 + 6.0 * s))
+            pitch = self._heel_rad * (1.0 - sm)
+            c, s = cos(pitch), sin(pitch)
+            lh, ha = self.l_heel, self.h_ankle
+            return (u - lh - -lh * c - ha * s, self.v[j], lh * s + ha * c, pitch, True, 0.0)
+        if s_tick < self.T_ho:
+            return (u, self.v[j], self.h_ankle, 0.0, True, 0.0)
+        # toe rocker until toe-off
+        s = (s_tick - self.T_ho) / self._toe_span
+        sm = 0.0 if s <= 0.0 else 1.0 if s >= 1.0 else s * s * s * (10.0 + s * (-15.0 + 6.0 * s))
+        pitch = self._neg_toe_rad * sm
+        c, s = cos(pitch), sin(pitch)
+        lt, ha = self.l_toe, self.h_ankle
+        return (u + lt - lt * c - ha * s, self.v[j], -lt * s + ha * c, pitch, True, 0.0)
+
+    def _swing(self, j_from: int, j_to: int, tau: float) -> tuple:
+        """:meth:`_swing_foot` as a tuple (u, v, z, pitch, stance, sole_h)."""
+        u, v = self.u, self.v
+        a0u = u[j_from] + self.l_toe - self._a0c - self._a0s
+        a1u = u[j_to] - self.l_heel - self._a1c - self._a1s
+        s = (tau - self._move0) / self._move_span  # prog = _smooth(s), inline as below
+        prog = 0.0 if s <= 0.0 else 1.0 if s >= 1.0 else s * s * s * (10.0 + s * (-15.0 + 6.0 * s))
+        au = a0u + (a1u - a0u) * prog
+        v0 = v[j_from]
+        av = v0 + (v[j_to] - v0) * prog
+        s = tau / 0.4
+        s1 = 0.0 if s <= 0.0 else 1.0 if s >= 1.0 else s * s * s * (10.0 + s * (-15.0 + 6.0 * s))
+        s = (tau - 0.6) / 0.4
+        s2 = 0.0 if s <= 0.0 else 1.0 if s >= 1.0 else s * s * s * (10.0 + s * (-15.0 + 6.0 * s))
+        pitch = (self._neg_toe_deg * (1.0 - s1) + self._heel_deg * s2) * DEG
+        p = self.p
+        if tau < p.swing_rise:
+            s = tau / p.swing_rise
+        elif tau > p.swing_fall:
+            s = (1.0 - tau) / self._fall_span
+        else:
+            s = 1.0
+        lift = 0.0 if s <= 0.0 else 1.0 if s >= 1.0 else s * s * s * (10.0 + s * (-15.0 + 6.0 * s))
+        h = self.clearance[j_to] * lift
+        sp, cp = sin(pitch), cos(pitch)
+        a, b = self.l_toe * sp, -self.l_heel * sp
+        lowest = (b if b < a else a) - self.h_ankle * cp  # sole corners vs the ankle
+        return (au, av, h - lowest, pitch, False, h)
+
+    def _stance_foot(self, j: int, s_tick: int) -> FootPlan:
+        u, v, z, pitch, _, _ = self._stance(j, s_tick)
+        return FootPlan(u, v, z, pitch, True, -1.0)
 
     def _swing_foot(self, j_from: int, j_to: int, tau: float) -> FootPlan:
-        p = self.p
-        a0u, _ = self._foot_from_pivot(self.u[j_from] + self.l_toe, self.l_toe, -p.toe_off_deg * DEG)
-        a1u, _ = self._foot_from_pivot(self.u[j_to] - self.l_heel, -self.l_heel, p.heel_strike_deg * DEG)
-        m0, m1 = p.swing_move
-        prog = _smooth((tau - m0) / (m1 - m0))
-        au = a0u + (a1u - a0u) * prog
-        av = self.v[j_from] + (self.v[j_to] - self.v[j_from]) * prog
-        pitch = (-p.toe_off_deg * (1.0 - _smooth(tau / 0.4)) + p.heel_strike_deg * _smooth((tau - 0.6) / 0.4)) * DEG
-        if tau < p.swing_rise:
-            lift = _smooth(tau / p.swing_rise)
-        elif tau > p.swing_fall:
-            lift = _smooth((1.0 - tau) / (1.0 - p.swing_fall))
-        else:
-            lift = 1.0
-        h = self.clearance[j_to] * lift
-        sp, cp = math.sin(pitch), math.cos(pitch)
-        lowest = min(self.l_toe * sp, -self.l_heel * sp) - self.h_ankle * cp  # sole corners vs the ankle
-        return FootPlan(au, av, h - lowest, pitch, False, tau, h)
+        u, v, z, pitch, _, h = self._swing(j_from, j_to, tau)
+        return FootPlan(u, v, z, pitch, False, tau, h)
 
     def feet_at(self, tick: int) -> tuple[FootPlan, FootPlan]:
         """Both feet's planned poses at ``tick`` (physics steps since reset), (left, right)."""
@@ -451,55 +531,111 @@ class WalkerGait:
     def targets_at(self, tick: int) -> np.ndarray:
         """Joint targets of every gait joint (``WALKER_GAIT_JOINTS`` order) at ``tick``, inside the
         joints' ranges."""
-        p = self.p
+        return np.array(self._targets(tick))
+
+    def _targets(self, tick: int) -> list[float]:
+        """:meth:`targets_at` as a list of floats (the per-step path)."""
+        T = self.T
         pu, pv = self._pelvis_uv(tick)
-        phase = 2.0 * math.pi * ((tick - self.T_mid) % self.T) / self.T
-        z = p.pelvis_height_m - 0.5 * p.bob_m * (1.0 - math.cos(phase))
-        feet = self.feet_at(tick)
+        phase = self._two_pi * ((tick - self.T_mid) % T) / T
+        z = self.p.pelvis_height_m - self._half_bob * (1.0 - cos(phase))
+        # The feet (feet_at): the one that landed last in stance, the other in stance or swing.
+        k = tick // T  # the current step: foothold k landed last
+        s = tick - k * T
+        lead = self._stance(k, s)
+        if s < self.T_ds:
+            trail = self._stance(k - 1, s + T)
+        else:
+            trail = self._swing(k - 1, k + 1, (s - self.T_ds) / self._swing_ticks)
+        left, right = (lead, trail) if k % 2 == LEFT else (trail, lead)
         # Lower the pelvis where a leg would otherwise over-reach (long steps).
-        hips = []
-        for side, foot in enumerate(feet):
-            hy = self.hip_y if side == LEFT else -self.hip_y
-            du, dv = foot.u - pu, foot.v - (pv + hy)
-            zmax = foot.z + math.sqrt(max(self.d_max * self.d_max - du * du - dv * dv, 0.0))
-            if zmax < z:
-                z = zmax
-            hips.append((du, dv))
+        hy = self.hip_y
+        d_max2 = self._d_max2
+        du0, dv0 = left[0] - pu, left[1] - (pv + hy)
+        r = d_max2 - du0 * du0 - dv0 * dv0
+        zmax = left[2] + sqrt(0.0 if 0.0 > r else r)  # max(r, 0.0)
+        if zmax < z:
+            z = zmax
+        du1, dv1 = right[0] - pu, right[1] - (pv + -hy)
+        r = d_max2 - du1 * du1 - dv1 * dv1
+        zmax = right[2] + sqrt(0.0 if 0.0 > r else r)
+        if zmax < z:
+            z = zmax
         c, s = self._c, self._s
         ox, oy = self.origin
         out = [ox + c * pu - s * pv, oy + s * pu + c * pv, z, self.yaw]
-        for side, foot in enumerate(feet):
-            fx, fy = hips[side]  # path frame = pelvis heading frame (the pelvis keeps the path heading)
-            roll, hip, knee = self._leg_ik(fx, fy, foot.z - z)
-            ankle = foot.pitch - (hip - knee)
-            ia = 7 + 5 * side  # the ankle pitch's index in the target list
-            n_fix = 0
-            while not foot.stance and not self._lo[ia] <= ankle <= self._hi[ia] and n_fix < 4:
-                # A high swing behind the body needs more dorsiflexion than the ankle has: let the foot
-                # hang at the ankle's limit and raise the ankle so the lowest sole point keeps its height
-                # (a few fixed-point passes: the raised ankle changes the shank's angle a little).
-                pitch = min(max(ankle, self._lo[ia]), self._hi[ia]) + (hip - knee)
-                sp, cp = math.sin(pitch), math.cos(pitch)
-                lowest = min(self.l_toe * sp, -self.l_heel * sp) - self.h_ankle * cp
-                roll, hip, knee = self._leg_ik(fx, fy, foot.sole_h - lowest - z)
-                ankle = pitch - (hip - knee)
-                n_fix += 1
-            out += [roll, hip, knee, ankle, -roll]
-        arm = p.arm_swing_deg * DEG * math.cos(math.pi * (tick % (2 * self.T)) / self.T)
-        out += [-arm, arm]  # left arm back when the left foot lands
-        return np.minimum(np.maximum(np.array(out), self._lo_a), self._hi_a)
+        leg_ik = self._leg_ik
+        for foot, fx, fy, bounds in ((left, du0, dv0, self._leg_bounds[LEFT]), (right, du1, dv1, self._leg_bounds[RIGHT])):
+            # path frame = pelvis heading frame (the pelvis keeps the path heading)
+            roll, hip, knee = leg_ik(fx, fy, foot[2] - z)
+            ankle = foot[3] - (hip - knee)
+            (lo0, hi0), (lo1, hi1), (lo2, hi2), (lo, hi), (lo4, hi4) = bounds
+            if not foot[4]:
+                n_fix = 0
+                while not lo <= ankle <= hi and n_fix < 4:
+                    # A high swing behind the body needs more dorsiflexion than the ankle has: let the foot
+                    # hang at the ankle's limit and raise the ankle so the lowest sole point keeps its height
+                    # (a few fixed-point passes: the raised ankle changes the shank's angle a little).
+                    a = lo if lo > ankle else ankle  # min(max(ankle, lo), hi)
+                    pitch = (hi if hi < a else a) + (hip - knee)
+                    sp, cp = sin(pitch), cos(pitch)
+                    a, b = self.l_toe * sp, -self.l_heel * sp
+                    lowest = (b if b < a else a) - self.h_ankle * cp
+                    roll, hip, knee = leg_ik(fx, fy, foot[5] - lowest - z)
+                    ankle = pitch - (hip - knee)
+                    n_fix += 1
+            # The targets clipped to the ranges: min(max(x, lo), hi) for each.
+            nroll = -roll
+            if lo0 > roll:
+                roll = lo0
+            if hi0 < roll:
+                roll = hi0
+            if lo1 > hip:
+                hip = lo1
+            if hi1 < hip:
+                hip = hi1
+            if lo2 > knee:
+                knee = lo2
+            if hi2 < knee:
+                knee = hi2
+            if lo > ankle:
+                ankle = lo
+            if hi < ankle:
+                ankle = hi
+            if lo4 > nroll:
+                nroll = lo4
+            if hi4 < nroll:
+                nroll = hi4
+            out += (roll, hip, knee, ankle, nroll)
+        arm = self._arm_rad * cos(math.pi * (tick % (2 * T)) / T)
+        out += (-arm, arm)  # left arm back when the left foot lands
+        for i, lo, hi in self._other_clip:
+            x = out[i]
+            if lo > x:
+                x = lo
+            if hi < x:
+                x = hi
+            out[i] = x
+        return out
 
     def _leg_ik(self, fx: float, fy: float, fz: float) -> tuple[float, float, float]:
         """Hip roll, hip pitch and knee placing the ankle at (fx, fy, fz) from the hip joint (pelvis
         heading frame): roll turns the leg's plane toward the ankle, then the two-link law of cosines in
         that plane (the knee bends backward); beyond ``max_reach`` the leg stays at that reach."""
-        L1, L2 = self.L1, self.L2
-        roll = math.atan2(fy, -fz)
-        dperp = math.sqrt(fy * fy + fz * fz)
-        d2 = min(fx * fx + dperp * dperp, self.d_max * self.d_max)
-        cos_k = (d2 - L1 * L1 - L2 * L2) / (2.0 * L1 * L2)
-        knee = math.acos(min(max(cos_k, -1.0), 1.0))
-        hip = math.atan2(fx, dperp) + math.atan2(L2 * math.sin(knee), L1 + L2 * math.cos(knee))
+        roll = atan2(fy, -fz)
+        dperp = sqrt(fy * fy + fz * fz)
+        d2 = fx * fx + dperp * dperp
+        d_max2 = self._d_max2
+        if d_max2 < d2:  # min(d2, d_max^2)
+            d2 = d_max2
+        cos_k = (d2 - self._L1sq - self._L2sq) / self._L12x2
+        if -1.0 > cos_k:  # min(max(cos_k, -1), 1)
+            cos_k = -1.0
+        if 1.0 < cos_k:
+            cos_k = 1.0
+        knee = acos(cos_k)
+        L2 = self.L2
+        hip = atan2(fx, dperp) + atan2(L2 * sin(knee), self.L1 + L2 * cos(knee))
         return roll, hip, knee
 
     # ------------------------------------------------------------------ MuJoCo side
@@ -515,32 +651,46 @@ class WalkerGait:
         data.qvel[self._dof_idx] = qd
         data.act[self._actslice] = q0 + self._lead_a * qd
         data.ctrl[self._ctrl] = qd
-        self._hist = [(0, q0)]
+        self._hist = [(0, q0.tolist())]
         self.t0 = float(data.time)
         mujoco.mj_forward(model, data)
+
+    def _set_dt(self, dt: float) -> None:
+        """Check a control period (a whole number of physics steps, else ValueError) and keep it."""
+        n = round(dt / self.timestep)
+        if n < 1 or abs(n * self.timestep - dt) > 1e-9:
+            raise ValueError(f"dt={dt} is not a whole number of {self.timestep} s physics steps")
+        self._dt_seen, self._dt_ticks = dt, n
 
     def advance(self, data: mujoco.MjData, dt: float) -> None:
         """Plan the next ``dt`` seconds (a whole number of physics steps): latch footsteps whose
         mid-stance falls in it, and set every gait servo's setpoint velocity so that its setpoint
         reaches the target (with velocity lead) at the end of the step."""
-        n = round(dt / self.timestep)
-        if n < 1 or abs(n * self.timestep - dt) > 1e-9:
-            raise ValueError(f"dt={dt} is not a whole number of {self.timestep} s physics steps")
+        if dt != self._dt_seen:
+            self._set_dt(dt)
+        n = self._dt_ticks
+        ts = self.timestep
         end = self.tick + n
         while self.next_latch_tick <= end:
             self._latch()
-        q1 = self.targets_at(end)
+        q1 = self._targets(end)
         # Target velocity at ``end`` by a second-order backward difference over the last targets (the
         # plan up to a latch never changes, so earlier targets stay valid); after a reset or a change
-        # of dt, from one more evaluation a physics step earlier.
+        # of dt, from one more evaluation a physics step earlier. Element by element, the operations
+        # of the array expressions qd = (3 q1 - 4 q_-1 + q_-2) * (0.5 / (n ts)) and
+        # ctrl = (q1 + lead qd - act) * (1 / (n ts)).
         h = self._hist
+        act = data.act[self._actslice].tolist()
+        k2 = 1.0 / (n * ts)
         if len(h) == 2 and h[1][0] == end - n and h[0][0] == end - 2 * n:
-            qd = (3.0 * q1 - 4.0 * h[1][1] + h[0][1]) * (0.5 / (n * self.timestep))
+            k = 0.5 / (n * ts)
+            ctrl = [(q + lead * ((3.0 * q - 4.0 * b + c) * k) - a) * k2
+                    for q, b, c, lead, a in zip(q1, h[1][1], h[0][1], self._lead, act)]
         else:
-            qd = (q1 - self.targets_at(end - 1)) / self.timestep
+            ctrl = [(q + lead * ((q - b) / ts) - a) * k2
+                    for q, b, lead, a in zip(q1, self._targets(end - 1), self._lead, act)]
         self._hist = [h[-1], (end, q1)] if h else [(end, q1)]
-        act = data.act[self._actslice]
-        data.ctrl[self._ctrl] = (q1 + self._lead_a * qd - act) * (1.0 / (n * self.timestep))
+        data.ctrl[self._ctrl] = ctrl
         self.tick = end
 
     # ------------------------------------------------------------------ contacts
@@ -615,16 +765,69 @@ class WalkerGait:
 
     def step_physics(self, model: mujoco.MjModel, data: mujoco.MjData, n_substeps: int) -> bool:
         """Run ``n_substeps`` physics steps, checking contacts after each one when an obstacle is
-        near the pelvis (else one ``mj_step`` call); return True when a trip or misstep began."""
+        near the pelvis (else one ``mj_step`` call); return True when a trip or misstep began.
+
+        Near an obstacle the substeps run as one ``mj_step`` call too, watched
+        (:meth:`watch_substeps`): only when a contact happened in one of them are they replayed one by
+        one with the checks (:meth:`watched_contacts`), which classifies exactly what checking after
+        every substep would have."""
         x, y = float(data.qpos[self._qpos_idx[0]]), float(data.qpos[self._qpos_idx[1]])
         if not self.pool.near(x, y, self.CONTACT_RADIUS_M):
             mujoco.mj_step(model, data, nstep=n_substeps)
             return False
+        self.watch_substeps(data)
+        mujoco.mj_step(model, data, nstep=n_substeps)
+        return self.watched_contacts(data, n_substeps, every=True, final=False)
+
+    # Watched substeps. Checking contacts after every physics substep costs a Python ``mj_step`` call
+    # per substep; but contacts with the legs are rare (a trip or a misstep), and MuJoCo keeps the
+    # largest number of contacts any step had (``data.maxuse_con``). So the substeps run as one call
+    # after the integration state is saved and that maximum cleared; when it comes back 0 no substep
+    # had a contact (every check would have found none), else the substeps are replayed from the saved
+    # state on a scratch ``MjData`` with the checks after each one. MuJoCo is deterministic given the
+    # integration state (``mjSTATE_INTEGRATION``), so the replay visits the very same states and
+    # contacts, and ``data`` itself is never stepped twice.
+    def watch_substeps(self, data: mujoco.MjData) -> None:
+        """Before physics substeps that must be checked for contacts: save the integration state and
+        clear ``data.maxuse_con``."""
+        if self._watch_state is None:
+            self._watch_state = np.empty(mujoco.mj_stateSize(self.model, _INTEGRATION))
+        mujoco.mj_getState(self.model, data, self._watch_state, _INTEGRATION)
+        data.maxuse_con = 0
+        self._watching = True
+
+    def watched_contacts(self, data: mujoco.MjData, n_substeps: int, *, every: bool = False,
+                         final: bool = True, replay: bool = False) -> bool:
+        """After the substeps (one ``mj_step(..., nstep=n_substeps)`` call on ``data``) that
+        :meth:`watch_substeps` prepared, classify contacts as :meth:`check_contacts` after each substep
+        would have: after every one (``every``), or, as the env's physics loop does, until the first
+        that reports a new event; then once more on ``data`` (``final``). ``replay``: replay even when
+        ``maxuse_con`` says no contact happened (after a divergence, which resets ``data``). Without a
+        watch pending, the one check on ``data``."""
+        if not self._watching:
+            return self.check_contacts(data)
+        self._watching = False
+        if not (replay or data.maxuse_con > 0):  # no contact in any substep: every check clears
+            return self.check_contacts(data)
+        scratch = self._scratch
+        if scratch is None:
+            scratch = self._scratch = mujoco.MjData(self.model)
+        mujoco.mj_setState(self.model, scratch, self._watch_state, _INTEGRATION)
         new = False
         for _ in range(n_substeps):
-            mujoco.mj_step(model, data)
-            new |= self.check_contacts(data)
+            mujoco.mj_step(self.model, scratch)
+            if every:
+                new |= self.check_contacts(scratch)
+            elif not new and self.check_contacts(scratch):
+                new = True
+        if final and not new:
+            new = self.check_contacts(data)
         return new
+
+    def __getstate__(self):
+        state = self.__dict__.copy()
+        state["_scratch"] = None  # rebuilt when next needed
+        return state
 
     # ------------------------------------------------------------------ read-outs for tasks
     @property

@@ -188,7 +188,8 @@ class ObstacleWalkEnv(VisuomotorEnv):
         self._set_visual_delay(visual_delay_s)
         body = WalkerBody(self.model, self.gait_params)
         task = ObstacleWalkTask(self.model, body, course_distribution=self.course_distribution,
-                                reward_weights=self.reward_weights, visual_delay_s=self.visual_delay_s)
+                                reward_weights=self.reward_weights, visual_delay_s=self.visual_delay_s,
+                                n_substeps=self.n_substeps)
         self._assemble_eye(body=body, task=task, obs_mode=obs_mode, width=width, height=height)
         self.gait = body.gait
 

@@ -113,8 +113,9 @@ class ObstacleWalkTask:
     trace_flag_fields = ("obstacle_seen",)
 
     def __init__(self, model: mujoco.MjModel, body, *, course_distribution: CourseDistribution,
-                 reward_weights: dict, visual_delay_s: float) -> None:
+                 reward_weights: dict, visual_delay_s: float, n_substeps: int) -> None:
         self.model = model
+        self.n_substeps = int(n_substeps)  # physics substeps per control step (the env's)
         self.body = body
         self.gait = body.gait
         self.pool = body.gait.pool
@@ -180,12 +181,20 @@ class ObstacleWalkTask:
         return None
 
     def needs_substep_checks(self, data: mujoco.MjData) -> bool:
-        """Contact checks every substep only while an obstacle is within reach of a leg."""
-        return self.pool.near(float(data.qpos[0]), float(data.qpos[1]), self.gait.CONTACT_RADIUS_M)
+        """Contact checks every substep only while an obstacle is within reach of a leg: then the
+        substeps are *watched* (:meth:`WalkerGait.watch_substeps`) and still run as one ``mj_step``
+        call (so this returns False); :meth:`check_substep`, called once after them, classifies their
+        contacts exactly as checks after every substep would have (replaying them when MuJoCo saw a
+        contact)."""
+        if self.pool.near(float(data.qpos[0]), float(data.qpos[1]), self.gait.CONTACT_RADIUS_M):
+            self.gait.watch_substeps(data)
+        return False
 
     def check_substep(self, data: mujoco.MjData) -> bool:
-        """Classify leg-obstacle contacts (:meth:`WalkerGait.check_contacts`): True on a new event."""
-        return self.gait.check_contacts(data)
+        """Classify leg-obstacle contacts (:meth:`WalkerGait.check_contacts`): True on a new event.
+        After watched substeps: as the env's substep loop would have (checks after each substep until
+        the first new event, then once more on the final kinematics)."""
+        return self.gait.watched_contacts(data, self.n_substeps)
 
     # --- observation --------------------------------------------------------------------------
     def before_observe(self, data: mujoco.MjData) -> None:
@@ -222,17 +231,18 @@ class ObstacleWalkTask:
     def observe_trailing(self, values: list, samples: list, data: mujoco.MjData) -> None:
         d = data
         sx, sy = self.body.start_xy
-        x, y = float(d.qpos[0]), float(d.qpos[1])
-        values += (x - sx, y - sy, float(d.qpos[3]) - self.body.start_yaw,
-                   self.course.length - (x - sx), float(d.time))
+        x, y, _, yaw = d.qpos[:4].tolist()
+        values += (x - sx, y - sy, yaw - self.body.start_yaw, self.course.length - (x - sx), d.time)
 
     # --- outcome ------------------------------------------------------------------------------
     def evaluate(self, data: mujoco.MjData, fired: bool, a: np.ndarray, eye) -> tuple[float, dict, bool, dict]:
         d = data
         g = self.gait
         new_trip = g.tripped and not self.tripped
-        new_missteps = sum(e.kind == "misstep" for e in g.events[self._n_events:])
-        self._n_events = len(g.events)
+        events = g.events
+        n_events = len(events)
+        new_missteps = sum(e.kind == "misstep" for e in events[self._n_events:]) if n_events != self._n_events else 0
+        self._n_events = n_events
         self.tripped = g.tripped
         self.misstepped = g.misstepped
         x = float(d.qpos[0])
@@ -248,6 +258,10 @@ class ObstacleWalkTask:
 
     def info(self, data: mujoco.MjData, *, diverged: bool = False) -> dict:
         """Step information (the course is true state: for scoring only, never for a policy)."""
+        if diverged and self.gait._watching:
+            # The physics diverged in watched substeps (the env returns before check_substep): their
+            # checks, as the substep loop made them before it noticed (no final check).
+            self.gait.watched_contacts(data, self.n_substeps, final=False, replay=True)
         return {
             "tripped": self.tripped,
             "misstepped": self.misstepped,
@@ -255,7 +269,7 @@ class ObstacleWalkTask:
             "events": len(self.gait.events),
             "obstacles_passed": self.n_passed,
             "obstacle_seen": False if diverged else any(self.seen),
-            "step_phase": self.gait.step_phase(),
+            "step_phase": (self.gait.tick % self.gait.T) / self.gait.T,  # gait.step_phase()
         }
 
 
