@@ -35,6 +35,10 @@ from .perception import ObstacleMemory, eye_motion
 from .planner import FootstepPlanner, PlannerParams
 
 _S = WALK_LAYOUT.slices
+# Where the blocks the agent reads start in the flat observation (read from a list of floats each step).
+_EYE_POS, _EYE_ROT, _ODOMETRY, _PELVIS = (_S[b].start for b in ("eye_pos", "eye_rot", "odometry", "pelvis"))
+_GAIT_PHASE, _FOOTHOLDS, _TIME = _S["gait_phase"].start, _S["footholds"].start, _S["time"].start
+_SLOTS = tuple(_S[f"obstacle_{k}"].start for k in range(K_SLOTS))
 NECK_PITCH_DOWN_DEG = 50.0  # the head action's -1 (envs_assets/common/head_eye.xml: neck_pitch -50 .. 40)
 
 
@@ -124,7 +128,7 @@ class IwaoAgent:
 
     def _act(self, obs: np.ndarray) -> np.ndarray:
         ol = obs.tolist()
-        e0, r0, o0, p0 = _S["eye_pos"].start, _S["eye_rot"].start, _S["odometry"].start, _S["pelvis"].start
+        e0, r0, o0, p0 = _EYE_POS, _EYE_ROT, _ODOMETRY, _PELVIS
         eye_pos = ol[e0:e0 + 3]
         rot = [ol[r0:r0 + 3], ol[r0 + 3:r0 + 6], ol[r0 + 6:r0 + 9]]
         odo = ol[o0:o0 + 3]
@@ -135,7 +139,7 @@ class IwaoAgent:
         seen_pose = self.poses[0] if len(self.poses) > self.delay_steps else pose
         self._perceive(ol, seen_pose)
 
-        g0 = _S["gait_phase"].start
+        g0 = _GAIT_PHASE
         phase, latch_in = ol[g0], ol[g0 + 2]
         if latch_in <= self.params.control_dt + 1e-6:  # this step's command is read at mid-stance
             self.footstep = self._plan(obs, odo)
@@ -150,8 +154,7 @@ class IwaoAgent:
         seen_eye = _eye_in_path(pose)
         prev, self.prev_seen_eye = self.prev_seen_eye, seen_eye
         motion = None if prev is None else eye_motion(prev, seen_eye, self.params.control_dt)
-        for k in range(K_SLOTS):
-            b = _S[f"obstacle_{k}"].start
+        for b in _SLOTS:
             near, far = ol[b + 7], ol[b + 8]
             if near == 0.0 and far == 0.0:
                 continue
@@ -215,7 +218,7 @@ class IwaoAgent:
         ex, ey, ez = _eye_in_path(pose)[0]
         sigma = gp.sigma_fraction * T
         fixating = abs(t - 0.5 * T) <= self.params.fixation_window_sigma * sigma
-        self.log.append((float(obs[_S["time"]][0]), self.target_id, head, eye))
+        self.log.append((float(obs[_TIME]), self.target_id, head, eye))
         self.eye_history.append((ex, ey, ez))
         n = len(self.eye_history)
         if n > self.period_steps + 1:

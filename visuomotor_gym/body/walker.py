@@ -372,6 +372,25 @@ class WalkerGait:
         from the nominal step width, positive to the left; ``clearance``: height of the lowest sole point
         over the swing's carry phase. Values are clipped to the ranges of :class:`GaitParams`."""
         p = self.p
+        if (length is not None and lateral is not None and clearance is not None and math.isfinite(length)
+                and math.isfinite(lateral) and math.isfinite(clearance)):
+            # The common case, clipped with the comparisons min(max(x, lo), hi) makes.
+            (l0, l1), (a0, a1), (c0, c1) = p.step_range_m, p.lateral_range_m, p.clearance_range_m
+            x, y, c = float(length), float(lateral), float(clearance)
+            if l0 > x:
+                x = l0
+            if l1 < x:
+                x = l1
+            if a0 > y:
+                y = a0
+            if a1 < y:
+                y = a1
+            if c0 > c:
+                c = c0
+            if c1 < c:
+                c = c1
+            self.pending = (x, y, c)
+            return
         for name, value in (("length", length), ("lateral", lateral), ("clearance", clearance)):
             if value is not None and not math.isfinite(value):
                 raise ValueError(f"footstep {name} must be finite, got {value}")

@@ -58,9 +58,10 @@ class WalkerBody:
         self._leg_qpos = [int(model.jnt_qposadr[j]) for j in leg]
         self._root_dof = [int(model.jnt_dofadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, n)])
                           for n in wn.WALKER_ROOT_JOINTS[:3]]
-        # The same indices as slices where they are consecutive (a slice reads faster than a list).
+        # The same indices as slices where they are evenly spaced (a slice reads faster than a list).
         self._leg_qpos_at = _as_slice(self._leg_qpos)
         self._root_dof_at = _as_slice(self._root_dof)
+        self._soles_at = _as_slice(self.gait.sole_sites)
         self.start_xy = (0.0, 0.0)
         self.start_yaw = 0.0
 
@@ -108,7 +109,7 @@ class WalkerBody:
         c, s = f._cos, f._sin
         ox, oy, oz = f.origin_list
         values += (oz, c * vx + s * vy, -s * vx + c * vy, vz)
-        for x, y, z in d.site_xpos[g.sole_sites].tolist():
+        for x, y, z in d.site_xpos[self._soles_at].tolist():
             dx, dy = x - ox, y - oy
             values += (c * dx + s * dy, -s * dx + c * dy, z - oz)
         n = (g.next_latch_tick - g.T_mid) // T + 2  # g.next_footstep_index
@@ -124,14 +125,19 @@ class WalkerBody:
         tick, T = g.tick, g.T
         return {
             "pelvis_pos": data.xpos[g.pelvis_body].copy(),
-            "feet_pos": data.site_xpos[g.sole_sites],  # fancy indexing: already a copy
+            "feet_pos": data.site_xpos[self._soles_at].copy(),
             "step_phase": (tick % T) / T,
             "stride_phase": (tick % (2 * T)) / (2 * T),
         }
 
 
 def _as_slice(indices: list[int]):
-    """``indices`` as a slice when they are consecutive and ascending, else the list itself."""
-    if indices and indices == list(range(indices[0], indices[0] + len(indices))):
-        return slice(indices[0], indices[0] + len(indices))
+    """``indices`` as a slice when they are evenly spaced and ascending (a slice reads faster than a
+    list of indices, and selects the same rows), else the list itself."""
+    if len(indices) >= 2 and indices[1] > indices[0]:
+        step = indices[1] - indices[0]
+        if indices == list(range(indices[0], indices[-1] + 1, step)):
+            return slice(indices[0], indices[-1] + 1, step)
+    elif len(indices) == 1:
+        return slice(indices[0], indices[0] + 1)
     return indices
