@@ -7,6 +7,7 @@ trips and missteps are read from ``data.contact``.
 from __future__ import annotations
 
 import math
+import pickle
 
 import mujoco
 import numpy as np
@@ -298,3 +299,77 @@ def test_throughput_benchmark_runs_and_reports_a_ratio(tmp_path):
     result = module.main(["--steps", "60", "--repeats", "1", "--json", str(tmp_path / "r.json")])
     assert result["ratio_walker_over_raw"] > 0 and (tmp_path / "r.json").exists()
     assert result["substeps_per_control_step"] == 10 and result["trips_and_missteps"] == 0
+
+
+def _per_substep_reference(gait, model, data, n, short_circuit):
+    """The plain contact checks: one mj_step per substep and a check after each (``short_circuit``: as
+    the env's substep loop, no check after the first that reports a new event)."""
+    new = False
+    for _ in range(n):
+        mujoco.mj_step(model, data)
+        if short_circuit:
+            if not new and gait.check_contacts(data):
+                new = True
+        else:
+            new |= gait.check_contacts(data)
+    return new
+
+
+@pytest.mark.parametrize("short_circuit", [False, True])
+def test_watched_substeps_classify_contacts_as_checks_after_every_substep(model, short_circuit):
+    """The watched substeps (one mj_step call, replayed from the saved state only when MuJoCo saw a
+    contact) give the same states, events and touches as checking after every substep, over walks
+    that trip, misstep and step over (bars of random heights, random footsteps)."""
+    rng = np.random.default_rng(3)
+    n_events = 0
+    for trial in range(3):
+        bars = [(2.0 + 1.3 * i + rng.uniform(-0.3, 0.3), rng.uniform(-0.2, 0.2), rng.uniform(0.03, 0.4),
+                 rng.uniform(0.3, 1.2), rng.uniform(0.05, 0.3)) for i in range(6)]
+        steps = [(rng.uniform(0.3, 0.9), rng.uniform(-0.2, 0.2), rng.uniform(0.0, 0.4)) for _ in range(300)]
+        runs = []
+        for watched in (False, True):
+            data = mujoco.MjData(model)
+            gait = WalkerGait(model)
+            gait.pool.park_all(model, data)
+            for i, bar in enumerate(bars):
+                gait.pool.place(model, data, i, *bar)
+            gait.reset(model, data)
+            log = []
+            for step in steps:
+                gait.set_next_footstep(*step)
+                gait.advance(data, DT)
+                if watched:
+                    gait.watch_substeps(data)
+                    mujoco.mj_step(model, data, nstep=NSUB)
+                    new = gait.watched_contacts(data, NSUB, every=not short_circuit, final=short_circuit)
+                else:
+                    new = _per_substep_reference(gait, model, data, NSUB, short_circuit)
+                    if short_circuit and not new:
+                        new = gait.check_contacts(data)  # the env's check on the final state
+                log.append((new, data.qpos.tobytes(), data.qvel.tobytes(), sorted(gait._touching)))
+            runs.append((log, [(e.time, e.kind, e.side, e.part, e.obstacle, e.normal_z) for e in gait.events]))
+        assert runs[0] == runs[1]
+        n_events += len(runs[0][1])
+    assert n_events > 0  # the walks did touch obstacles
+
+
+def test_watched_substeps_after_a_divergence_replay_the_checks(model):
+    """When the physics diverged (MuJoCo resets the data), ``replay=True`` still classifies the
+    contacts of the substeps before it from the saved state."""
+    data = mujoco.MjData(model)
+    gait = WalkerGait(model)
+    gait.pool.park_all(model, data)
+    gait.reset(model, data)
+    gait.pool.place(model, data, 0, float(data.qpos[0]) + 0.3, 0.0, 0.05, 1.0, 0.3)  # in the swing's way
+    for _ in range(40):
+        gait.advance(data, DT)
+        gait.watch_substeps(data)
+        mujoco.mj_step(model, data, nstep=NSUB)
+        if data.maxuse_con > 0:
+            break
+        gait.watched_contacts(data, NSUB)
+    assert data.maxuse_con > 0
+    mujoco.mj_resetData(model, data)  # what a divergence does to the data
+    assert gait.watched_contacts(data, NSUB, final=False, replay=True)
+    assert gait.events and not gait._watching
+    assert gait._scratch is not None and pickle.loads(pickle.dumps(gait))._scratch is None  # rebuilt on need

@@ -1,3 +1,4 @@
+# ruff: noqa: PLR1730, FURB136  (the per-step path writes min/max as the builtins' comparisons, on purpose)
 """The walker's scripted gait: a footstep-level interface on a kinematic gait that physics servos track.
 
 No learned gait (as footstep-planner controllers such as DeepLoco do): the pelvis follows a trajectory planned through the
