@@ -2,8 +2,8 @@
 physics on the same model and substeps, same run.
 
 The walk is a 20 m course with 10 cm bars every ~2 m, stepped over with a 20 cm toe clearance (so the
-per-substep contact checks near obstacles are exercised, and nothing trips); episodes restart at the
-end of the course. Each control step calls ``set_next_footstep``, ``advance`` and ``step_physics``. The
+contact checks near obstacles, the watched substeps of ``WalkerGait.step_physics``, are exercised, and
+nothing trips); episodes restart at the end of the course. Each control step calls ``set_next_footstep``, ``advance`` and ``step_physics``. The
 reference restores each recorded physics state (``mj_setState``) and calls ``mj_step`` with the same
 substeps, as ``benchmarks/env_throughput.py`` does for the envs. Issue 12 wants ObstacleWalk-v0 at
 >= 0.5 of raw physics; this is the body's share of that budget. Best of ``--repeats`` interleaved runs.

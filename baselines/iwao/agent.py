@@ -143,11 +143,10 @@ class IwaoAgent:
         phase, latch_in = ol[g0], ol[g0 + 2]
         if latch_in <= self.params.control_dt + 1e-6:  # this step's command is read at mid-stance
             self.footstep = self._plan(obs, odo)
-        action = np.zeros(8, dtype=np.float32)
-        action[0:3] = self.footstep
-        if not self.params.gaze_blind:
-            action[3:8] = self._look(obs, phase, pose)
-        return action
+        # (One float32 array from the list: the same rounding as writing into np.zeros(8, float32).)
+        if self.params.gaze_blind:
+            return np.array(self.footstep + [0.0, 0.0, 0.0, 0.0, 0.0], dtype=np.float32)
+        return np.array(self.footstep + self._look(obs, phase, pose), dtype=np.float32)
 
     def _perceive(self, ol: list, pose) -> None:
         eye_pos, rot_rows, odo = pose
