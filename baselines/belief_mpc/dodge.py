@@ -15,15 +15,17 @@ radius, 0.25 m here, it is ~1e-7 at 1 m and does not pull the gaze). This agent 
   of the catch agent (:func:`.belief.observation_variance`: the env's foveated model, the mean of the three
   positional variances, retinal slip), ``r = inf`` beyond the 20 deg field; the means follow the filters'
   constant velocity (Eom section 6's deterministic mean update), the eye the walker's present velocity.
-* **Not yet seen pedestrians** (no belief in Eom, who track perceived objects only): each of the
-  ``fajen_warren`` agent's search directions (40 and 70 deg to either side, 6 m away, where crossing
-  pedestrians appear) is a pseudo-object with a vague prior (``search_prior_var``), whose compact
+* **Not yet seen pedestrians** (no belief in Eom, who track perceived objects only): four search
+  directions (``search_dirs_deg``: 40 and 70 deg to either side, ``search_dist_m`` = 5 m away, where
+  crossing pedestrians appear) are pseudo-objects with a prior (``search_prior_var``), whose compact
   covariance is reduced by looking there as if a pedestrian stood there and grows again with ``alpha``
-  (modelling choice: so that the uncertainty term also asks for the search).
-* **Plan**: piecewise-constant fixation schedules over ``window_s`` (0.1 s nodes, <= 2 switches >= 0.2 s
-  apart, a switch blind for the saccade's duration) among at most 4 objects (the closest known
-  pedestrians first, then the most uncertain search directions), the one minimising
-  ``sum_k sum_j w_uct |sigma_j(k)|^2`` (Eom's c_uct) is executed through ``fajen_warren``'s gaze request.
+  (modelling choice: so that the uncertainty term also asks for the search); they are candidates only
+  while some pedestrian has not been seen.
+* **Plan**: piecewise-constant fixation schedules over ``window_s`` (0.1 s nodes, ``max_switches`` = 1
+  switch, >= 0.2 s after the last saccade, blind for the saccade's duration) among at most 4 objects
+  (the closest known pedestrians first, then the most uncertain search directions); the one minimising
+  ``sum_k sum_j w_uct |sigma_j(k)|^2`` (Eom's c_uct) gives the object to look at now, and the eye is
+  asked for its direction (``_look``: ``fajen_warren``'s request, the head ``look_head_share`` of it).
 
 Every other constant is ``fajen_warren``'s.
 """
