@@ -43,7 +43,7 @@ def test_every_rung_runs_from_the_registry_on_the_same_crowd(env_id):
     _, ref_info = ObstacleDodgeEnv().reset(seed=7)
     np.testing.assert_array_equal(info["pedestrians"], ref_info["pedestrians"])  # same scenario on every rung
     for _ in range(5):
-        obs, r, term, trunc, info = env.step(env.action_space.sample())
+        obs, _r, _term, _trunc, info = env.step(env.action_space.sample())
         assert env.observation_space.contains(obs) and np.isfinite(obs).all()
 
 
@@ -130,7 +130,7 @@ def test_crowd_sampler_follows_its_distribution():
     for _ in range(400):
         crowd = sample_crowd(rng, dist)
         assert 15.0 <= crowd.goal <= 20.0 and crowd.pedestrians.shape == (N_PEDESTRIANS, 9)
-        onset, x0, y0, vx, vy, xc = crowd.pedestrians[:, :6].T
+        onset, _x0, y0, vx, vy, xc = crowd.pedestrians[:, :6].T
         assert np.all(np.diff(onset) >= 1.5 - 1e-9)
         assert np.all((np.abs(y0) >= 4.0 - 1e-9) & (np.abs(y0) <= 6.0 / math.cos(math.radians(30)) + 1e-9))
         speed = np.hypot(vx, vy)
@@ -174,7 +174,7 @@ def test_heading_action_moves_the_walker_sideways():
     act[0] = 1.0  # 30 deg left (the gait gives ~18 deg)
     path = []
     for _ in range(200):
-        _, _, done, _, info = env.step(act)
+        _, _, _done, _, info = env.step(act)
         path.append(info["pelvis_pos"][:2])
     (x0, y0), (x1, y1) = path[100], path[200 - 1]
     # Left steps 0.12 + 0.3 m, right steps -0.06 m (feet never closer than 0.06 m): 0.36 m per 1.13 m stride
