@@ -38,6 +38,8 @@ def main(argv=None) -> None:
     parser.add_argument("--out", type=Path, required=True)
     parser.add_argument("--base", type=float, default=None,
                         help="catch rate of the residual's base (belief_intercept) on EyeCatch-v0, drawn as a line")
+    parser.add_argument("--line", action="append", default=[], metavar="RATE=LABEL",
+                        help="a horizontal reference line (catch rate in [0, 1] and its label); repeatable")
     args = parser.parse_args(argv)
     fig = Figure(figsize=(13, 6.5), layout="constrained")
     FigureCanvasAgg(fig)
@@ -64,6 +66,11 @@ def main(argv=None) -> None:
         ax_min.axhline(args.base, color="0.3", lw=1.0, ls=":")
         ax_steps.axhline(args.base, color="0.3", lw=1.0, ls=":",
                          label=f"belief_intercept on EyeCatch-v0, nothing learned: {args.base:.0%} (200 throws)")
+    for k, item in enumerate(args.line):
+        rate, _, text = item.partition("=")
+        style = dict(color=f"C{k + 5}", lw=1.0, ls="-.")
+        ax_min.axhline(float(rate), **style)
+        ax_steps.axhline(float(rate), label=text, **style)
     fig.legend(*ax_steps.get_legend_handles_labels(), loc="outside lower center", ncols=2, fontsize=7)
     args.out.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(args.out, dpi=110)

@@ -52,6 +52,16 @@ class _Recorder:
         return out
 
 
+def median_curve(traces, grid) -> np.ndarray:
+    """Median (over throws) angle between the line of sight and the ball at each time of ``grid``."""
+    curves = [np.interp(grid, tr.t, gaze_error_deg(tr), right=np.nan) for tr in traces]
+    with np.errstate(all="ignore"):
+        return np.nanmedian(np.array(curves), axis=0)
+
+
+GRID = np.arange(0.0, 1.6, 0.02)
+
+
 def measure(spec: str, env_id: str, episodes: int, seed: int = 0) -> dict:
     env = make_env(env_id)
     policy = _Recorder(make_agent(spec, env_id, action_dim=int(env.action_space.shape[0]), seed=seed))
@@ -69,6 +79,7 @@ def measure(spec: str, env_id: str, episodes: int, seed: int = 0) -> dict:
         "ball_within_10deg": float(np.mean(errors < 10.0)),
         "saccades_per_throw": float(np.mean([tr.saccade_onset.sum() for tr in traces])),
         "outcomes": [bool(tr.caught) for tr in traces],
+        "median_angle_curve_deg": [None if math.isnan(v) else round(float(v), 4) for v in median_curve(traces, GRID)],
     }
     if policy.policy_actions:
         acts = np.array(policy.policy_actions)
@@ -84,7 +95,9 @@ def main(argv=None) -> None:
     parser.add_argument("--env", default="EyeCatch-v0")
     parser.add_argument("--agents", nargs="+", required=True)
     parser.add_argument("--episodes", type=int, default=200)
-    parser.add_argument("--out", type=Path, required=True)
+    parser.add_argument("--labels", nargs="*", default=None, help="one legend label per agent")
+    parser.add_argument("--out", type=Path, required=True, help="JSON of the rows")
+    parser.add_argument("--png", type=Path, default=None, help="also plot the median gaze angle against time")
     args = parser.parse_args(argv)
     rows = []
     for spec in args.agents:
@@ -103,6 +116,31 @@ def main(argv=None) -> None:
               f"{100 * r['ball_within_2deg']:.0f} % | {100 * r['ball_within_5deg']:.0f} % | "
               f"{100 * r['ball_within_10deg']:.0f} % | {r['saccades_per_throw']:.1f} | "
               f"{'–' if gate is None or math.isnan(gate) else f'{100 * gate:.0f} %'} |")
+    if args.png:
+        plot(rows, args.labels or args.agents, args.env, args.episodes, args.png)
+
+
+def plot(rows, labels, env_id, episodes, out: Path) -> None:
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(8.5, 4.5), layout="constrained")
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot()
+    for r, label in zip(rows, labels):
+        curve = np.array([np.nan if v is None else v for v in r["median_angle_curve_deg"]], dtype=float)
+        ax.plot(GRID, curve, label=f"{label} ({100 * r['catch_rate']:.1f} %, "
+                                   f"{100 * r['ball_within_5deg']:.0f} % of steps within 5°)")
+    ax.axhline(5.0, color="k", lw=0.8, ls="--")
+    ax.set_xlabel("time since the throw (s)")
+    ax.set_ylabel("median angle, line of sight to ball (deg)")
+    ax.set_title(f"{env_id}: where the eye looks, {episodes} pinned throws")
+    ax.set_yscale("log")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out, dpi=110)
+    print(f"wrote {out}")
 
 
 if __name__ == "__main__":
