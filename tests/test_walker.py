@@ -373,3 +373,100 @@ def test_watched_substeps_after_a_divergence_replay_the_checks(model):
     assert gait.watched_contacts(data, NSUB, final=False, replay=True)
     assert gait.events and not gait._watching
     assert gait._scratch is not None and pickle.loads(pickle.dumps(gait))._scratch is None  # rebuilt on need
+
+
+def _reference_targets(gait, tick):
+    """The gait's joint targets by the plain formulas (FootPlan-free copies of the original
+    ``_stance_foot``, ``_swing_foot``, ``targets_at`` with numpy's clip), for the bit-identity test."""
+    from visuomotor_gym.body.walker import DEG, _smooth
+
+    p, g = gait.p, gait
+
+    def stance(j, s_tick):
+        u, v = g.u[j], g.v[j]
+        if s_tick < g.T_ds:
+            pitch = p.heel_strike_deg * DEG * (1.0 - _smooth(s_tick / g.T_ds))
+            au, az = g._foot_from_pivot(u - g.l_heel, -g.l_heel, pitch)
+        elif s_tick < g.T_ho:
+            pitch, au, az = 0.0, u, g.h_ankle
+        else:
+            pitch = -p.toe_off_deg * DEG * _smooth((s_tick - g.T_ho) / (g.T + g.T_ds - g.T_ho))
+            au, az = g._foot_from_pivot(u + g.l_toe, g.l_toe, pitch)
+        return au, v, az, pitch, True, 0.0
+
+    def swing(j_from, j_to, tau):
+        a0u, _ = g._foot_from_pivot(g.u[j_from] + g.l_toe, g.l_toe, -p.toe_off_deg * DEG)
+        a1u, _ = g._foot_from_pivot(g.u[j_to] - g.l_heel, -g.l_heel, p.heel_strike_deg * DEG)
+        m0, m1 = p.swing_move
+        prog = _smooth((tau - m0) / (m1 - m0))
+        au = a0u + (a1u - a0u) * prog
+        av = g.v[j_from] + (g.v[j_to] - g.v[j_from]) * prog
+        pitch = (-p.toe_off_deg * (1.0 - _smooth(tau / 0.4)) + p.heel_strike_deg * _smooth((tau - 0.6) / 0.4)) * DEG
+        if tau < p.swing_rise:
+            lift = _smooth(tau / p.swing_rise)
+        elif tau > p.swing_fall:
+            lift = _smooth((1.0 - tau) / (1.0 - p.swing_fall))
+        else:
+            lift = 1.0
+        h = g.clearance[j_to] * lift
+        sp, cp = math.sin(pitch), math.cos(pitch)
+        lowest = min(g.l_toe * sp, -g.l_heel * sp) - g.h_ankle * cp
+        return au, av, h - lowest, pitch, False, h
+
+    def leg_ik(fx, fy, fz):
+        roll = math.atan2(fy, -fz)
+        dperp = math.sqrt(fy * fy + fz * fz)
+        d2 = min(fx * fx + dperp * dperp, g.d_max * g.d_max)
+        cos_k = (d2 - g.L1 * g.L1 - g.L2 * g.L2) / (2.0 * g.L1 * g.L2)
+        knee = math.acos(min(max(cos_k, -1.0), 1.0))
+        hip = math.atan2(fx, dperp) + math.atan2(g.L2 * math.sin(knee), g.L1 + g.L2 * math.cos(knee))
+        return roll, hip, knee
+
+    pu, pv = g._pelvis_uv(tick)
+    phase = 2.0 * math.pi * ((tick - g.T_mid) % g.T) / g.T
+    z = p.pelvis_height_m - 0.5 * p.bob_m * (1.0 - math.cos(phase))
+    k = tick // g.T
+    s = tick - k * g.T
+    lead = stance(k, s)
+    trail = stance(k - 1, s + g.T) if s < g.T_ds else swing(k - 1, k + 1, (s - g.T_ds) / (g.T - g.T_ds))
+    feet = (lead, trail) if k % 2 == 0 else (trail, lead)
+    hips = []
+    for side, foot in enumerate(feet):
+        hy = g.hip_y if side == 0 else -g.hip_y
+        du, dv = foot[0] - pu, foot[1] - (pv + hy)
+        zmax = foot[2] + math.sqrt(max(g.d_max * g.d_max - du * du - dv * dv, 0.0))
+        if zmax < z:  # noqa: PLR1730 (the original's form)
+            z = zmax
+        hips.append((du, dv))
+    out = [g.origin[0] + g._c * pu - g._s * pv, g.origin[1] + g._s * pu + g._c * pv, z, g.yaw]
+    for side, foot in enumerate(feet):
+        fx, fy = hips[side]
+        roll, hip, knee = leg_ik(fx, fy, foot[2] - z)
+        ankle = foot[3] - (hip - knee)
+        ia, n_fix = 7 + 5 * side, 0
+        while not foot[4] and not g._lo[ia] <= ankle <= g._hi[ia] and n_fix < 4:
+            pitch = min(max(ankle, g._lo[ia]), g._hi[ia]) + (hip - knee)
+            sp, cp = math.sin(pitch), math.cos(pitch)
+            lowest = min(g.l_toe * sp, -g.l_heel * sp) - g.h_ankle * cp
+            roll, hip, knee = leg_ik(fx, fy, foot[5] - lowest - z)
+            ankle = pitch - (hip - knee)
+            n_fix += 1
+        out += [roll, hip, knee, ankle, -roll]
+    arm = p.arm_swing_deg * DEG * math.cos(math.pi * (tick % (2 * g.T)) / g.T)
+    out += [-arm, arm]
+    return np.minimum(np.maximum(np.array(out), np.array(g._lo)), np.array(g._hi))
+
+
+def test_targets_are_bit_identical_to_the_plain_formulas(model):
+    """The per-step path (scalar Python, cached constants, comparisons for min/max) gives the very
+    floats of the plain formulas, over random footsteps (long, wide, high swings that hit the ankle's
+    limit) and headings."""
+    rng = np.random.default_rng(7)
+    gait = WalkerGait(model)
+    for _ in range(4):
+        gait.reset_plan(*rng.uniform(-3.0, 3.0, 2), rng.uniform(-1.0, 1.0))
+        for tick in range(-250, 1500):
+            while gait.next_latch_tick <= tick + 1:
+                gait.set_next_footstep(rng.uniform(0.2, 1.0), rng.uniform(-0.35, 0.35), rng.uniform(0.0, 0.5))
+                gait._latch()
+            assert gait.targets_at(tick).tobytes() == _reference_targets(gait, tick).tobytes(), tick
