@@ -55,7 +55,10 @@ class _Recorder:
 def median_curve(traces, grid) -> np.ndarray:
     """Median (over throws) angle between the line of sight and the ball at each time of ``grid``."""
     curves = [np.interp(grid, tr.t, gaze_error_deg(tr), right=np.nan) for tr in traces]
-    with np.errstate(all="ignore"):
+    import warnings
+
+    with warnings.catch_warnings():  # late times no throw reaches are all-NaN columns
+        warnings.simplefilter("ignore", RuntimeWarning)
         return np.nanmedian(np.array(curves), axis=0)
 
 
@@ -94,11 +97,17 @@ def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--env", default="EyeCatch-v0")
     parser.add_argument("--agents", nargs="+", required=True)
+    parser.add_argument("--replot", type=Path, default=None,
+                        help="plot these agents' rows from an earlier --out JSON instead of playing them")
     parser.add_argument("--episodes", type=int, default=200)
     parser.add_argument("--labels", nargs="*", default=None, help="one legend label per agent")
     parser.add_argument("--out", type=Path, required=True, help="JSON of the rows")
     parser.add_argument("--png", type=Path, default=None, help="also plot the median gaze angle against time")
     args = parser.parse_args(argv)
+    if args.replot:
+        saved = {r["agent"]: r for r in json.loads(args.replot.read_text())["rows"]}
+        plot([saved[a] for a in args.agents], args.labels or args.agents, args.env, args.episodes, args.png or args.out)
+        return
     rows = []
     for spec in args.agents:
         rows.append(measure(spec, args.env, args.episodes))
@@ -124,7 +133,7 @@ def plot(rows, labels, env_id, episodes, out: Path) -> None:
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    fig = Figure(figsize=(8.5, 4.5), layout="constrained")
+    fig = Figure(figsize=(8.5, 6.2), layout="constrained")
     FigureCanvasAgg(fig)
     ax = fig.add_subplot()
     for r, label in zip(rows, labels):
@@ -137,7 +146,7 @@ def plot(rows, labels, env_id, episodes, out: Path) -> None:
     ax.set_title(f"{env_id}: where the eye looks, {episodes} pinned throws")
     ax.set_yscale("log")
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=7)
+    fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center", ncols=1, fontsize=7)
     out.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(out, dpi=110)
     print(f"wrote {out}")
