@@ -87,6 +87,7 @@ ENV_SPECS = ENV_SPECS + vision_rungs("ShelfReach", REACH_ENTRY_POINT, family="re
                                      max_episode_steps=REACH_MAX_EPISODE_STEPS, what="object")
 ENV_IDS = tuple(spec.id for spec in ENV_SPECS)
 FAMILIES: dict[str, tuple[str, ...]] = {}
+WALKER_FAMILIES = ("walk", "stones", "dodge")  # the families on the walker body (its 20 deg recognition field)
 for _spec in ENV_SPECS:
     FAMILIES[_spec.family] = FAMILIES.get(_spec.family, ()) + (_spec.id,)
 CATCH_ENV_IDS = FAMILIES["catch"]
@@ -113,17 +114,21 @@ def env_vision(env_id: str) -> dict:
     }
 
 
-def vision_params_for(kwargs: dict):
-    """The ``VisionParams`` an ``EyeCatchEnv`` built with ``kwargs`` gives its agent's brain to model.
+def vision_params_for(kwargs: dict, defaults=None):
+    """The ``VisionParams`` an env built with ``kwargs`` gives its agent's brain to model.
 
-    As the env builds its own (``vision_params`` fields, times ``vision_noise_scale``; ``full_view``
-    drops foveation), except that ``vision="oracle"`` gives noise scale 0 and no foveation (the true
-    state: nothing to weight).
+    As the env builds its own (``vision_params`` fields over the family's ``defaults`` -- the catch
+    family's ``VisionParams()`` when None -- times ``vision_noise_scale``; ``full_view`` drops
+    foveation), except that ``vision="oracle"`` gives noise scale 0 and no foveation (the true state:
+    nothing to weight).
     """
     from visuomotor_gym.vision.foveation import VisionParams
 
     base = kwargs.get("vision_params") or {}
-    params = base if isinstance(base, VisionParams) else VisionParams(**base)
+    if isinstance(base, VisionParams):
+        params = base
+    else:
+        params = VisionParams(**{**(asdict(defaults) if defaults is not None else {}), **base})
     mode = kwargs.get("vision", "foveated")
     params = params.scaled(0.0 if mode == "oracle" else float(kwargs.get("vision_noise_scale", 1.0)))
     if mode != "foveated":
@@ -132,8 +137,14 @@ def vision_params_for(kwargs: dict):
 
 
 def env_vision_params(env_id: str):
-    """:func:`vision_params_for` the registered kwargs of ``env_id``: every vision constant of its eye."""
-    return vision_params_for(gym.spec(env_id).kwargs or {})
+    """:func:`vision_params_for` the registered kwargs of ``env_id``: every vision constant of its eye
+    (the walker families' defaults have Iwao's 20 deg recognition field, ``envs.walk.WALK_VISION``)."""
+    defaults = None
+    if family_of(env_id) in WALKER_FAMILIES:
+        from visuomotor_gym.envs.walk import WALK_VISION
+
+        defaults = WALK_VISION
+    return vision_params_for(gym.spec(env_id).kwargs or {}, defaults)
 
 
 def register_envs() -> None:

@@ -30,12 +30,17 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import asdict, dataclass, fields, replace
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
-
-from visuomotor_gym.baselines.lookahead.agent import NECK_PITCH_DOWN_DEG, NECK_YAW_DEG, LookaheadAgent, LookaheadParams
+from visuomotor_gym.baselines.lookahead.agent import (
+    NECK_PITCH_DOWN_DEG,
+    NECK_YAW_DEG,
+    LookaheadAgent,
+    LookaheadParams,
+)
 from visuomotor_gym.baselines.lookahead.perception import STONE_PLANE_Z, StoneMemory
+
 from visuomotor_gym.body.walker import GaitParams
 from visuomotor_gym.envs.stones import STONES_LAYOUT
 from visuomotor_gym.registration import env_vision, env_vision_params
@@ -94,27 +99,10 @@ class StonesBeliefMPCParams(LookaheadParams):
 
 
 def stones_vision(env_id: str) -> VisionParams:
-    """The ``VisionParams`` of a registered stones env's eye, as the env builds them: the walk family's
-    defaults (``WALK_VISION``: the 20 deg field) under the id's ``vision_params`` fields, scaled by its
-    noise scale, unfoveated off the foveated rung. (``registration.env_vision_params`` starts from
-    the catch family's 60 deg field; the planner's ``r`` needs the real field.)"""
-    import gymnasium as gym
-
-    from visuomotor_gym.envs.walk import WALK_VISION
-
-    kw = gym.spec(env_id).kwargs or {}
-    given = kw.get("vision_params")
-    if isinstance(given, VisionParams):
-        params = given
-    else:
-        params = VisionParams(**{**asdict(WALK_VISION), **(given or {})})
-    mode = kw.get("vision", "foveated")
-    params = params.scaled(0.0 if mode == "oracle" else float(kw.get("vision_noise_scale", 1.0)))
-    if mode != "foveated":
-        params = replace(params, foveated=False)
-    ref = env_vision_params(env_id)  # every other constant as the registry gives it
-    assert (ref.noise_scale, ref.foveated) == (params.noise_scale, params.foveated)
-    return params
+    """The ``VisionParams`` of a registered walker-family env's eye, as the env builds them (the walk
+    family's 20 deg field under the id's ``vision_params`` fields, scaled by its noise scale,
+    unfoveated off the foveated rung): :func:`~visuomotor_gym.registration.env_vision_params`."""
+    return env_vision_params(env_id)
 
 
 class StonesBeliefMPCAgent(LookaheadAgent):

@@ -179,15 +179,24 @@ def _belief_mpc_export(spec: str, env_id: str) -> bytes:
     if name != "belief_mpc":
         raise ValueError(f"the {BELIEF_MPC_FORMAT} format serves the belief_mpc agent, not {name!r}")
     import visuomotor_gym  # noqa: F401  (registers the ids for gym.spec)
+    from visuomotor_gym.registration import family_of
 
-    params = asdict(BeliefMPCAgent.for_env(env_id, **overrides).params)
+    if family_of(env_id) == "stones":  # the stones agent (baselines/belief_mpc/stones.py, issue 13)
+        from visuomotor_gym.baselines.belief_mpc.stones import StonesBeliefMPCAgent
+
+        params = asdict(StonesBeliefMPCAgent.for_env(env_id, **overrides).params)
+        note = ("Every StonesBeliefMPCParams field as StonesBeliefMPCAgent.for_env(env_id, **overrides) resolves "
+                "it; the policy is StonesBeliefMPCAgent(StonesBeliefMPCParams(**params), vision=stones_vision(env_id)).")
+    else:
+        params = asdict(BeliefMPCAgent.for_env(env_id, **overrides).params)
+        note = ("Every BeliefMPCParams field as BeliefMPCAgent.for_env(env_id, **overrides) resolves it; "
+                "the policy is BeliefMPCAgent(BeliefMPCParams(**params)).")
     obj = {
         "format": BELIEF_MPC_FORMAT,
         "format_version": 1,
         "agent": spec,
         "env_id": env_id,
-        "note": "Every BeliefMPCParams field as BeliefMPCAgent.for_env(env_id, **overrides) resolves it; "
-        "the policy is BeliefMPCAgent(BeliefMPCParams(**params)).",
+        "note": note,
         "params": params,
     }
     return (json.dumps(obj, indent=2, allow_nan=False) + "\n").encode("utf-8")
@@ -196,8 +205,18 @@ def _belief_mpc_export(spec: str, env_id: str) -> bytes:
 def _belief_mpc_load(data: bytes, env_id: str) -> Policy:
     from visuomotor_gym.baselines.belief_mpc import BeliefMPCAgent
     from visuomotor_gym.baselines.belief_mpc.agent import BeliefMPCParams
+    from visuomotor_gym.registration import family_of
 
     obj = _read_json_policy(data, BELIEF_MPC_FORMAT, env_id)
+    if family_of(env_id) == "stones":
+        from visuomotor_gym.baselines.belief_mpc.stones import (
+            StonesBeliefMPCAgent,
+            StonesBeliefMPCParams,
+            stones_vision,
+        )
+
+        params = _typed_params(obj["params"], StonesBeliefMPCParams, "StonesBeliefMPCParams")
+        return StonesBeliefMPCAgent(StonesBeliefMPCParams(**params), vision=stones_vision(env_id))
     params = _typed_params(obj["params"], BeliefMPCParams, "BeliefMPCParams")
     return BeliefMPCAgent(BeliefMPCParams(**params))
 
