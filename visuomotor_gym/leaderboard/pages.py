@@ -165,6 +165,35 @@ def _series(rows: list[Row]) -> list[str]:
     return names
 
 
+TWIN_PREFIX = "gaze-blind-"
+
+
+def _base_agent(name: str) -> str:
+    """The agent an entry name belongs to, for its colour: without the gaze-blind twin's prefix and the
+    version suffix (``gaze-blind-eyecatch-v2`` and ``eyecatch-v4`` are both ``eyecatch``)."""
+    base = name.removeprefix(TWIN_PREFIX)
+    head, sep, tail = base.rpartition("-v")
+    return head if sep and tail.isdigit() else base
+
+
+def _colours(names: list[str]) -> dict[str, str]:
+    """One colour per agent (an agent's versions and its gaze-blind twin share it)."""
+    bases: list[str] = []
+    for n in names:
+        if _base_agent(n) not in bases:
+            bases.append(_base_agent(n))
+    return {n: PALETTE[bases.index(_base_agent(n)) % len(PALETTE)] for n in names}
+
+
+def _family(env_id: str) -> str:
+    from visuomotor_gym.registration import family_of
+
+    try:
+        return family_of(env_id)
+    except (KeyError, ValueError):
+        return env_id
+
+
 # ------------------------------------------------------------------------------ README.md
 
 
@@ -330,7 +359,8 @@ def _empty(ident: str, label: str) -> str:
 
 
 def svg_catch_rate(rows: list[Row], ladder: list[str]) -> str:
-    """Catch rate with its 95 % interval per env id (x: the ladder), one colour per agent name."""
+    """Catch rate with its 95 % interval per env id (x: the ladder), one colour per agent (its versions
+    and its gaze-blind twin, hollow and dashed, share it); lines join an agent's ids of one family."""
     label = "Success rate (catch rate) with 95 % Wilson interval per env id, along the observability ladder"
     if not rows or not ladder:
         return _empty("plot-catch-rate", label)
@@ -371,16 +401,31 @@ def svg_catch_rate(rows: list[Row], ladder: list[str]) -> str:
         f'<text x="{left + step * len(ladder) / 2:.1f}" y="{height - 6}" text-anchor="middle" '
         f'class="muted">more observable ← → less observable</text>'
     )
+    colours = _colours(names)
+
+    def marker(cx, cy, name):  # filled: the agent; hollow: its gaze-blind twin
+        color = colours[name]
+        fill = "#ffffff" if name.startswith(TWIN_PREFIX) else color
+        return f'<circle class="point" cx="{cx:.1f}" cy="{cy:.1f}" r="5" fill="{fill}" stroke="{color}" stroke-width="2"/>'
+
     for k, name in enumerate(names):
-        color = PALETTE[k % len(PALETTE)]
+        color = colours[name]
         mine = [r for r in rows if r.name == name and r.env_id in ladder]
         mine.sort(key=lambda r: ladder.index(r.env_id))
-        if len(mine) > 1:
-            pts = " ".join(f"{x(r.env_id, k):.1f},{y(r.rate):.1f}" for r in mine)
-            parts.append(
-                f'<polyline points="{pts}" fill="none" stroke="{color}" stroke-width="1.5" '
-                f'stroke-opacity="0.6"/>'
-            )
+        runs: list[list[Row]] = []  # lines join an agent's points within one family's ids only
+        for r in mine:
+            if runs and _family(runs[-1][-1].env_id) == _family(r.env_id):
+                runs[-1].append(r)
+            else:
+                runs.append([r])
+        dash = ' stroke-dasharray="4 3"' if name.startswith(TWIN_PREFIX) else ""
+        for run in runs:
+            if len(run) > 1:
+                pts = " ".join(f"{x(r.env_id, k):.1f},{y(r.rate):.1f}" for r in run)
+                parts.append(
+                    f'<polyline points="{pts}" fill="none" stroke="{color}" stroke-width="1.5" '
+                    f'stroke-opacity="0.6"{dash}/>'
+                )
         for r in mine:
             xx = x(r.env_id, k)
             lo, hi = y(r.ci[0]), y(r.ci[1])
@@ -390,16 +435,13 @@ def svg_catch_rate(rows: list[Row], ladder: list[str]) -> str:
                 + _line(xx, lo, xx, hi, color, "2")
                 + _line(xx - 4, lo, xx + 4, lo, color, "2")
                 + _line(xx - 4, hi, xx + 4, hi, color, "2")
-                + f'<circle class="point" cx="{xx:.1f}" cy="{y(r.rate):.1f}" r="5" fill="{color}"/></g>'
+                + marker(xx, y(r.rate), r.name) + "</g>"
             )
     lx = left + step * len(ladder) + 24
     for k, name in enumerate(names):
-        color = PALETTE[k % len(PALETTE)]
         ly = top + 10 + 22 * k
-        parts.append(
-            f'<circle cx="{lx}" cy="{ly}" r="5" fill="{color}"/>'
-            f'<text x="{lx + 12}" y="{ly + 4}" class="legend">{E(name)}</text>'
-        )
+        parts.append(marker(lx, ly, name).replace(' class="point"', "")
+                     + f'<text x="{lx + 12}" y="{ly + 4}" class="legend">{E(name)}</text>')
     parts.append("</svg>")
     return "\n".join(parts)
 
@@ -510,10 +552,10 @@ def svg_latency(rows: list[Row]) -> str:
             f'<text x="{xx - 4:.1f}" y="{top + 4}" text-anchor="end" class="muted">{p:g} ms control period'
             f"</text>"
         )
-    names = _series(rows)
+    colours = _colours(_series(rows))
     for i, r in enumerate(rows):
         yy = top + row_h * i + row_h / 2
-        color = PALETTE[names.index(r.name) % len(PALETTE)]
+        color = colours[r.name]
         parts.append(
             f'<text x="{label_w - 8}" y="{yy + 4:.1f}" text-anchor="end" class="tick">'
             f"{E(r.name)} · {E(r.env_id)}</text>"
