@@ -107,6 +107,27 @@ def test_hyperparameters_resolve_default_then_env_then_overrides():
         train.load_config(train.parse_args(["--set", "not_a_key=1"]))
 
 
+def test_walk_id_trains_without_the_catch_features_and_its_npz_walks(tmp_path):
+    """ObstacleWalk-v0 (issue 15): its hyperparameters replace the catch family's shaped reward (only the
+    env's own progress term is shaped), no belief features; a tiny run packs to ppo-npz and is scored."""
+    config = train.load_config(train.parse_args(["--env", "ObstacleWalk-v0"]))
+    assert config["belief"] is False and config["hand_action"] == "absolute" and config["intercept_shaping"] == 0.0
+    assert config["env_kwargs"] == {"reward_weights": {"progress": 0.05}} and "replace" not in config
+    catch = train.load_config(train.parse_args(["--env", "EyeCatch-v0"]))
+    assert catch["env_kwargs"]["reward"] == "shaped"  # the catch ids still merge with the default
+    run = train.main(["--env", "ObstacleWalk-v0", "--timesteps", "256", "--out", str(tmp_path), "--run-name", "t",
+                      "--no-progress-bar", "--set", "n_envs=2", "n_steps=128", "batch_size=128", "eval_freq=100000",
+                      "eval_episodes=1", "checkpoint_freq=100000"])
+    meta = json.loads((run / "ppo_meta.json").read_text())
+    assert meta["env_id"] == "ObstacleWalk-v0" and not meta["belief"] and len(meta["obs_mean"]) == 94
+    from visuomotor_gym.baselines.ppo.agent import pack_npz
+
+    npz = tmp_path / "walk.npz"
+    npz.write_bytes(pack_npz(run))
+    result = evaluate(f"ppo:{npz}", "ObstacleWalk-v0", 1, 0, workers=1)
+    assert result.summary["episodes"] == 1 and result.traces[0].action.shape[1] == 8
+
+
 def test_ppo_agent_needs_a_policy_file():
     with pytest.raises(ValueError, match="needs a policy file"):
         make_agent("ppo", "EyeCatch-v0", 9)

@@ -106,8 +106,10 @@ def load_config(args: Args) -> dict:
     else:
         table = yaml.safe_load(resources.files("visuomotor_gym.baselines.ppo").joinpath("hyperparams.yml").read_text())
     config = copy.deepcopy(table["default"])
-    for key, value in (table.get(args.env) or {}).items():
-        if isinstance(value, dict) and isinstance(config.get(key), dict):
+    entry = dict(table.get(args.env) or {})
+    replace = set(entry.pop("replace", []) or [])  # keys whose dict replaces the default's (not merged)
+    for key, value in entry.items():
+        if isinstance(value, dict) and isinstance(config.get(key), dict) and key not in replace:
             config[key] = {**config[key], **value}
         else:
             config[key] = value
