@@ -214,6 +214,29 @@ def test_gated_gaze_maps_the_look_gate_to_the_belief_request_and_zero_to_held_ga
         BeliefFeatures("EyeCatch-v0", "intercept", gaze_action="look")
 
 
+def test_frozen_gaze_action_sees_what_gated_sees_and_holds_gaze_and_head():
+    """gaze_action="frozen" (a policy *trained* with its gaze held): the gated mode's inputs, the env's
+    9 action values, gaze and head held at 0 whatever the policy says; hand, grasp, fixation its own."""
+    import gymnasium as gym
+
+    from visuomotor_gym.baselines.ppo.belief import BeliefFeatures
+
+    env = gym.make("EyeCatch-v0")
+    obs, _ = env.reset(seed=5)
+    frozen = BeliefFeatures("EyeCatch-v0", "intercept", gaze_action="frozen")
+    gated = BeliefFeatures("EyeCatch-v0", "intercept", gaze_action="gated")
+    assert frozen.action_dim == 9 and frozen.size == gated.size == 10 + 4 + 3
+    np.testing.assert_array_equal(frozen(obs), gated(obs))
+    a = np.array([0.2, -0.1, 0.3, 0.9, 1.0, -1.0, 0.4, 0.7, -0.6], np.float32)
+    out = frozen.env_action(a)
+    np.testing.assert_array_equal(out[4:6], [0.0, 0.0])  # gaze
+    np.testing.assert_array_equal(out[7:9], [0.0, 0.0])  # head
+    assert out[3] == np.float32(0.9) and out[6] == np.float32(0.4)  # grasp and fixation pass through
+    np.testing.assert_array_equal(out[:3], gated.env_action(np.append(a, -1.0))[:3])  # the same hand residual
+    with pytest.raises(ValueError, match="needs hand_action='intercept'"):
+        BeliefFeatures("EyeCatch-v0", "absolute", gaze_action="frozen")
+
+
 def test_gated_base_looks_only_with_the_gate_on():
     """The structure's fixed bases: gate 0 (the zero action) never saccades; gate on saccades to and
     pursues the believed ball, so the ball is much nearer the line of sight."""

@@ -29,6 +29,11 @@ So *how* to look at the believed ball is given by the structure; *whether and wh
 gate), the head, the residual gaze, grasp and the hand residual are the policy's. Before the filter
 has a sample, the gate does nothing (there is no believed ball to look at).
 
+With ``gaze_action="frozen"`` the inputs are the gated mode's, the action is the env's 9 values, and
+the gaze and head blocks are held at 0 whatever the policy outputs (as ``gaze_blind:<agent>`` holds
+them): a policy *trained* with its gaze frozen, the comparison the issue asks for beside the gated
+policy with its gaze frozen only at evaluation.
+
 The same object is used by the training wrapper and by the evaluation-time agent, so both see
 identical inputs and produce identical env actions.
 """
@@ -49,7 +54,8 @@ N_BELIEF = 10
 N_INTERCEPT = 4
 N_GAZE = 3
 HAND_ACTIONS = ("absolute", "intercept")
-GAZE_ACTIONS = ("free", "gated")
+GAZE_ACTIONS = ("free", "gated", "frozen")
+GAZE_HEAD = (slice(4, 6), slice(7, 9))  # the env action's gaze and head blocks (held with "frozen")
 ENV_ACTION_DIM = 9
 _S = ObservationLayout().slices
 
@@ -69,8 +75,8 @@ class BeliefFeatures:
             raise ValueError(f"residual_m must be a positive number of metres, got {residual_m!r}")
         if gaze_action not in GAZE_ACTIONS:
             raise ValueError(f"gaze_action must be one of {GAZE_ACTIONS}, got {gaze_action!r}")
-        if gaze_action == "gated" and hand_action != "intercept":
-            raise ValueError("gaze_action='gated' needs hand_action='intercept'")
+        if gaze_action != "free" and hand_action != "intercept":
+            raise ValueError(f"gaze_action={gaze_action!r} needs hand_action='intercept'")
         if not (math.isfinite(gaze_residual_deg) and gaze_residual_deg >= 0):
             raise ValueError(f"gaze_residual_deg must be a number of degrees >= 0, got {gaze_residual_deg!r}")
         # The Eyecatch agent owns the filter plumbing (delay, covariance from the prior, resets);
@@ -80,7 +86,7 @@ class BeliefFeatures:
         self.residual_m = float(residual_m)
         self.gaze_action = gaze_action
         self.gaze_residual = math.radians(float(gaze_residual_deg))
-        self.size = N_BELIEF + (N_INTERCEPT if hand_action == "intercept" else 0) + (N_GAZE if gaze_action == "gated" else 0)
+        self.size = N_BELIEF + (N_INTERCEPT if hand_action == "intercept" else 0) + (N_GAZE if gaze_action != "free" else 0)
         # the policy's action: the env's 9 values, plus the look gate with gaze_action="gated"
         self.action_dim = ENV_ACTION_DIM + (1 if gaze_action == "gated" else 0)
         self.reset()
@@ -107,7 +113,7 @@ class BeliefFeatures:
             self.intercept_point = point
             extra[N_BELIEF : N_BELIEF + 3] = point - SEAT_ORIGIN
             extra[N_BELIEF + 3] = seconds
-        if self.gaze_action == "gated":
+        if self.gaze_action != "free":  # gated and frozen see the same inputs
             k = N_BELIEF + N_INTERCEPT
             self.look_gaze = self._look(obs64)
             if self.look_gaze is not None:
@@ -162,6 +168,9 @@ class BeliefFeatures:
             if float(action[ENV_ACTION_DIM]) > 0.0 and self.look_gaze is not None:
                 gaze = gaze + np.asarray(self.look_gaze)
             out[4:6] = np.clip(gaze / self._agent.gaze_range, -1.0, 1.0)
+        elif self.gaze_action == "frozen":
+            for block in GAZE_HEAD:
+                out[block] = 0.0
         return out
 
 

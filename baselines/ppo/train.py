@@ -136,10 +136,10 @@ def load_config(args: Args) -> dict:
     config.setdefault("intercept_residual_m", 0.15)
     config.setdefault("gaze_action", "free")
     config.setdefault("gaze_residual_deg", 3.0)
-    if config["gaze_action"] not in ("free", "gated"):
-        raise SystemExit(f"gaze_action must be 'free' or 'gated', got {config['gaze_action']!r}")
-    if config["gaze_action"] == "gated" and config["hand_action"] != "intercept":
-        raise SystemExit("gaze_action=gated needs hand_action=intercept (and the belief features)")
+    if config["gaze_action"] not in ("free", "gated", "frozen"):
+        raise SystemExit(f"gaze_action must be 'free', 'gated' or 'frozen', got {config['gaze_action']!r}")
+    if config["gaze_action"] != "free" and config["hand_action"] != "intercept":
+        raise SystemExit(f"gaze_action={config['gaze_action']} needs hand_action=intercept (and the belief features)")
     if config["hand_action"] not in ("absolute", "intercept"):
         raise SystemExit(f"hand_action must be 'absolute' or 'intercept', got {config['hand_action']!r}")
     if config["hand_action"] == "intercept" and not config["belief"]:
