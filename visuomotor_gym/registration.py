@@ -20,6 +20,15 @@ POOR_VISION_SCALE = 2.0  # the PoorVision rungs: every vision noise x2, i.e. 20/
 PAPER_POOR_VISION_SCALE = 10.0  # Eyecatch section 5: every vision noise x10 (81.2 % caught in the paper)
 WALK_ENTRY_POINT = "visuomotor_gym.envs.walk:ObstacleWalkEnv"
 WALK_MAX_EPISODE_STEPS = 2000  # 40 s at 50 Hz: three times the nominal walk (1.3 m/s) of the longest (20 m) course
+# The reach family (seed 002, Faraway, Reed & Wang 2007): ShelfReach-v0 and its vision rungs.
+REACH_ENTRY_POINT = "visuomotor_gym.envs.reach:ShelfReachEnv"
+REACH_MAX_EPISODE_STEPS = 150  # 3 s at 50 Hz: first saccade (~0.2 s), fixation, a ~0.6-1 s reach, slack (modelling choice)
+# The dodge family (issue 13; Eom et al. section 7): ObstacleDodge-v0 and its vision rungs.
+DODGE_ENTRY_POINT = "visuomotor_gym.envs.dodge:ObstacleDodgeEnv"
+DODGE_MAX_EPISODE_STEPS = 2000  # 40 s at 50 Hz: about three times the nominal walk (1.3 m/s) to the farthest (20 m) goal
+# The stones family (issue 13; Eom et al. 2019 section 7): SteppingStones-v0 and its vision rungs.
+STONES_ENTRY_POINT = "visuomotor_gym.envs.stones:SteppingStonesEnv"
+STONES_MAX_EPISODE_STEPS = 1000  # 20 s at 50 Hz: twice the nominal crossing (~18 steps of 0.5 s) (modelling choice)
 VISUAL_DELAY_S = 0.1  # the Delayed rung's latency: ~100 ms of human visual processing (modelling choice)
 
 
@@ -79,12 +88,13 @@ ENV_SPECS: tuple[EnvEntry, ...] = (
              description="Eyecatch paper's vision with all noise x10 (Eyecatch 5: 81.2 %)"),
     *vision_rungs("ObstacleWalk", WALK_ENTRY_POINT, family="walk", max_episode_steps=WALK_MAX_EPISODE_STEPS,
                   what="obstacle"),
+    *vision_rungs("ShelfReach", REACH_ENTRY_POINT, family="reach", max_episode_steps=REACH_MAX_EPISODE_STEPS,
+                  what="object"),
+    *vision_rungs("ObstacleDodge", DODGE_ENTRY_POINT, family="dodge", max_episode_steps=DODGE_MAX_EPISODE_STEPS,
+                  what="pedestrian"),
+    *vision_rungs("SteppingStones", STONES_ENTRY_POINT, family="stones", max_episode_steps=STONES_MAX_EPISODE_STEPS,
+                  what="stone"),
 )
-# The reach family (seed 002, Faraway, Reed & Wang 2007): ShelfReach-v0 and its vision rungs.
-REACH_ENTRY_POINT = "visuomotor_gym.envs.reach:ShelfReachEnv"
-REACH_MAX_EPISODE_STEPS = 150  # 3 s at 50 Hz: first saccade (~0.2 s), fixation, a ~0.6-1 s reach, slack (modelling choice)
-ENV_SPECS = ENV_SPECS + vision_rungs("ShelfReach", REACH_ENTRY_POINT, family="reach",
-                                     max_episode_steps=REACH_MAX_EPISODE_STEPS, what="object")
 ENV_IDS = tuple(spec.id for spec in ENV_SPECS)
 FAMILIES: dict[str, tuple[str, ...]] = {}
 WALKER_FAMILIES = ("walk", "stones", "dodge")  # the families on the walker body (its 20 deg recognition field)
@@ -159,18 +169,3 @@ def register_envs() -> None:
             max_episode_steps=spec.max_episode_steps,
         )
 
-
-# The dodge family (issue 13; Eom et al. section 7): ObstacleDodge-v0 and its vision rungs.
-DODGE_ENTRY_POINT = "visuomotor_gym.envs.dodge:ObstacleDodgeEnv"
-DODGE_MAX_EPISODE_STEPS = 2000  # 40 s at 50 Hz: about three times the nominal walk (1.3 m/s) to the farthest (20 m) goal
-ENV_SPECS = ENV_SPECS + vision_rungs("ObstacleDodge", DODGE_ENTRY_POINT, family="dodge",
-                                     max_episode_steps=DODGE_MAX_EPISODE_STEPS, what="pedestrian")
-ENV_IDS = tuple(spec.id for spec in ENV_SPECS)
-FAMILIES.setdefault("dodge", tuple(s.id for s in ENV_SPECS if s.family == "dodge"))
-# The stones family (issue 13; Eom et al. 2019 section 7): SteppingStones-v0 and its vision rungs.
-STONES_ENTRY_POINT = "visuomotor_gym.envs.stones:SteppingStonesEnv"
-STONES_MAX_EPISODE_STEPS = 1000  # 20 s at 50 Hz: twice the nominal crossing (~18 steps of 0.5 s) (modelling choice)
-ENV_SPECS = ENV_SPECS + vision_rungs("SteppingStones", STONES_ENTRY_POINT, family="stones",
-                                     max_episode_steps=STONES_MAX_EPISODE_STEPS, what="stone")
-ENV_IDS = tuple(spec.id for spec in ENV_SPECS)
-FAMILIES["stones"] = FAMILIES.get("stones", ()) + tuple(s.id for s in ENV_SPECS if s.family == "stones")
