@@ -294,3 +294,19 @@ def test_old_policies_load_with_free_gaze():
     assert "gaze_action" not in agent.meta
     assert agent.features.gaze_action == "free" and agent.features.action_dim == 9
     assert agent.actor.low.shape == (9,)
+
+
+def test_frozen_holds_the_blocks_the_gaze_blind_twin_holds():
+    """belief.GAZE_HEAD (the frozen mode's held slices) are the env's 'gaze' and 'head' blocks, as
+    ``GazeBlind`` reads them from its action_structure."""
+    import gymnasium as gym
+
+    from visuomotor_gym.agents import GazeBlind
+    from visuomotor_gym.baselines.ppo.belief import ENV_ACTION_DIM, GAZE_HEAD
+
+    structure = gym.make("EyeCatch-v0").unwrapped.action_structure
+    twin = GazeBlind(None, structure)
+    mask = np.zeros(ENV_ACTION_DIM, dtype=bool)
+    for block in GAZE_HEAD:
+        mask[block] = True
+    np.testing.assert_array_equal(mask, twin.held)

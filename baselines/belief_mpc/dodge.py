@@ -37,9 +37,9 @@ import time
 from dataclasses import dataclass, fields, replace
 
 import numpy as np
-
 from visuomotor_gym.baselines.fajen_warren.agent import FajenWarrenAgent, FajenWarrenParams
-from visuomotor_gym.registration import env_vision
+
+from visuomotor_gym.registration import env_vision, env_vision_params
 from visuomotor_gym.vision.foveation import DEG, VisionParams
 
 from .belief import ObservationNoise, covariance_step, observation_variance
@@ -66,12 +66,6 @@ class DodgeBeliefMPCParams(FajenWarrenParams):
     look_head_share: float = 0.5  # the head takes this share of the gaze's azimuth (fajen_warren's value)
     saccade_refractory_s: float = 0.2
     saccade_threshold_deg: float = 3.0
-
-
-def walk_family_vision(env_id: str) -> VisionParams:
-    from .stones import stones_vision
-
-    return stones_vision(env_id)  # the same construction (WALK_VISION under the id's kwargs)
 
 
 def compact_step_information(sp, sv, spv, w, h: float, q: float):
@@ -102,7 +96,7 @@ class DodgeBeliefMPCAgent(FajenWarrenAgent):
         unknown = sorted(set(overrides) - known)
         if unknown:
             raise TypeError(f"unknown belief_mpc parameter(s) for the dodge family {unknown}; known: {sorted(known)}")
-        return cls(replace(base, **overrides), vision=walk_family_vision(env_id))
+        return cls(replace(base, **overrides), vision=env_vision_params(env_id))
 
     def reset(self) -> None:
         super().reset()

@@ -98,11 +98,9 @@ class StonesBeliefMPCParams(LookaheadParams):
             raise ValueError(f"n_tracked must be in [1, {K_SLOTS}] and max_switches a whole number")
 
 
-def stones_vision(env_id: str) -> VisionParams:
-    """The ``VisionParams`` of a registered walker-family env's eye, as the env builds them (the walk
-    family's 20 deg field under the id's ``vision_params`` fields, scaled by its noise scale,
-    unfoveated off the foveated rung): :func:`~visuomotor_gym.registration.env_vision_params`."""
-    return env_vision_params(env_id)
+# The name the committed policy files' "note" uses (their bytes are re-exported and compared by the
+# leaderboard check, so the note stays as written): the walker families' vision of a registered id.
+stones_vision = env_vision_params
 
 
 class StonesBeliefMPCAgent(LookaheadAgent):
@@ -124,7 +122,7 @@ class StonesBeliefMPCAgent(LookaheadAgent):
         unknown = sorted(set(overrides) - known)
         if unknown:
             raise TypeError(f"unknown belief_mpc parameter(s) for the stones family {unknown}; known: {sorted(known)}")
-        return cls(replace(base, **overrides), vision=stones_vision(env_id))
+        return cls(replace(base, **overrides), vision=env_vision_params(env_id))
 
     def reset(self) -> None:
         super().reset()

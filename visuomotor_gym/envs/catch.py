@@ -133,7 +133,7 @@ class EyeCatchEnv(VisuomotorEnv):
     |---|---|---|
     | ``render_mode`` | None | ``"rgb_array"`` or ``"human"`` |
     | ``vision`` | ``"foveated"`` | ``"foveated"``, ``"full_view"`` (foveal noise everywhere, no field-of-view limit, no saccadic blindness) or ``"oracle"`` (true ball state) |
-    | ``vision_noise_scale`` | 1.0 | multiplies every vision standard deviation (10: poor vision) |
+    | ``vision_noise_scale`` | 1.0 | multiplies every vision standard deviation (2: the PoorVision rung, 20/40 acuity; 10: the Eyecatch paper's poor vision) |
     | ``vision_params`` | None | ``VisionParams`` or a dict of its fields (acuity, retinal-slip knee, Weber fraction, depth noise, field of view) |
     | ``visual_delay_s`` | 0.0 | visual latency, a multiple of the control period |
     | ``bounce_wall`` | False | an invisible wall deflects the ball mid-flight |

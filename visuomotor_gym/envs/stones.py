@@ -119,7 +119,7 @@ class SteppingStonesEnv(VisuomotorEnv):
     |---|---|---|
     | ``render_mode`` | None | ``"rgb_array"`` or ``"human"`` |
     | ``vision`` | ``"foveated"`` | ``"foveated"``, ``"full_view"`` (foveal noise everywhere, no field-of-view limit, no saccadic blindness) or ``"oracle"`` (true stone centres) |
-    | ``vision_noise_scale`` | 1.0 | multiplies every vision standard deviation (10: poor vision) |
+    | ``vision_noise_scale`` | 1.0 | multiplies every vision standard deviation (2: the PoorVision rung, 20/40 acuity; 10: the Eyecatch paper's poor vision) |
     | ``vision_params`` | None | ``VisionParams`` or a dict of its fields; default the walk family's (``field_of_view_deg`` = 20) |
     | ``visual_delay_s`` | 0.0 | visual latency, a multiple of the control period |
     | ``obs_mode`` | ``"flat"`` | ``"flat"`` or ``"dict"`` |

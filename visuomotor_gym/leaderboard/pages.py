@@ -190,7 +190,7 @@ def _family(env_id: str) -> str:
 
     try:
         return family_of(env_id)
-    except (KeyError, ValueError):
+    except ValueError:  # not a registered id (the check reports it): a family of its own
         return env_id
 
 

@@ -209,14 +209,11 @@ def _belief_mpc_load(data: bytes, env_id: str) -> Policy:
 
     obj = _read_json_policy(data, BELIEF_MPC_FORMAT, env_id)
     if family_of(env_id) == "stones":
-        from visuomotor_gym.baselines.belief_mpc.stones import (
-            StonesBeliefMPCAgent,
-            StonesBeliefMPCParams,
-            stones_vision,
-        )
+        from visuomotor_gym.baselines.belief_mpc.stones import StonesBeliefMPCAgent, StonesBeliefMPCParams
+        from visuomotor_gym.registration import env_vision_params
 
         params = _typed_params(obj["params"], StonesBeliefMPCParams, "StonesBeliefMPCParams")
-        return StonesBeliefMPCAgent(StonesBeliefMPCParams(**params), vision=stones_vision(env_id))
+        return StonesBeliefMPCAgent(StonesBeliefMPCParams(**params), vision=env_vision_params(env_id))
     params = _typed_params(obj["params"], BeliefMPCParams, "BeliefMPCParams")
     return BeliefMPCAgent(BeliefMPCParams(**params))
 
