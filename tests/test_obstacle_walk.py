@@ -14,7 +14,15 @@ import visuomotor_gym  # noqa: F401  (registers the ids)
 from visuomotor_gym.agents import make_agent
 from visuomotor_gym.envs.walk import WALK_LAYOUT, ObstacleWalkEnv
 from visuomotor_gym.registration import ENV_SPECS, FAMILIES
-from visuomotor_gym.tasks.obstacle_walk import K_SLOTS, CourseDistribution, sample_course
+from visuomotor_gym.tasks.obstacle_walk import (
+    BAR,
+    K_SLOTS,
+    N_POINTS,
+    CourseDistribution,
+    ObstacleWalkTask,
+    sample_course,
+    top_points,
+)
 
 WALK_IDS = FAMILIES["walk"]
 
@@ -46,7 +54,7 @@ def test_layout_docstring_and_spaces_agree():
     env = ObstacleWalkEnv()
     assert env.observation_structure == WALK_LAYOUT.structure
     assert env.action_structure == {"footstep": 3, "gaze": 2, "fixation": 1, "head": 2}
-    assert "| 0-8 | obstacle_0 | 9 |" in ObstacleWalkEnv.__doc__
+    assert "| 0-16 | obstacle_0 | 17 |" in ObstacleWalkEnv.__doc__
     assert f"({WALK_LAYOUT.size},)" in ObstacleWalkEnv.__doc__
 
 
@@ -90,8 +98,8 @@ def _move_obstacles(env):
     for i, (x, y, depth, width, height, kind) in enumerate(task.course.obstacles.tolist()):
         x, height = x + 0.7, min(height + 0.1, 0.4)
         env.gait.pool.place(env.model, env.data, i, x, y, depth, width, height)
-        task.targets[2 * i].place(x - 0.5 * depth, y + 0.5 * width, height)
-        task.targets[2 * i + 1].place(x + 0.5 * depth, y - 0.5 * width, height)
+        for t, point in zip(task.targets[N_POINTS * i: N_POINTS * (i + 1)], top_points(x, y, depth, width, height)):
+            t.place(*point)
         task.course.obstacles[i, [0, 4]] = (x, height)
 
 
@@ -112,7 +120,7 @@ def test_no_observation_leak_of_the_obstacles_true_state(vision):
         differ |= not np.array_equal(oa, ob)
     if vision == "foveated":
         assert not differ
-        seen = [oa[WALK_LAYOUT.slices[f"obstacle_{k}"]][7:9] for k in range(K_SLOTS)]
+        seen = [oa[WALK_LAYOUT.slices[f"obstacle_{k}"]][1 + 3 * N_POINTS:] for k in range(K_SLOTS)]
         assert not np.any(seen)
     else:
         assert differ
@@ -129,6 +137,75 @@ def test_course_sampler_follows_its_distribution():
         assert np.all(near[1:] - far[:-1] >= 1.6 - 1e-9)
         tall = ob[:, 5] != 2
         assert np.all((ob[tall, 4] >= 0.05) & (ob[tall, 4] <= 0.30)) and np.all(ob[~tall, 4] == 0.01)
+
+
+def test_bars_span_the_walkway_and_everything_else_lies_inside_it():
+    dist = CourseDistribution()
+    half = 0.5 * dist.walkway_width_m
+    n_bars = 0
+    for seed in range(50):
+        ob = sample_course(np.random.default_rng(seed), dist, 16).obstacles
+        bars = ob[:, 5] == BAR
+        n_bars += int(bars.sum())
+        np.testing.assert_array_equal(ob[bars, 3], dist.walkway_width_m)
+        np.testing.assert_array_equal(ob[bars, 1], 0.0)
+        assert np.all(np.abs(ob[:, 1]) + 0.5 * ob[:, 3] <= half + 1e-12)
+    assert n_bars > 20
+    with pytest.raises(ValueError, match="walkway_width_m"):
+        ObstacleWalkEnv(course_distribution={"walkway_width_m": 0.0}).reset(seed=0)
+
+
+def test_the_eye_sees_four_points_of_each_top_face():
+    """On the oracle rung the slot's four points are the true corners and edge midpoints (eye frame)."""
+    env = ObstacleWalkEnv(vision="oracle")
+    obs, info = env.reset(seed=3)
+    block = obs[WALK_LAYOUT.slices["obstacle_0"]]
+    x, y, depth, width, height, _ = info["obstacles"][0]
+    truth = np.array(top_points(x, y, depth, width, height))
+    assert block[0] == 0.0 and np.all(block[1 + 3 * N_POINTS:] == 1.0)
+    seen_world = np.asarray(block[1:1 + 3 * N_POINTS], float).reshape(N_POINTS, 3) @ env.eye.rot.T + env.eye.pos
+    np.testing.assert_allclose(seen_world, truth, atol=1e-4)
+    # The near-edge and far-edge midpoints lie on the centre line of a bar that spans the walkway.
+    assert truth[2, 1] == truth[3, 1] == y
+
+
+def _walk_sideways(env, lateral):
+    a = np.zeros(8, np.float32)
+    a[1] = lateral  # the lateral offset block: every step this far beside the nominal step width
+    a[2] = 1.0  # high toe clearance
+    for _ in range(1000):
+        obs, r, term, trunc, info = env.step(a)
+        if term or trunc:
+            return r, term, info
+    raise AssertionError("the episode did not end")
+
+
+def test_leaving_the_walkway_ends_the_episode_as_a_failure():
+    env = ObstacleWalkEnv(course_distribution={"first_m": (8.0, 8.0)})  # nothing to trip on for 8 m
+    env.reset(seed=0)
+    r, term, info = _walk_sideways(env, 1.0)
+    assert term and info["off_path"] and not info["is_success"] and not info["tripped"]
+    assert info["reward_terms"]["off_path"] == -1.0
+    feet_y = env.gait.feet_world(env.data)[:, 1]
+    assert np.abs(feet_y).max() > 0.5 * env.course_distribution.walkway_width_m
+    # Drifting sideways is fine inside a walkway wide enough for it.
+    wide = ObstacleWalkEnv(course_distribution={"first_m": (8.0, 8.0), "walkway_width_m": 40.0})
+    wide.reset(seed=0)
+    a = np.zeros(8, np.float32)
+    a[1], a[2] = 1.0, 1.0
+    for _ in range(150):
+        *_, term, trunc, info = wide.step(a)
+    assert not info["off_path"] and not term
+
+
+def test_the_task_checks_every_landed_foothold_once():
+    env = ObstacleWalkEnv()
+    env.reset(seed=0)
+    task: ObstacleWalkTask = env.task
+    for _ in range(100):
+        env.step(np.zeros(8, np.float32))
+    g = env.gait
+    assert task._next_check == (g.tick - g.T_ds) // g.T + 1  # footholds 0 .. k flat by now
 
 
 def test_a_trip_ends_the_episode_and_scores_nothing():

@@ -9,6 +9,7 @@ import pytest
 from visuomotor_gym.agents import make_agent
 from visuomotor_gym.baselines.ppo import train
 from visuomotor_gym.bench.evaluate import evaluate
+from visuomotor_gym.envs.walk import WALK_LAYOUT
 
 
 @pytest.mark.parametrize(
@@ -119,7 +120,7 @@ def test_walk_id_trains_without_the_catch_features_and_its_npz_walks(tmp_path):
                       "--no-progress-bar", "--set", "n_envs=2", "n_steps=128", "batch_size=128", "eval_freq=100000",
                       "eval_episodes=1", "checkpoint_freq=100000"])
     meta = json.loads((run / "ppo_meta.json").read_text())
-    assert meta["env_id"] == "ObstacleWalk-v0" and not meta["belief"] and len(meta["obs_mean"]) == 94
+    assert meta["env_id"] == "ObstacleWalk-v0" and not meta["belief"] and len(meta["obs_mean"]) == WALK_LAYOUT.size
     from visuomotor_gym.baselines.ppo.agent import pack_npz
 
     npz = tmp_path / "walk.npz"

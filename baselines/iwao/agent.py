@@ -27,7 +27,7 @@ from visuomotor_gym.body.walker import GaitParams
 from visuomotor_gym.body.walker_body import WalkerBody
 from visuomotor_gym.envs.walk import WALK_LAYOUT
 from visuomotor_gym.registration import env_vision, env_vision_params
-from visuomotor_gym.tasks.obstacle_walk import K_SLOTS
+from visuomotor_gym.tasks.obstacle_walk import K_SLOTS, N_POINTS
 from visuomotor_gym.vision.foveation import VisionParams
 
 from .gaze import DEG, IwaoGazeParams, peak_angles, pitch_at
@@ -84,7 +84,7 @@ class IwaoAgent:
                                    position_slip_knee_deg_s=p.position_slip_knee_deg_s)
         self.delay_steps = round(p.visual_delay_s / p.control_dt)
         self.gaze_range = p.gaze_action_range_deg * DEG
-        self.memory = ObstacleMemory(self.vision)
+        self.memory = ObstacleMemory(self.vision, self.planner.p.walkway_half_width_m)
         self.period_steps = round(self.gait.step_s / p.control_dt)
         self.lead_steps = min(round(p.pursuit_lead_s / p.control_dt), self.period_steps)
         self.reset()
@@ -153,15 +153,15 @@ class IwaoAgent:
         seen_eye = _eye_in_path(pose)
         prev, self.prev_seen_eye = self.prev_seen_eye, seen_eye
         motion = None if prev is None else eye_motion(prev, seen_eye, self.params.control_dt)
+        f = 1 + 3 * N_POINTS  # the seen flags follow the id and the points
         for b in _SLOTS:
-            near, far = ol[b + 7], ol[b + 8]
-            if near == 0.0 and far == 0.0:
+            flags = ol[b + f:b + f + N_POINTS]
+            if 1.0 not in flags:
                 continue
             index = round(ol[b])
-            if near > 0.0:
-                self.memory.add(index, 0, ol[b + 1:b + 4], eye_pos, rot_rows, odo, motion)
-            if far > 0.0:
-                self.memory.add(index, 1, ol[b + 4:b + 7], eye_pos, rot_rows, odo, motion)
+            for which, seen in enumerate(flags):
+                if seen > 0.0:
+                    self.memory.add(index, which, ol[b + 1 + 3 * which:b + 4 + 3 * which], eye_pos, rot_rows, odo, motion)
 
     def _footholds(self, obs: np.ndarray, odo) -> list[tuple[float, float, float]]:
         f = obs[_S["footholds"]].reshape(3, 3)
@@ -184,7 +184,7 @@ class IwaoAgent:
         for o in self.memory.known():
             if o.x1 > u_last:  # not yet stepped over: the next obstacle
                 return (o.x0, 0.5 * (o.y0 + o.y1), o.height), o.index
-        # Slots seen on one corner only, or not yet: the travel point ahead on the ground.
+        # Slots seen on one edge only, or not yet: the travel point ahead on the ground.
         eye_x = odo[0] + pose[0][0]
         return (eye_x + self.params.travel_look_ahead_m, odo[1], 0.0), -1
 

@@ -1,12 +1,14 @@
-"""The iwao agent's memory of the obstacles: each seen corner fused over time in the path frame.
+"""The iwao agent's memory of the obstacles: each seen point of their top faces (two corners and the
+midpoints of the near and far edges: ``tasks.obstacle_walk.TOP_POINTS``) fused over time in the path frame.
 
-A corner is a still point, so every visual sample is one more measurement of the same point: the
+A point is a still point, so every visual sample is one more measurement of the same point: the
 agent adds its information ``C^-1`` (the inverse of the vision model's covariance, Eyecatch Eq. 1-3,
 along and across the line of sight) to that corner's running sum (a static Kalman filter in
 information form). Samples are placed in the *path frame* (x along the path from the start, y left,
 z up) with the agent's own proprioception: the eye pose in the pelvis frame and the odometry block.
 The covariance is evaluated at the perceived point (the agent does not know the truth). Nothing is
-assumed about the obstacles except that they are boxes whose two seen corners span the footprint.
+assumed about the obstacles except that they are boxes whose corners span the footprint, and that an
+obstacle whose corners were not seen may span the walkway (its edges are painted and known).
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from visuomotor_gym.tasks.obstacle_walk import N_POINTS, CourseDistribution
 from visuomotor_gym.vision.foveation import VisionParams, _sigmas
 
 MIN_STD_M = 1e-4  # a floor for the noiseless oracle rung (its information would be infinite)
@@ -114,23 +117,37 @@ class ObstacleEstimate:
     sz: float
 
 
-class ObstacleMemory:
-    """Fused corners of every obstacle seen so far, by course index."""
+NEAR_LEFT, FAR_RIGHT, NEAR_MID, FAR_MID = range(N_POINTS)  # the order of tasks.obstacle_walk.TOP_POINTS
 
-    def __init__(self, vision: VisionParams) -> None:
+
+def _fused(estimates: list, axis: int) -> tuple[float, float]:
+    """Inverse-variance mean and std along ``axis`` of ``(position, stds)`` estimates of one coordinate."""
+    w = [1.0 / max(float(s[axis]), 1e-6) ** 2 for _, s in estimates]
+    total = sum(w)
+    return sum(wi * float(p[axis]) for wi, (p, _) in zip(w, estimates)) / total, math.sqrt(1.0 / total)
+
+
+class ObstacleMemory:
+    """Fused points of every obstacle seen so far, by course index. ``walkway_half_width_m``: the
+    lateral extent assumed for a side whose corner was not seen (the obstacle may span the walkway)."""
+
+    def __init__(self, vision: VisionParams,
+                 walkway_half_width_m: float = 0.5 * CourseDistribution().walkway_width_m) -> None:
         self.vision = vision
-        self.corners: dict[int, tuple[Corner, Corner]] = {}
+        self.walkway_half_width_m = walkway_half_width_m
+        self.corners: dict[int, tuple[Corner, ...]] = {}
 
     def reset(self) -> None:
         self.corners = {}
 
     def add(self, index: int, which: int, p_eye, eye_pos, rot_rows, odo, motion=None) -> None:
-        """One sample of corner ``which`` (0 near-left, 1 far-right) of obstacle ``index``: ``p_eye`` in
+        """One sample of point ``which`` (``TOP_POINTS`` order: 0 near-left, 1 far-right, 2 near-edge
+        midpoint, 3 far-edge midpoint) of obstacle ``index``: ``p_eye`` in
         the eye frame, ``eye_pos`` and ``rot_rows`` (3x3, columns = eye axes) in the pelvis frame,
         ``odo`` = (x, y, yaw, pelvis height) placing the pelvis frame in the path frame. ``motion`` =
         (eye velocity, gaze angular velocity), path frame, over the control step that ended with this
         sample (the agent's efference copy and proprioception: :func:`eye_motion`): the retinal slip of
-        a still corner, which widens the lateral noise above the knee (``VisionParams``
+        a still point, which widens the lateral noise above the knee (``VisionParams``
         ``position_slip_knee_deg_s``, Westheimer & McKee 1975), is predicted from it; None: no slip."""
         ex, ey, ez = p_eye
         d = math.sqrt(ex * ex + ey * ey + ez * ez)
@@ -146,16 +163,16 @@ class ObstacleMemory:
         c, s = math.cos(yaw), math.sin(yaw)
         z = (ox + c * bx - s * by, oy + s * bx + c * by, pz + bz)
         u = ((c * lx - s * ly) / d, (s * lx + c * ly) / d, lz / d)
-        pair = self.corners.get(index)
-        if pair is None:
-            pair = self.corners[index] = (Corner(), Corner())
-        corner = pair[which]
+        points = self.corners.get(index)
+        if points is None:
+            points = self.corners[index] = tuple(Corner() for _ in range(N_POINTS))
+        corner = points[which]
         eye_w = (z[0] - d * u[0], z[1] - d * u[1], z[2] - d * u[2])  # the eye, path frame
         # The noise is spread along and across the *true* line of sight at the *true* distance, which the
         # agent does not know. The perceived point is no guide when the depth noise is as large as the
         # distance (~40 deg off the fovea): it may come out next to the eye or behind it, its direction
         # then wrong by a lot. So, as an extended Kalman filter linearises at its prior, the line of sight
-        # and the distance are those of the corner's current estimate; before there is one, of the point
+        # and the distance are those of the point's current estimate; before there is one, of the point
         # where the perceived ray meets the plane 0.15 m above the floor (mid-range of the obstacles).
         prior = corner.prior()
         if prior is not None:
@@ -177,17 +194,24 @@ class ObstacleMemory:
         corner.add(z, u, max(s_depth, MIN_STD_M), max(s_lat, MIN_STD_M))
 
     def obstacle(self, index: int) -> ObstacleEstimate | None:
-        """The box of obstacle ``index`` once both its corners were seen, else None."""
-        pair = self.corners.get(index)
-        if pair is None or pair[0].n == 0 or pair[1].n == 0:
+        """The box of obstacle ``index`` once its near and its far edge were seen (each at a corner or at
+        its midpoint), else None. A side whose corner was not seen extends to the walkway's edge."""
+        points = self.corners.get(index)
+        if points is None:
             return None
-        (p0, s0), (p1, s1) = pair[0].estimate(), pair[1].estimate()
-        w0, w1 = 1.0 / max(s0[2], 1e-6) ** 2, 1.0 / max(s1[2], 1e-6) ** 2
-        height = (w0 * p0[2] + w1 * p1[2]) / (w0 + w1)
-        return ObstacleEstimate(
-            index, min(p0[0], p1[0]), max(p0[0], p1[0]), min(p0[1], p1[1]), max(p0[1], p1[1]),
-            max(height, 0.0), float(max(s0[0], s1[0])), float(max(s0[1], s1[1])), float(math.sqrt(1.0 / (w0 + w1))),
-        )
+        est = [pt.estimate() if pt.n else None for pt in points]
+        near = [e for e in (est[NEAR_LEFT], est[NEAR_MID]) if e is not None]
+        far = [e for e in (est[FAR_RIGHT], est[FAR_MID]) if e is not None]
+        if not near or not far:
+            return None
+        x0, s_x0 = _fused(near, 0)
+        x1, s_x1 = _fused(far, 0)
+        height, s_z = _fused(near + far, 2)
+        half = self.walkway_half_width_m
+        y1, s_y1 = (float(est[NEAR_LEFT][0][1]), float(est[NEAR_LEFT][1][1])) if est[NEAR_LEFT] else (half, 0.0)
+        y0, s_y0 = (float(est[FAR_RIGHT][0][1]), float(est[FAR_RIGHT][1][1])) if est[FAR_RIGHT] else (-half, 0.0)
+        return ObstacleEstimate(index, min(x0, x1), max(x0, x1), min(y0, y1), max(y0, y1), max(height, 0.0),
+                                max(s_x0, s_x1), max(s_y0, s_y1), s_z)
 
     def known(self) -> list[ObstacleEstimate]:
         out = []

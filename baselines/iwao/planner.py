@@ -7,7 +7,7 @@ its foot out of every obstacle's *keep-out zone* (the footprint grown by the est
 by gaps that the swing needs in front of the toe and behind the heel, growing with the obstacle's height)
 and leave at least one such foothold for the other foot next; among those, the cheapest in deviation from
 the nominal step and from the lateral corridor (the path's centre line, or beside an obstacle that has to
-be walked around). The toe clearance of the swing is the highest obstacle under it plus a margin.
+be walked around, inside the walkway's edges). The toe clearance of the swing is the highest obstacle under it plus a margin.
 """
 
 from __future__ import annotations
@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from visuomotor_gym.body.walker import GaitParams
+from visuomotor_gym.tasks.obstacle_walk import CourseDistribution
 
 # Foot box around the foothold (envs_assets/common/walker_body.xml: heel 6 cm behind the ankle, toe 20 cm
 # ahead, 9 cm wide).
@@ -39,10 +40,15 @@ class PlannerParams:
     sigmas: float = 2.0  # obstacle extents grown by this many estimate standard deviations
     clearance_margin_m: float = 0.06  # toe clearance above the highest obstacle under the swing
     tall_m: float = 0.15  # over an obstacle taller than this ...
-    max_stride_over_tall_m: float = 0.85  # ... no step longer than this
+    max_stride_over_tall_m: float = 0.90  # ... no step longer than this
     max_step_over_m: float = 0.85  # a keep-out zone longer than this is walked around
     corridor_margin_m: float = 0.08  # the feet pass this far beside an obstacle walked around
     look_ahead_m: float = 3.5  # obstacles this far ahead of the last foothold shape the corridor
+    corridor_release_m: float = 0.15  # ... until the last foothold is this far past their far end
+    # The walkway's half width (the env's CourseDistribution.walkway_width_m / 2: its edges are painted on
+    # the floor and known, like the path's direction); a foothold keeps its foot box this far inside.
+    walkway_half_width_m: float = 0.5 * CourseDistribution().walkway_width_m
+    edge_margin_m: float = 0.05
     w_length: float = 1.0
     w_corridor: float = 2.0
     w_lateral: float = 0.3
@@ -63,6 +69,10 @@ class FootstepPlanner:
         self._cost_length = self.p.w_length * np.abs(self._L - g.nominal_step_m)
         self._cost_lateral = self.p.w_lateral * np.abs(self._A)
         self._cost_length2 = np.abs(g.nominal_step_m - self.lengths2) * self.p.w_length
+        # Inside the walkway: a foothold's lateral position at most this far from the centre line, and a
+        # corridor (the pelvis's lateral target) at most ``_corridor_limit`` (its outer foot inside then).
+        self._v_limit = self.p.walkway_half_width_m - self.p.edge_margin_m - HALF_WIDTH_M
+        self._corridor_limit = self._v_limit - 0.5 * g.step_width_m
 
     def _next_v(self, v_prev, lateral, side: int):
         """Lateral position of a foothold of ``side`` (0 left) from the previous one (the gait's rule)."""
@@ -104,14 +114,17 @@ class FootstepPlanner:
         to step over; then beside it, on the side nearer the pelvis's lateral position ``y_now``."""
         p = self.p
         for o, zone, gf, gb in zip(obstacles, arr.tolist(), gap[0].tolist(), gap[1].tolist()):
-            if zone[1] < u_last - 0.3 or zone[0] > u_last + p.look_ahead_m:
+            if zone[1] < u_last - p.corridor_release_m or zone[0] > u_last + p.look_ahead_m:
                 continue
             if (zone[1] - zone[0]) + TOE_M + HEEL_M + gf + gb <= p.max_step_over_m:
                 continue
             half = HALF_WIDTH_M + 0.5 * self.g.step_width_m + p.corridor_margin_m
             left, right = zone[3] + half, zone[2] - half
-            if right < 0.0 < left:  # the centre line runs into it: pass on the nearer side
-                return float(left if abs(left - y_now) < abs(right - y_now) else right)
+            if right < 0.0 < left:  # the centre line runs into it: pass on the nearer side inside the walkway
+                sides = [c for c in (left, right) if abs(c) <= self._corridor_limit]
+                if not sides:
+                    continue  # no room beside it: stepped over (the footholds' own tests decide how)
+                return float(min(sides, key=lambda c: abs(c - y_now)))
         return 0.0
 
     def plan(self, footholds, obstacles) -> tuple[float, float, float]:
@@ -134,7 +147,7 @@ class FootstepPlanner:
         L, A = self._L, self._A
         u1 = u_b + self.lengths  # U[i, j] = u1[i]
         v1 = self._next_v(v_b, self.laterals, side)  # V[i, j] = v1[j]
-        ok = self._ok_first(u_b, u1, v1, arr, gap)
+        ok = self._ok_first(u_b, u1, v1, arr, gap) & (np.abs(v1) <= self._v_limit)[None, :]
         # One step of look-ahead: the other foot must find a clear foothold after this one.
         best2 = self._best_next(u1, v1, arr, gap, side, y_goal)
         cost = (self._cost_length + p.w_corridor * np.abs(0.5 * (v1 + v_b) - y_goal) + self._cost_lateral + best2)
@@ -185,6 +198,7 @@ class FootstepPlanner:
             over = tall & (arr[:, 0] > u1[:, None, None]) & (arr[:, 1] < u2[..., None])  # (i, k, zone)
             stride = ~(over.any(axis=-1) & (l2 > p.max_stride_over_tall_m))  # (i, k)
             ok2 = clear & stride[:, None, :, None]
+        ok2 = ok2 & (np.abs(v2) <= self._v_limit)[None, :, None, :]  # inside the walkway
         corridor = p.w_corridor * np.abs(0.5 * (v1[:, None] + v2) - y_goal)  # (j, l)
         if math.inf * p.w_length == math.inf:
             # Where not clear, |inf| w_length + corridor is inf (or NaN with a NaN corridor, which, like

@@ -20,6 +20,7 @@ WALKER_SHINS = ("left_shin", "right_shin")
 WALKER_FEET = ("left_foot", "right_foot")
 WALKER_ARMS = ("left_arm", "right_arm")
 WALKER_FINISH = "finish_line"  # a visual marker the task moves to the end of the path
+WALKER_WALKWAY_EDGES = ("walkway_left", "walkway_right")  # visual edge lines the task moves to the walkway's width
 WALKER_OBSTACLE_POOL = 16  # pre-allocated obstacle bodies (modelling choice: >= obstacles per course)
 WALKER_OBSTACLES = tuple(f"obstacle_{i:02d}" for i in range(WALKER_OBSTACLE_POOL))  # mocap bodies and their box geoms
 
@@ -56,7 +57,7 @@ WALKER_CAMERAS = (WALKER_SIDE_CAMERA, WALKER_FOLLOW_CAMERA, WALKER_SCENE_CAMERA,
 
 WALKER_ALL_NAMES = {
     "body": (WALKER_PELVIS, WALKER_TORSO) + WALKER_THIGHS + WALKER_SHINS + WALKER_FEET + WALKER_ARMS
-    + (WALKER_FINISH, _shared.HEAD, _shared.EYE, _shared.FIXATION) + WALKER_OBSTACLES,
+    + (WALKER_FINISH, _shared.HEAD, _shared.EYE, _shared.FIXATION) + WALKER_WALKWAY_EDGES + WALKER_OBSTACLES,
     "joint": WALKER_GAIT_JOINTS + _shared.NECK_JOINTS
     + (_shared.EYE_AZIMUTH, _shared.EYE_ELEVATION, _shared.EYE_FIXATION),
     "actuator": WALKER_GAIT_ACTUATORS + _shared.NECK_ACTUATORS,

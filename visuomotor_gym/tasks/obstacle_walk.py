@@ -5,19 +5,30 @@ a foot landing on one a misstep (no success).
 **Course** (:func:`sample_course`, drawn first from the env's ``np_random`` so every rung of the ladder
 gets the same course for a seed): the path runs along +x from the walker's first heel strike at the
 origin to a finish line 15-20 m ahead. Obstacles follow one another along it with free gaps of
-1.6-3.0 m; each is a bar (5 cm deep, 0.8-1.2 m wide: stepped over), a box (20-40 cm deep, 40-80 cm
+1.6-3.0 m; each is a bar (5 cm deep, spanning the walkway: stepped over), a box (20-40 cm deep, 40-80 cm
 wide: stepped over or around) or a flat mat (70 x 70 cm, 1 cm: Iwao's cloth, stepped around; landing on
 it is a misstep), 5-30 cm high except the mats (issue 12). Kinds, sizes and lateral offsets are uniform
 draws (modelling choice).
 
-**What the eye sees of an obstacle**: two corners of its top face, the near-left and the far-right
+**The walkway**: the path is a walkway ``walkway_width_m`` = 1.5 m wide (modelling choice: the passing
+width of accessible routes, ADA 2010 Standards 403.5.3, 60 in), its edges painted on the floor. A foot
+that lands outside it (sole centre beyond an edge at a foothold) ends the episode, *off path*, a failure.
+Without it a walker could pass every obstacle metres to the side without ever looking (a PPO policy did:
+docs/reproductions/ppo.md), and bars that span the walkway can only be stepped over.
+
+**What the eye sees of an obstacle**: four points of its top face (:data:`TOP_POINTS`): the near-left
+and far-right corners and the midpoints of the near and far edges
 (:class:`~visuomotor_gym.core.retina.PointTarget`), each sampled by the retina like any target
 (eccentricity-dependent noise, field of view, saccadic suppression, visual delay). For the axis-aligned
-boxes of v0 the two corners fix the footprint and the height. The observation holds the percepts of
+boxes of v0 the corners fix the footprint and the height; the edge midpoints fix the near and far edges
+and the height where the eye looks at an obstacle too wide for both corners to fall in the field (a bar
+across the 1.5 m walkway: its ends lie 20 deg off a gaze 2 m ahead on its middle, at the edge of the
+20 deg field of the walker family): a human looking at the middle of a bar sees its edges there. The
+observation holds the percepts of
 the ``K_SLOTS`` = 4 next obstacles of the course (slot ``k`` = course obstacle ``n + k``, ``n`` the
 number of obstacles the pelvis has passed by more than ``PASSED_M``): with free gaps >= 1.6 m four slots
 reach >= 6 m ahead, more than the 2 steps (~1.3 m) that walkers need to see (Matthis & Fajen 2014) and
-the 1-2 m of travel fixations (Patla & Vickers 1997). An obstacle not seen this step reads as zeros.
+the 1-2 m of travel fixations (Patla & Vickers 1997). A point not seen this step reads as zeros.
 """
 
 from __future__ import annotations
@@ -32,11 +43,14 @@ from visuomotor_gym.core.observation import Block
 from visuomotor_gym.core.retina import PointTarget
 
 K_SLOTS = 4
+# The seen points of an obstacle's top face, in the order of the observation (module docstring).
+TOP_POINTS = ("near_left", "far_right", "near_mid", "far_mid")
+N_POINTS = len(TOP_POINTS)
 PASSED_M = 0.5  # an obstacle whose far edge is this far behind the pelvis leaves the slots (modelling choice)
 KINDS = ("bar", "box", "mat")
 BAR, BOX, MAT = 0, 1, 2
-REWARD_TERMS = ("finish", "trip", "misstep", "progress")
-DEFAULT_REWARD_WEIGHTS = {"finish": 1.0, "trip": -1.0, "misstep": -1.0, "progress": 0.0}
+REWARD_TERMS = ("finish", "trip", "misstep", "off_path", "progress")
+DEFAULT_REWARD_WEIGHTS = {"finish": 1.0, "trip": -1.0, "misstep": -1.0, "off_path": -1.0, "progress": 0.0}
 OBSTACLE_RGBA = {BAR: (0.80, 0.25, 0.20, 1.0), BOX: (0.85, 0.55, 0.15, 1.0), MAT: (0.08, 0.08, 0.08, 1.0)}
 
 
@@ -50,13 +64,13 @@ class CourseDistribution:
     finish_clear_m: float = 1.5  # no obstacle within this distance of the finish (modelling choice)
     kind_p: tuple[float, float, float] = (0.4, 0.35, 0.25)  # bar, box, mat (modelling choice)
     height_m: tuple[float, float] = (0.05, 0.30)  # issue 12: bars and boxes 5-30 cm high
+    walkway_width_m: float = 1.5  # see the module docstring (modelling choice); bars span it
     bar_depth_m: float = 0.05
-    bar_width_m: tuple[float, float] = (0.8, 1.2)
     box_depth_m: tuple[float, float] = (0.2, 0.4)
     box_width_m: tuple[float, float] = (0.4, 0.8)
     mat_size_m: float = 0.7  # Iwao et al.: a 70 cm square black cloth
     mat_height_m: float = 0.01
-    offset_m: tuple[float, float] = (-0.15, 0.15)  # bars and boxes: centre beside the path's centre line
+    offset_m: tuple[float, float] = (-0.15, 0.15)  # boxes: centre beside the path's centre line
     mat_offset_m: tuple[float, float] = (-0.3, 0.3)
 
 
@@ -68,14 +82,16 @@ class Course:
 
 def sample_course(rng: np.random.Generator, dist: CourseDistribution, max_obstacles: int) -> Course:
     """One course: obstacles in path order, free gaps between them, none near the finish."""
+    if not dist.walkway_width_m > 0.0:
+        raise ValueError(f"course_distribution.walkway_width_m must be > 0 m, got {dist.walkway_width_m!r}")
     length = float(rng.uniform(*dist.length_m))
     rows = []
     near = float(rng.uniform(*dist.first_m))
     while len(rows) < max_obstacles:
         kind = int(rng.choice(3, p=np.asarray(dist.kind_p) / sum(dist.kind_p)))
         if kind == BAR:
-            depth, width, height = dist.bar_depth_m, float(rng.uniform(*dist.bar_width_m)), float(rng.uniform(*dist.height_m))
-            y = float(rng.uniform(*dist.offset_m))
+            depth, width, height = dist.bar_depth_m, dist.walkway_width_m, float(rng.uniform(*dist.height_m))
+            y = 0.0
         elif kind == BOX:
             depth, width = float(rng.uniform(*dist.box_depth_m)), float(rng.uniform(*dist.box_width_m))
             height, y = float(rng.uniform(*dist.height_m)), float(rng.uniform(*dist.offset_m))
@@ -90,9 +106,10 @@ def sample_course(rng: np.random.Generator, dist: CourseDistribution, max_obstac
 
 
 def obstacle_blocks(k: int) -> Block:
-    return Block(f"obstacle_{k}", 9, "-, m, 0/1",
+    return Block(f"obstacle_{k}", 1 + 4 * N_POINTS, "-, m, 0/1",
                  f"slot {k}: course index of the obstacle ({k} after the last one passed); perceived near-left "
-                 "then far-right corner of its top face, eye frame (zeros when not seen); seen flags of the two corners")
+                 "corner, far-right corner, near-edge midpoint and far-edge midpoint of its top face, eye frame "
+                 "(zeros when not seen); seen flags of the four points")
 
 
 PERCEPT_BLOCKS = tuple(obstacle_blocks(k) for k in range(K_SLOTS))
@@ -123,10 +140,14 @@ class ObstacleWalkTask:
         self.reward_weights = reward_weights
         self.visual_delay_s = visual_delay_s
         n = len(self.pool)
-        self.all_targets = [PointTarget(f"obstacle_{i:02d}_{c}") for i in range(n) for c in ("near", "far")]
+        self.all_targets = [PointTarget(f"obstacle_{i:02d}_{c}") for i in range(n) for c in TOP_POINTS]
         self.targets = self.all_targets
         self._finish_body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, wn.WALKER_FINISH)
         self._finish_mocap = int(model.body_mocapid[self._finish_body])
+        self._edge_mocaps = [int(model.body_mocapid[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, name)])
+                             for name in wn.WALKER_WALKWAY_EDGES]
+        self._sole_sites = list(body.gait.sole_sites)
+        self.half_width = 0.5 * course_distribution.walkway_width_m
         self.course = Course(0.0, np.zeros((0, 6)))
         self.reset_state()
 
@@ -135,7 +156,9 @@ class ObstacleWalkTask:
         self.success = False
         self.tripped = False
         self.misstepped = False
+        self.off_path = False
         self.finished = False
+        self._next_check = 0  # the next foothold whose landing is checked against the walkway's edges
         self.n_passed = 0
         self._slots_set = False
         self._n_events = 0
@@ -149,12 +172,14 @@ class ObstacleWalkTask:
         self.pool.park_all(m, d)
         for t in self.all_targets:
             t.hidden = True
-        self.targets = self.all_targets[: 2 * len(course.obstacles)]  # what the retina samples
+        self.targets = self.all_targets[: N_POINTS * len(course.obstacles)]  # what the retina samples
         for i, (x, y, depth, width, height, kind) in enumerate(course.obstacles.tolist()):
             self.pool.place(m, d, i, x, y, depth, width, height, rgba=OBSTACLE_RGBA[int(kind)])
-            self.targets[2 * i].place(x - 0.5 * depth, y + 0.5 * width, height)
-            self.targets[2 * i + 1].place(x + 0.5 * depth, y - 0.5 * width, height)
+            for t, point in zip(self.targets[N_POINTS * i: N_POINTS * (i + 1)], top_points(x, y, depth, width, height)):
+                t.place(*point)
         d.mocap_pos[self._finish_mocap] = (course.length, 0.0, 0.0)
+        for mocap, sign in zip(self._edge_mocaps, (1.0, -1.0)):  # the painted edges (walker.xml: 30 m from x = -5 m)
+            d.mocap_pos[mocap] = (10.0, sign * self.half_width, 0.0)
         self._prev_x = float(d.qpos[0])
 
     def initial_gaze(self) -> tuple[np.ndarray, tuple[float, float]]:
@@ -174,7 +199,7 @@ class ObstacleWalkTask:
     @staticmethod
     def trace_final_fields(info: dict) -> dict:
         return {"tripped": bool(info["tripped"]), "misstepped": bool(info["misstepped"]),
-                "finished": bool(info["finished"])}
+                "off_path": bool(info["off_path"]), "finished": bool(info["finished"])}
 
     # --- physics ------------------------------------------------------------------------------
     def before_physics(self, data: mujoco.MjData) -> None:
@@ -209,24 +234,26 @@ class ObstacleWalkTask:
             # passed lie behind the walker, beyond any reach of the eye and the head).
             for i in range(len(obs)):
                 hidden = not (self.n_passed <= i < self.n_passed + K_SLOTS)
-                self.targets[2 * i].hidden = self.targets[2 * i + 1].hidden = hidden
+                for t in self.targets[N_POINTS * i: N_POINTS * (i + 1)]:
+                    t.hidden = hidden
             self._slots_set = True
 
     def observe_leading(self, values: list, samples: list) -> None:
-        """The :data:`PERCEPT_BLOCKS`: per slot, id, two corners (eye frame) and their seen flags."""
-        n_targets = len(samples) // 2
+        """The :data:`PERCEPT_BLOCKS`: per slot, id, the four points (eye frame) and their seen flags."""
+        n_obstacles = len(samples) // N_POINTS
         for k in range(K_SLOTS):
             i = self.n_passed + k
             values.append(float(i))
-            if i < n_targets:
-                (p0, _, v0), (p1, _, v1) = samples[2 * i], samples[2 * i + 1]
+            if i < n_obstacles:
+                seen = []
+                for p, _, v in samples[N_POINTS * i: N_POINTS * (i + 1)]:
+                    values += p
+                    seen.append(1.0 if v else 0.0)
+                values += seen
+                self.seen[k] = 1.0 in seen
             else:
-                p0 = p1 = [0.0, 0.0, 0.0]
-                v0 = v1 = False
-            values += p0
-            values += p1
-            values += (1.0 if v0 else 0.0, 1.0 if v1 else 0.0)
-            self.seen[k] = v0 or v1
+                values += _UNSEEN_SLOT
+                self.seen[k] = False
 
     def observe_trailing(self, values: list, samples: list, data: mujoco.MjData) -> None:
         d = data
@@ -235,6 +262,18 @@ class ObstacleWalkTask:
         values += (x - sx, y - sy, yaw - self.body.start_yaw, self.course.length - (x - sx), d.time)
 
     # --- outcome ------------------------------------------------------------------------------
+    def _check_footholds(self, data: mujoco.MjData) -> bool:
+        """Check every foothold flat by now (heel strike + double support) against the walkway's edges:
+        True when a sole's centre lies beyond one (the walker left the walkway)."""
+        g = self.gait
+        y0 = self.body.start_xy[1]
+        while not self.off_path and self._next_check * g.T + g.T_ds <= g.tick:
+            side = self._next_check % 2  # g.side_of
+            self._next_check += 1
+            if abs(float(data.site_xpos[self._sole_sites[side], 1]) - y0) > self.half_width:
+                self.off_path = True
+        return self.off_path
+
     def evaluate(self, data: mujoco.MjData, fired: bool, a: np.ndarray, eye) -> tuple[float, dict, bool, dict]:
         d = data
         g = self.gait
@@ -245,15 +284,18 @@ class ObstacleWalkTask:
         self._n_events = n_events
         self.tripped = g.tripped
         self.misstepped = g.misstepped
+        was_off = self.off_path
+        self._check_footholds(d)
         x = float(d.qpos[0])
-        arrived = not self.finished and x - self.body.start_xy[0] >= self.course.length
+        arrived = not self.finished and not self.off_path and x - self.body.start_xy[0] >= self.course.length
         self.finished = self.finished or arrived
         self.success = self.finished and not self.tripped and not self.misstepped
         values = {"finish": 1.0 if (arrived and self.success) else 0.0, "trip": 1.0 if new_trip else 0.0,
-                  "misstep": float(new_missteps), "progress": x - self._prev_x}
+                  "misstep": float(new_missteps), "off_path": 1.0 if self.off_path and not was_off else 0.0,
+                  "progress": x - self._prev_x}
         self._prev_x = x
         terms = {k: w * values[k] for k, w in self.reward_weights.items() if w != 0.0}
-        terminated = self.tripped or self.finished
+        terminated = self.tripped or self.off_path or self.finished
         return float(sum(terms.values())), terms, terminated, self.info(d)
 
     def info(self, data: mujoco.MjData, *, diverged: bool = False) -> dict:
@@ -265,6 +307,7 @@ class ObstacleWalkTask:
         return {
             "tripped": self.tripped,
             "misstepped": self.misstepped,
+            "off_path": self.off_path,
             "finished": self.finished,
             "events": len(self.gait.events),
             "obstacles_passed": self.n_passed,
@@ -273,12 +316,19 @@ class ObstacleWalkTask:
         }
 
 
-def top_corners(obstacles: np.ndarray) -> np.ndarray:
-    """(N, 2, 3) near-left and far-right top corners of course obstacles (the points the eye sees)."""
-    x, y, depth, width, height = (obstacles[:, i] for i in range(5))
-    near = np.stack([x - 0.5 * depth, y + 0.5 * width, height], axis=1)
-    far = np.stack([x + 0.5 * depth, y - 0.5 * width, height], axis=1)
-    return np.stack([near, far], axis=1)
+def top_points(x: float, y: float, depth: float, width: float, height: float) -> tuple:
+    """The :data:`TOP_POINTS` of an obstacle's top face (centre x, y; extents along x and y; height)."""
+    x0, x1, y0, y1 = x - 0.5 * depth, x + 0.5 * depth, y - 0.5 * width, y + 0.5 * width
+    return (x0, y1, height), (x1, y0, height), (x0, y, height), (x1, y, height)
 
 
-__all__ = ["KINDS", "K_SLOTS", "Course", "CourseDistribution", "ObstacleWalkTask", "sample_course", "top_corners"]
+def top_points_of(obstacles: np.ndarray) -> np.ndarray:
+    """(N, 4, 3) :data:`TOP_POINTS` of course obstacles (rows of :attr:`Course.obstacles`)."""
+    return np.array([top_points(*row[:5]) for row in obstacles.tolist()], dtype=float).reshape(-1, N_POINTS, 3)
+
+
+_UNSEEN_SLOT = [0.0] * (4 * N_POINTS)
+
+
+__all__ = ["KINDS", "K_SLOTS", "N_POINTS", "TOP_POINTS", "Course", "CourseDistribution", "ObstacleWalkTask",
+           "sample_course", "top_points", "top_points_of"]
