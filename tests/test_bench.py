@@ -441,3 +441,21 @@ def test_the_twin_of_a_twin_is_refused():
     for spec in ("fixed_gaze", "gaze_blind:eyecatch"):
         with pytest.raises(ValueError, match="already a gaze-blind agent"):
             twin_spec(spec)
+
+
+def test_summary_rows_speak_each_familys_terms():
+    """A walk result reads 'success rate' and 'distance left', with no throw reaction times; a catch
+    result keeps 'catch rate' and its reaction times (same results dict, only the env id differs)."""
+    from visuomotor_gym.bench.commands import summary_rows
+
+    base = {"catch_rate": 0.5, "catch_rate_ci95": [0.1, 0.9], "caught": 1, "episodes": 2,
+            "gaze_realism": {"score": 0.5, "components": {}}, "latency_ms": {"p50": 1.0, "p95": 2.0, "max": 3.0},
+            "real_time": True, "control_period_ms": 20.0,
+            "reaction_times_s": {"first_saccade": {"mean": 0.2, "median": 0.2}},
+            "time_to_catch_s": {"mean": 1.0, "median": 1.0}, "miss_distance_m": {"mean": 0.3, "median": 0.3},
+            "diverged": 0}
+    walk = dict(summary_rows({**base, "env_id": "ObstacleWalk-v0"}))
+    catch = dict(summary_rows({**base, "env_id": "EyeCatch-v0"}))
+    assert "success rate" in walk and "catch rate" not in walk and "distance left, failed walks (m)" in walk
+    assert not any(k.startswith("reaction time") for k in walk)
+    assert "catch rate" in catch and "reaction time, first saccade (s)" in catch and "miss distance (m)" in catch

@@ -50,8 +50,8 @@ class ObstacleWalkEnv(VisuomotorEnv):
     ## Description
 
     A walker (pelvis, torso, two 5-DOF legs, neck and the cyclopean eye of every body in this package)
-    walks a straight 15-20 m path across bars and boxes 5-30 cm high and flat 70 cm mats, **seeing them
-    only through a human-like eye**: the same oculomotor plant, foveated noise (Eyecatch Eq. 1-3),
+    walks a straight 15-20 m walkway, 1.5 m wide, across bars that span it and boxes 5-30 cm high and
+    flat 70 cm mats, **seeing them only through a human-like eye**: the same oculomotor plant, foveated noise (Eyecatch Eq. 1-3),
     field of view, saccadic suppression and vestibulo-ocular reflex as the catch family. An obstacle
     2 m ahead lies ~40 deg below a level gaze, where the noise is ~20x the fovea's: to place its feet
     the walker has to look down (Iwao et al., seed 003; Patla & Vickers 1997). An obstacle is seen
@@ -63,7 +63,7 @@ class ObstacleWalkEnv(VisuomotorEnv):
     the next footstep (length, lateral offset, toe clearance) is read at each mid-stance; the pelvis
     and legs follow analytic inverse kinematics tracked by servos at 500 Hz (``envs_assets/README.md``).
     MuJoCo contacts decide what happens: a leg striking an obstacle is a **trip**, a foot landing on
-    one a **misstep**. Physics 500 Hz, control 50 Hz. The rungs of the observability ladder are
+    one a **misstep**, a foot landing beyond the walkway's painted edges is **off path**. Physics 500 Hz, control 50 Hz. The rungs of the observability ladder are
     keyword arguments of this one class (``visuomotor_gym.registration``).
 
     ## Action Space
@@ -86,10 +86,11 @@ class ObstacleWalkEnv(VisuomotorEnv):
     ## Observation Space
 
     ``Box(-inf, inf, (N,), float32)`` (N in the table) by default, or with ``obs_mode="dict"`` a
-    ``Dict`` of the same blocks. The obstacle blocks are what the eye perceived (true corners only with
-    ``vision="oracle"``); everything else is proprioception. Each obstacle is seen as two points, the
-    near-left and far-right corners of its top face (footprint and height of an axis-aligned box); the
-    four slots hold the next four obstacles of the course (a slot's obstacle leaves when the pelvis is
+    ``Dict`` of the same blocks. The obstacle blocks are what the eye perceived (true points only with
+    ``vision="oracle"``); everything else is proprioception. Each obstacle is seen as four points of its
+    top face: the near-left and far-right corners (footprint and height of an axis-aligned box) and the
+    midpoints of the near and far edges (where the eye meets a bar too wide for both ends to be in its
+    field); the four slots hold the next four obstacles of the course (a slot's obstacle leaves when the pelvis is
     0.5 m past it; the id says which obstacle a slot holds).
 
     OBSERVATION_TABLE
@@ -97,21 +98,22 @@ class ObstacleWalkEnv(VisuomotorEnv):
     ## Rewards
 
     A sum of named terms, each in ``info["reward_terms"]``: ``finish`` (+1 when the finish line is
-    reached with no trip and no misstep), ``trip`` (-1 on the trip), ``misstep`` (-1 per misstep) and
-    ``progress`` (weight 0 by default; x metres walked this step). ``reward_weights`` overrides any
+    reached with no trip and no misstep), ``trip`` (-1 on the trip), ``misstep`` (-1 per misstep),
+    ``off_path`` (-1 when a foot lands outside the walkway) and ``progress`` (weight 0 by default; x metres walked this step). ``reward_weights`` overrides any
     weight by name.
 
     ## Starting State
 
     The walker is in stride at 1.3 m/s, its left heel striking at the start of the path, head
     straight, gaze level along the path. The course is drawn from ``course_distribution``
-    (``CourseDistribution`` in ``visuomotor_gym.tasks.obstacle_walk``: 15-20 m; bars, boxes and mats
-    with free gaps of 1.6-3 m, the first 3-4.5 m ahead) before any vision noise, so a seed gives the
+    (``CourseDistribution`` in ``visuomotor_gym.tasks.obstacle_walk``: 15-20 m of 1.5 m walkway; bars,
+    boxes and mats with free gaps of 1.6-3 m, the first 3-4.5 m ahead) before any vision noise, so a seed gives the
     same course on every rung.
 
     ## Episode End
 
-    Terminated at the first **trip** (``info["tripped"]``), when the pelvis crosses the finish line
+    Terminated at the first **trip** (``info["tripped"]``), when a foot lands outside the walkway
+    (``info["off_path"]``, a failure), when the pelvis crosses the finish line
     (``info["finished"]``; ``info["is_success"]`` when nothing was tripped over or stepped on: a
     misstep does not end the walk but fails it), or when the physics diverges
     (``info["physics_diverged"]``). Truncated only by the registered ``max_episode_steps`` (2000
@@ -127,7 +129,7 @@ class ObstacleWalkEnv(VisuomotorEnv):
     | ``vision_params`` | None | ``VisionParams`` or a dict of its fields; the default is the catch family's except ``field_of_view_deg`` = 20 (see below) |
     | ``visual_delay_s`` | 0.0 | visual latency, a multiple of the control period |
     | ``obs_mode`` | ``"flat"`` | ``"flat"`` or ``"dict"`` |
-    | ``reward_weights`` | None | dict overriding term weights (``finish``, ``trip``, ``misstep``, ``progress``) |
+    | ``reward_weights`` | None | dict overriding term weights (``finish``, ``trip``, ``misstep``, ``off_path``, ``progress``) |
     | ``oculomotor_params`` | None | ``OculomotorParams`` or dict |
     | ``gait_params`` | None | ``GaitParams`` or dict (``visuomotor_gym.body.walker``) |
     | ``course_distribution`` | None | ``CourseDistribution`` or dict |
@@ -139,7 +141,8 @@ class ObstacleWalkEnv(VisuomotorEnv):
 
     ## Version History
 
-    * v0: initial release (issue 12).
+    * v0: initial release (issue 12); redefined before release: the 1.5 m walkway (off path ends the
+      episode), bars across it, four seen points per obstacle.
     """
 
     render_cameras = {
