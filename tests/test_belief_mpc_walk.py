@@ -138,8 +138,8 @@ def test_dispatch_on_the_family():
     assert isinstance(agent, StonesBeliefMPCAgent)
     assert agent.vision.field_of_view_deg == 20.0  # the env's own vision constants
     with pytest.raises(TypeError):
-        make_agent("belief_mpc:no_such=1", ENV, 8)
-    assert make_agent("belief_mpc:w_tsk=0", ENV, 8).params.w_tsk == 0.0
+        make_agent("belief_mpc:no_such=1", ENV, 9)
+    assert make_agent("belief_mpc:w_tsk=0", ENV, 9).params.w_tsk == 0.0
     with pytest.raises(ValueError):
         StonesBeliefMPCParams(window_s=0.1)
 
@@ -148,7 +148,7 @@ def test_short_episode_looks_down_lands_on_stones_and_shrinks_the_belief():
     agent, actions, info = _run("belief_mpc", 3, 200)  # 4 s: the slab and the first stones
     assert not info["fell"] and info["stones_landed"] >= 2
     assert np.all(np.abs(actions) <= 1.0)
-    assert np.any(actions[:, 4] < -0.05)  # the eye is sent down toward the stones
+    assert np.any(actions[:, 5] < -0.05)  # the eye is sent down toward the stones
     fixated = {e["fixate"] for e in agent.plan_log}
     assert len(fixated) >= 4
     for i in range(4):  # every stone looked at: its compact covariance far below the course prior
@@ -161,7 +161,7 @@ def test_determinism_and_the_gaze_blind_twin():
     _, a2, _ = _run("belief_mpc", 5, 80)
     assert np.array_equal(a1, a2)
     _, b, _ = _run("gaze_blind:belief_mpc", 5, 80)
-    assert np.all(b[:, 3:5] == 0.0) and np.all(b[:, 6:8] == 0.0)
+    assert np.all(b[:, 4:6] == 0.0) and np.all(b[:, 7:9] == 0.0)
 
 
 # --- ObstacleDodge-v0 (experimental) -----------------------------------------------------------

@@ -46,14 +46,14 @@ def test_gymnasium_and_sb3_checkers():
 def test_layout_docstring_and_spaces_agree():
     env = SteppingStonesEnv()
     assert env.observation_structure == STONES_LAYOUT.structure
-    assert env.action_structure == {"footstep": 3, "gaze": 2, "fixation": 1, "head": 2}
+    assert env.action_structure == {"footstep": 4, "gaze": 2, "fixation": 1, "head": 2}
     assert "| 0-4 | stone_0 | 5 |" in SteppingStonesEnv.__doc__
     assert f"({STONES_LAYOUT.size},)" in SteppingStonesEnv.__doc__
 
 
 def test_same_seed_same_episode_and_pickling_mid_episode():
     rng = np.random.default_rng(0)
-    actions = rng.uniform(-1, 1, (60, 8)).astype(np.float32)
+    actions = rng.uniform(-1, 1, (60, 9)).astype(np.float32)
     assert_reproducible_and_picklable(SteppingStonesEnv, actions)
     a = rollout(SteppingStonesEnv(), 3, actions)
     c = rollout(SteppingStonesEnv(), 4, actions)
@@ -63,12 +63,12 @@ def test_same_seed_same_episode_and_pickling_mid_episode():
 def test_bad_input_gives_clear_errors():
     env = SteppingStonesEnv()
     env.reset(seed=0)
-    bad = np.zeros(8, np.float32)
-    bad[2] = np.nan
+    bad = np.zeros(9, np.float32)
+    bad[3] = np.nan  # the turn
     with pytest.raises(ValueError, match="NaN or inf"):
         env.step(bad)
     with pytest.raises(ValueError, match="shape"):
-        env.step(np.zeros(9, np.float32))
+        env.step(np.zeros(8, np.float32))
     with pytest.raises(TypeError, match="unknown argument"):
         SteppingStonesEnv(n_balls=2)
     with pytest.raises(ValueError, match="unknown term"):
@@ -80,16 +80,16 @@ def test_bad_input_gives_clear_errors():
     with pytest.raises(ValueError, match="n_stones"):
         SteppingStonesEnv(course_distribution={"n_stones": 40})
     with pytest.raises(RuntimeError, match="before reset"):
-        SteppingStonesEnv().step(np.zeros(8, np.float32))
-    agent = make_agent("lookahead", "SteppingStones-v0", 8)
+        SteppingStonesEnv().step(np.zeros(9, np.float32))
+    agent = make_agent("lookahead", "SteppingStones-v0", 9)
     with pytest.raises(ValueError, match="observation of size"):
         agent.predict(np.zeros(5))
 
 
 def _look_up(n):
-    a = np.zeros((n, 8), np.float32)
-    a[:, 4] = 0.5  # gaze up (elevation, 30 deg a step until the eye's range)
-    a[:, 7] = 1.0  # head up (neck pitch +40 deg)
+    a = np.zeros((n, 9), np.float32)
+    a[:, 5] = 0.5  # gaze up (elevation, 30 deg a step until the eye's range)
+    a[:, 8] = 1.0  # head up (neck pitch +40 deg)
     return a
 
 
@@ -125,41 +125,55 @@ def test_no_observation_leak_of_the_stones_true_positions(vision):
         assert differ
 
 
-def _steppable(course, dist, lo, hi):
-    """Interval propagation: a foot-centre sequence within ``foot_margin_m`` of each stone exists."""
-    a, b = dist.start_foot_y_m - dist.start_foot_spread_m, dist.start_foot_y_m + dist.start_foot_spread_m
-    for k, (_, y) in enumerate(course.stones.tolist()):
-        ra, rb = (a + lo, b + hi) if k % 2 == 0 else (a - hi, b - lo)
-        a, b = max(ra, y - dist.foot_margin_m), min(rb, y + dist.foot_margin_m)
-        if a > b + 1e-9:
+def _steppable(course, dist, w_lo, w_hi, max_turn_deg):
+    """Brute force over a 0.1 deg grid of headings: a foothold sequence exists with each foot's centre
+    on its stone's centre, each step's width (across its own heading) in [w_lo, w_hi] on the foot's side
+    and each heading within ``max_turn_deg`` of the one before (the last slab foot: heading 0)."""
+    grid = np.radians(np.arange(-120.0, 120.0, 0.1))
+    ok = np.abs(grid) < 1e-9  # headings the previous foothold can have
+    reach = round(max_turn_deg / 0.1)
+    prev = np.array([dist.start_foot_x_m, dist.start_foot_y_m])
+    for k, st in enumerate(course.stones):
+        d = st - prev
+        width = (-d[0] * np.sin(grid) + d[1] * np.cos(grid)) * (1.0 if k % 2 == 0 else -1.0)
+        fwd = d[0] * np.cos(grid) + d[1] * np.sin(grid)
+        spread = np.convolve(ok.astype(float), np.ones(2 * reach + 1), mode="same") > 0
+        ok = spread & (width >= w_lo - 1e-9) & (width <= w_hi + 1e-9) & (fwd >= 0.25) & (fwd <= 0.95)
+        if not ok.any():
             return False
+        prev = st
     return True
 
 
-def test_course_sampler_follows_alsteps_and_every_course_is_steppable():
+def test_course_sampler_follows_allsteps_turns_beyond_20_deg_and_every_course_is_steppable():
     dist = CourseDistribution()
-    turns, in_range = [], []
+    turns, in_range, widest = [], [], []
     for seed in range(200):
-        course = sample_course(np.random.default_rng(seed), dist, (-0.3, 0.3), (0.12, 0.06))
+        course = sample_course(np.random.default_rng(seed), dist, (-0.3, 0.3), (0.12, 0.06), 45.0)
         st = course.stones
         assert len(st) == dist.n_stones
         prev = np.vstack([[dist.start_foot_x_m, dist.start_foot_y_m], st[:-1]])
         spacing = np.linalg.norm(st - prev, axis=1)
         in_range += ((spacing >= 0.65 - 1e-9) & (spacing <= 0.85 + 1e-9)).tolist()
-        assert np.all((spacing > 0.5) & (spacing < 1.0))  # a redrawn stone moves sideways only
         assert np.all(np.abs(course.headings) <= math.radians(dist.max_heading_deg) + 1e-9)
         turns += np.abs(np.diff(np.concatenate([[0.0], course.headings]))).tolist()
-        assert np.all(np.diff(st[:, 0]) > 0.5)  # stones never overlap (radius 0.25)
-        assert _steppable(course, dist, 0.06 + dist.lateral_slack_m, 0.42 - dist.lateral_slack_m)
-    assert np.mean(in_range) > 0.98  # ALLSTEPS' 0.65-0.85 m spacing (the rare redraw moves a stone sideways)
+        widest.append(np.degrees(np.abs(course.headings).max()))
+        assert np.all(np.diff(st[:, 0]) > 0.3)  # the path always leads away from the slab
+        gaps = np.linalg.norm(st[:, None] - st[None], axis=2) + 9.0 * np.eye(len(st))
+        assert gaps.min() > 0.5  # stones never overlap (radius 0.25)
+        assert _steppable(course, dist, 0.06 + dist.lateral_slack_m, 0.42 - dist.lateral_slack_m, 45.0 - dist.turn_slack_deg)
+    assert np.mean(in_range) > 0.98  # ALLSTEPS' 0.65-0.85 m spacing
     turns = np.degrees(turns)
-    assert np.mean(turns <= 30.0 + 1e-6) > 0.98 and turns.max() > 20.0  # ALLSTEPS: +-30 deg, and used
+    assert np.mean(turns <= 30.0 + 1e-6) > 0.98 and turns.max() > 25.0  # ALLSTEPS: +-30 deg, and used
+    widest = np.array(widest)
+    # The path's direction drifts well beyond the +-20 deg the first (non-turning) walker was held to.
+    assert np.mean(widest > 20.0) > 0.9 and np.mean(widest > 40.0) > 0.5 and widest.max() > 55.0
 
 
 def test_a_foot_over_the_gap_ends_the_episode_and_scores_minus_one():
     env = SteppingStonesEnv()
     env.reset(seed=0)
-    a = np.zeros(8, np.float32)
+    a = np.zeros(9, np.float32)
     a[0] = 1.0  # 0.95 m steps: off the slab and past the stones
     for _ in range(1000):
         _, r, term, _, info = env.step(a)
@@ -172,7 +186,7 @@ def test_a_foot_over_the_gap_ends_the_episode_and_scores_minus_one():
 
 def _successes(agent, seeds, env_id="SteppingStones-v0"):
     env = gym.make(env_id)
-    policy = make_agent(agent, env_id, 8)
+    policy = make_agent(agent, env_id, 9)
     wins = 0
     for seed in seeds:
         obs, _ = env.reset(seed=seed)
@@ -187,7 +201,7 @@ def _successes(agent, seeds, env_id="SteppingStones-v0"):
 
 def test_the_oracle_lookahead_crosses_and_success_lands_on_the_last_stone():
     env = gym.make("SteppingStonesOracle-v0")
-    policy = make_agent("lookahead", "SteppingStonesOracle-v0", 8)
+    policy = make_agent("lookahead", "SteppingStonesOracle-v0", 9)
     obs, info = env.reset(seed=1)
     while True:
         obs, r, term, trunc, info = env.step(policy.predict(obs)[0])
@@ -196,6 +210,28 @@ def test_the_oracle_lookahead_crosses_and_success_lands_on_the_last_stone():
     task = env.unwrapped.task
     assert info["is_success"] and info["finished"] and r == pytest.approx(1.0)
     assert task.landings[-1][1] == len(task.course.stones) - 1 and info["stones_landed"] >= 10
+
+
+def test_lookahead_turns_the_walker_along_a_curving_course():
+    """A course whose path turns beyond +-40 deg: the oracle lookahead crosses it, the pelvis turning with
+    the path (its yaw follows the stones' headings) and every foot landing on a stone."""
+    env = gym.make("SteppingStonesOracle-v0")
+    policy = make_agent("lookahead", "SteppingStonesOracle-v0", 9)
+    for seed in range(20):
+        obs, info = env.reset(seed=seed)
+        if np.abs(env.unwrapped.course.headings).max() > math.radians(45.0):
+            break
+    headings = env.unwrapped.course.headings
+    yaws = []
+    while True:
+        obs, _, term, trunc, info = env.step(policy.predict(obs)[0])
+        yaws.append(float(env.unwrapped.data.qpos[3]))
+        if term or trunc:
+            break
+    assert info["is_success"]
+    yaws = np.array(yaws)
+    assert np.abs(yaws).max() > math.radians(35.0)  # the walker turned, well beyond +-20 deg
+    assert np.sign(yaws[np.argmax(np.abs(yaws))]) == np.sign(headings[np.argmax(np.abs(headings))])
 
 
 def test_lookahead_crosses_more_courses_than_its_gaze_blind_twin():
@@ -237,7 +273,7 @@ def test_summary_routes_stones_traces_to_the_stones_realism():
     from visuomotor_gym.metrics.summary import summarize
 
     env = gym.make("SteppingStones-v0")
-    trace = run_episode(env, make_agent("lookahead", "SteppingStones-v0", 8), 2, "SteppingStones-v0", "lookahead")
+    trace = run_episode(env, make_agent("lookahead", "SteppingStones-v0", 9), 2, "SteppingStones-v0", "lookahead")
     out = summarize([trace])
     assert set(out["gaze_realism"]["components"]) == {"fixation_steps_ahead", "fixation_lead_s"}
     assert out["episodes"] == 1 and out["success_rate"] in (0.0, 1.0)

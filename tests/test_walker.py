@@ -16,7 +16,7 @@ import pytest
 from visuomotor_gym import assets
 from visuomotor_gym.body import names
 from visuomotor_gym.body import walker_names as wn
-from visuomotor_gym.body.walker import GaitParams, WalkerGait
+from visuomotor_gym.body.walker import DEG, GaitParams, TurningGait, WalkerGait
 
 OBJ = {
     "body": mujoco.mjtObj.mjOBJ_BODY,
@@ -470,3 +470,99 @@ def test_targets_are_bit_identical_to_the_plain_formulas(model):
                 gait.set_next_footstep(rng.uniform(0.2, 1.0), rng.uniform(-0.35, 0.35), rng.uniform(0.0, 0.5))
                 gait._latch()
             assert gait.targets_at(tick).tobytes() == _reference_targets(gait, tick).tobytes(), tick
+
+
+def _turning_walk(model, duration_s, command, record=None, x=0.0, y=0.0, yaw=0.0):
+    data = mujoco.MjData(model)
+    gait = TurningGait(model)
+    gait.pool.park_all(model, data)
+    gait.reset(model, data, x, y, yaw)
+    for _ in range(round(duration_s / DT)):
+        gait.set_next_footstep(*command(gait))
+        gait.advance(data, DT)
+        gait.step_physics(model, data, NSUB)
+        if record is not None:
+            record(gait, data)
+    return gait, data
+
+
+def test_turning_gait_follows_its_footholds_headings(model):
+    """Footsteps turning by up to +-45 deg (SteppingStones' gait): the feet land within 1 cm of the
+    commanded footholds, the pelvis and the stance foot face each foothold's heading at its
+    mid-stance, the soles stay on the floor, nothing trips, and the heading drifts far beyond 20 deg."""
+    rng = np.random.default_rng(5)
+    plan = {}
+    lim = GaitParams().max_turn_deg * DEG
+
+    def command(gait):
+        j = gait.next_footstep_index
+        if j not in plan:
+            plan[j] = (float(rng.uniform(0.55, 0.8)), float(rng.uniform(-0.05, 0.05)), 0.05,
+                       float(rng.uniform(-lim, lim)) if j % 3 else lim)
+        return plan[j]
+
+    landed, mid = {}, {}
+    feet = [model.body(n).id for n in wn.WALKER_FEET]
+
+    def record(gait, data):
+        k = gait.current_step()
+        s = gait.tick - k * gait.T
+        side = gait.side_of(k)
+        if s == round(0.2 / gait.timestep):  # foot flat
+            sole = data.site_xpos[gait.sole_sites[side]]
+            landed[k] = (sole[0], sole[1], sole[2])
+        if s == gait.T_mid:  # mid-stance of foothold k
+            fx = data.xmat[feet[side]].reshape(3, 3)[:, 0]
+            mid[k] = (float(data.qpos[3]), math.atan2(fx[1], fx[0]))
+
+    gait, data = _turning_walk(model, 10.0, command, record, x=0.5, y=1.0, yaw=-0.3)
+    assert gait.events == [] and not gait.tripped and not gait.misstepped
+    assert np.isfinite(data.qpos).all()
+    checked = 0
+    for j, cmd in plan.items():
+        if j in landed and j in gait.commanded and j in mid:
+            assert gait.commanded[j] == pytest.approx(cmd)
+            x, y = gait.foothold_world(j)
+            assert math.hypot(landed[j][0] - x, landed[j][1] - y) < 0.01, (j, landed[j], (x, y))
+            assert abs(landed[j][2]) < 0.01  # the sole on the floor (servo lag in the sharpest turns: ~5 mm)
+            h = gait.heading_of(j)
+            assert abs(math.remainder(mid[j][0] - h, 2 * math.pi)) < 2.0 * DEG  # pelvis yaw
+            assert abs(math.remainder(mid[j][1] - h, 2 * math.pi)) < 2.0 * DEG  # the stance foot points along it
+            # The foothold is the command in the new heading's frame.
+            assert gait.h[j] - gait.h[j - 1] == pytest.approx(cmd[3])
+            c, s = math.cos(gait.h[j]), math.sin(gait.h[j])
+            du, dv = gait.u[j] - gait.u[j - 1], gait.v[j] - gait.v[j - 1]
+            sign = 1.0 if gait.side_of(j) == 0 else -1.0
+            assert c * du + s * dv == pytest.approx(cmd[0])
+            assert -s * du + c * dv == pytest.approx(sign * max(gait.p.step_width_m + sign * cmd[1], gait.p.min_step_width_m))
+            checked += 1
+    assert checked >= 14
+    assert max(abs(h) for h in gait.h.values()) > 60.0 * DEG
+
+
+def test_turning_gait_without_turns_walks_as_the_straight_gait(model):
+    """Zero turns: the same footholds as :class:`WalkerGait` and targets within float rounding."""
+    a, b = WalkerGait(model), TurningGait(model)
+    rng = np.random.default_rng(11)
+    for g in (a, b):
+        g.reset_plan(0.3, -0.2, 0.25)
+    for tick in range(-250, 1500):
+        while a.next_latch_tick <= tick + 1:
+            cmd = (rng.uniform(0.3, 0.9), rng.uniform(-0.3, 0.3), rng.uniform(0.02, 0.4))
+            a.set_next_footstep(*cmd)
+            b.set_next_footstep(*cmd, turn=0.0)
+            a._latch()
+            b._latch()
+        np.testing.assert_allclose(b.targets_at(tick), a.targets_at(tick), rtol=0, atol=1e-9)
+    for j in a.u:
+        assert a.foothold_world(j) == pytest.approx(b.foothold_world(j), abs=1e-12)
+
+
+def test_turns_are_clipped_and_checked(model):
+    g = TurningGait(model)
+    g.set_next_footstep(0.6, 0.0, 0.05, turn=2.0)
+    assert g.pending_turn == pytest.approx(g.p.max_turn_deg * DEG)
+    with pytest.raises(ValueError):
+        g.set_next_footstep(0.6, 0.0, 0.05, turn=float("nan"))
+    g2 = pickle.loads(pickle.dumps(g))
+    assert g2.pending_turn == g.pending_turn

@@ -20,7 +20,8 @@ Every 20 ms control step the agent
 3. **executes** the first node of the plan: the eye is asked for the direction of the chosen stone's
    believed centre (a saccade when far, pursuit when near; the env's plant decides), the head taking
    ``head_share`` of it (the lookahead agent's split); the footstep at each mid-stance read is the
-   lookahead agent's planner on the same belief means (foot centre on the believed stone).
+   lookahead agent's planner on the same belief means (foot centre on the believed stone, the step's
+   heading turned toward it within the gait's 45 deg a step).
 
 ``gaze_blind:belief_mpc`` on a stones env is its gaze-blind twin (gaze and head held; the same belief
 and planners).
@@ -185,8 +186,8 @@ class StonesBeliefMPCAgent(LookaheadAgent):
         if reads_now:  # this step's command is read at mid-stance
             self.footstep = self._plan(obs, odo)
         self._lap("footsteps")
-        action = np.zeros(8, dtype=np.float32)
-        action[0:3] = self.footstep
+        action = np.zeros(9, dtype=np.float32)
+        action[0:4] = self.footstep
 
         # --- 2. the gaze plan ---------------------------------------------------------------------------
         world = StoneMemory.eye_pose(*pose)
@@ -196,7 +197,7 @@ class StonesBeliefMPCAgent(LookaheadAgent):
         # --- 3. execute -----------------------------------------------------------------------------------
         self.log.append((t, target))
         if not self.params.gaze_blind:
-            action[3:8] = self._look_at(self._believed_xy(target), pose)
+            action[4:9] = self._look_at(self._believed_xy(target), pose)
         self._lap("execution")
         return action
 

@@ -15,10 +15,13 @@ yaw (modelling choice, the iwao agent's head/eye split).
 **Belief**: :class:`~.perception.StoneMemory` fuses every percept of a stone.
 
 **Footsteps**: at each mid-stance read the next foothold goes onto the first stone ahead of the last
-latched foothold (the foot's centre on the stone's estimated centre, nudged toward the foot's own side
-and so that the next stone stays reachable by the other foot); an unseen stone is extrapolated from the
-two before it; beyond the longest step (still on the slab) the distance is split into equal nominal
-steps.
+latched foothold: the foot's centre on the stone's estimated centre, nudged toward the foot's own
+side. The walker turns (:class:`~visuomotor_gym.body.walker.TurningGait`): the footstep's **heading**
+is the direction of that step less the angle of the nominal step width (so the step is straight ahead
+in its own frame, the feet its width apart), clipped to the gait's largest turn from the previous
+foothold's heading; length and width follow in that frame. An unseen stone is extrapolated from the two
+before it; beyond the longest step (still on the slab) the distance is split into equal nominal steps
+along the current heading.
 
 ``gaze_blind=True`` holds gaze and head (gaze action 0: gaze stays level along the slab where the
 episode put it; head straight): the gaze-blind twin of DESIGN section 2, the same belief and planner.
@@ -32,7 +35,7 @@ from dataclasses import dataclass, fields, replace
 import numpy as np
 
 from visuomotor_gym.body.walker import GaitParams
-from visuomotor_gym.body.walker_body import WalkerBody
+from visuomotor_gym.body.walker_body import TurningWalkerBody as WalkerBody
 from visuomotor_gym.envs.stones import STONES_LAYOUT
 from visuomotor_gym.registration import env_vision, env_vision_params
 from visuomotor_gym.tasks.stepping_stones import FOOT_CENTRE_AHEAD_M, K_SLOTS
@@ -58,14 +61,12 @@ class LookaheadParams:
     # Fraction of the gaze's pitch and yaw taken by the head (modelling choice: a third, as the iwao
     # agent's alpha = 0.5).
     head_share: float = 1.0 / 3.0
-    # Where the foot's centre aims on a stone: this far toward the foot's own side (modelling choice:
-    # keeps the feet apart at the gait's nominal half step width).
+    # Where the foot's centre aims on a stone: this far toward the foot's own side, across the step's
+    # heading (modelling choice: keeps the feet apart at a third of the gait's nominal 0.12 m step width).
     side_offset_m: float = 0.04
-    # The foot centre may be planned this far from a stone's estimated centre (modelling choice: 0.25 m
-    # radius less the foot's half width and ~6 cm for the estimate's error).
-    on_stone_m: float = 0.15
-    # Reach assumed for the other foot onto the stone after (the course generator's 12 cm margin).
-    next_margin_m: float = 0.12
+    # A turn is planned at most this far short of the gait's largest (modelling choice: margin for the
+    # clipping of the action's float32 round trip).
+    turn_margin_deg: float = 0.5
     # Nominal spacing used to extrapolate a stone not seen yet (the middle of ALLSTEPS' 0.65-0.85 m).
     spacing_m: float = 0.75
 
@@ -99,8 +100,8 @@ class LookaheadAgent:
         self.poses: list = []
         self.planned_stone = -1  # the stone the last latched foothold was planned onto
         self.next_stone = 0
-        self.footstep = WalkerBody.action_from_footstep(self.gait.nominal_step_m, 0.0, self.gait.nominal_clearance_m,
-                                                        self.gait)
+        self.footstep = [*WalkerBody.action_from_footstep(self.gait.nominal_step_m, 0.0, self.gait.nominal_clearance_m,
+                                                          self.gait), 0.0]
         self.log: list[tuple] = []  # (time, gaze target stone) per step
 
     # ------------------------------------------------------------------------------------------
@@ -138,10 +139,10 @@ class LookaheadAgent:
         latch_in = ol[_S["gait_phase"].start + 2]
         if latch_in <= self.params.control_dt + 1e-6:  # this step's command is read at mid-stance
             self.footstep = self._plan(obs, odo)
-        action = np.zeros(8, dtype=np.float32)
-        action[0:3] = self.footstep
+        action = np.zeros(9, dtype=np.float32)
+        action[0:4] = self.footstep
         if not self.params.gaze_blind:
-            action[3:8] = self._look(obs, pose)
+            action[4:9] = self._look(obs, pose)
         return action
 
     # --- belief -------------------------------------------------------------------------------
@@ -157,46 +158,49 @@ class LookaheadAgent:
         h = math.atan2(by - ay, bx - ax)
         return bx + self.params.spacing_m * math.cos(h), by + self.params.spacing_m * math.sin(h)
 
-    def _footholds(self, obs: np.ndarray, odo) -> list[tuple[float, float, float]]:
+    def _footholds(self, obs: np.ndarray, odo) -> list[tuple[float, float, float, float]]:
+        """The three observed footholds in the path frame: (x, y, side, heading)."""
         f = obs[_S["footholds"]].reshape(3, 3)
+        hd = obs[_S["foothold_headings"]].tolist()
         c, s = math.cos(odo[2]), math.sin(odo[2])
-        return [(odo[0] + c * x - s * y, odo[1] + s * x + c * y, side) for x, y, side in f.tolist()]
+        return [(odo[0] + c * x - s * y, odo[1] + s * x + c * y, side, odo[2] + h)
+                for (x, y, side), h in zip(f.tolist(), hd)]
 
     # --- footsteps ----------------------------------------------------------------------------
     def _plan(self, obs: np.ndarray, odo) -> list[float]:
         g, p = self.gait, self.params
-        u_b, v_b, side_b = self._footholds(obs, odo)[-1]
+        x_b, y_b, side_b, h_b = self._footholds(obs, odo)[-1]
         side = 1 - round(side_b)  # the new foothold's foot
         sign = 1.0 if side == 0 else -1.0
-        lo, hi = g.min_step_width_m, g.step_width_m + g.lateral_range_m[1]
-        reach = (v_b + lo, v_b + hi) if side == 0 else (v_b - hi, v_b - lo)
         target = max(self.planned_stone + 1, self.next_stone)
         xy = self.stone_xy(target)
-        length, v = g.nominal_step_m, v_b + sign * g.step_width_m
+        length, width, heading = g.nominal_step_m, g.step_width_m, h_b
         if xy is None and target >= 1 and self.planned_stone == target - 1:
             self.planned_stone = target  # an unseen stone: a nominal step toward where it should be
         if xy is not None:
-            dist = xy[0] - FOOT_CENTRE_AHEAD_M - u_b
-            if dist > g.step_range_m[1] - 0.05:  # still on the slab: equal steps up to the stone
-                length = dist / max(math.ceil(dist / (g.step_range_m[1] - 0.05)), round(dist / g.nominal_step_m))
-                v = v_b + sign * g.step_width_m
+            cb, sb = math.cos(h_b), math.sin(h_b)
+            ahead = (xy[0] - x_b) * cb + (xy[1] - y_b) * sb - FOOT_CENTRE_AHEAD_M
+            if ahead > g.step_range_m[1] - 0.05:  # still on the slab: equal steps up to the stone
+                length = ahead / max(math.ceil(ahead / (g.step_range_m[1] - 0.05)), round(ahead / g.nominal_step_m))
             else:
-                length = dist
-                lo_v, hi_v = max(reach[0], xy[1] - p.on_stone_m), min(reach[1], xy[1] + p.on_stone_m)
-                nxt = self.stone_xy(target + 1)
-                if nxt is not None:  # the other foot must reach the stone after this one
-                    m = p.next_margin_m
-                    if side == 1:  # the next foot is a left one: v' in [v + lo, v + hi]
-                        a, b = nxt[1] - m - hi, nxt[1] + m - lo
-                    else:
-                        a, b = nxt[1] - m + lo, nxt[1] + m + hi
-                    if max(lo_v, a) <= min(hi_v, b):
-                        lo_v, hi_v = max(lo_v, a), min(hi_v, b)
-                want = xy[1] + sign * p.side_offset_m
-                v = min(max(want, lo_v), hi_v) if lo_v <= hi_v else min(max(want, reach[0]), reach[1])
+                lim = (g.max_turn_deg - p.turn_margin_deg) * DEG
+                heading = h_b
+                for _ in range(3):  # the aim depends on the heading (foot centre ahead, side offset across)
+                    c, s = math.cos(heading), math.sin(heading)
+                    fx = xy[0] - FOOT_CENTRE_AHEAD_M * c - sign * p.side_offset_m * s
+                    fy = xy[1] - FOOT_CENTRE_AHEAD_M * s + sign * p.side_offset_m * c
+                    dx, dy = fx - x_b, fy - y_b
+                    dist = math.hypot(dx, dy)
+                    w = min(g.step_width_m, 0.9 * dist)
+                    want = math.atan2(dy, dx) - sign * math.asin(w / dist)
+                    heading = h_b + min(max(math.remainder(want - h_b, 2.0 * math.pi), -lim), lim)
+                c, s = math.cos(heading), math.sin(heading)
+                length = dx * c + dy * s
+                width = sign * (-dx * s + dy * c)
                 self.planned_stone = target
-        lateral = (v - v_b) - sign * g.step_width_m
-        return WalkerBody.action_from_footstep(length, lateral, g.nominal_clearance_m, g)
+        lateral = sign * (width - g.step_width_m)
+        turn = WalkerBody.action_from_turn(heading - h_b, g)
+        return [*WalkerBody.action_from_footstep(length, lateral, g.nominal_clearance_m, g), turn]
 
     # --- gaze ---------------------------------------------------------------------------------
     def _look(self, obs: np.ndarray, pose) -> list:

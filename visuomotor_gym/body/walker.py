@@ -38,6 +38,13 @@ time ``j * step_s``; even ``j`` = left foot)::
   coming down onto an obstacle's top (contact normal within 45 deg of vertical) in the last part of its
   swing.
 
+* **Turning** (:class:`TurningGait`, SteppingStones only): a fourth footstep value turns the new
+  foothold's heading from the previous one's by up to ``max_turn_deg`` (45 deg: between the 30 and 60
+  deg one-step turns of Patla et al. 1991); length and lateral offset count in the new heading's frame,
+  the pelvis yaws through each foothold's heading at its mid-stance (a Catmull-Rom channel like its
+  position) and the feet point along the pelvis (no hip-yaw joint). :class:`WalkerGait` itself, the
+  gait of ObstacleWalk and ObstacleDodge, never turns and is unchanged.
+
 The ground is flat at z = 0 and supports the feet by construction: the floor is not in contact with the
 feet, the gait puts the stance soles at z = 0 (see ``envs_assets/README.md``).
 """
@@ -107,6 +114,12 @@ class GaitParams:
     arm_swing_deg: float = 15.0
     # The IK never asks for more than this fraction of the hip-ankle reach (the knee keeps >= ~16 deg).
     max_reach: float = 0.99
+    # Largest heading change of one footstep (:class:`TurningGait` only, SteppingStones; the gait of
+    # ObstacleWalk and ObstacleDodge never turns). Walkers at their preferred speed turn by 30 and 60 deg
+    # within a step when told a step ahead (Patla, Prentice, Robinson & Neufeld 1991, J Exp Psychol Hum
+    # Percept Perform 17:603 [recalled]); 45 deg is a modelling choice between the two, above ALLSTEPS'
+    # +-30 deg path changes (Xie et al. 2020) plus the ~10 deg the alternating feet add.
+    max_turn_deg: float = 45.0
 
 
 def _smooth(s: float) -> float:
@@ -584,9 +597,17 @@ class WalkerGait:
         c, s = self._c, self._s
         ox, oy = self.origin
         out = [ox + c * pu - s * pv, oy + s * pu + c * pv, z, self.yaw]
+        # path frame = pelvis heading frame (the pelvis keeps the path heading)
+        return self._leg_targets(out, left, du0, dv0, right, du1, dv1, z, tick)
+
+    def _leg_targets(self, out: list, left: tuple, du0: float, dv0: float, right: tuple, du1: float, dv1: float,
+                     z: float, tick: int) -> list[float]:
+        """Append the legs' and arms' targets to ``out`` (the root's four): each foot's plan tuple and
+        its ankle's offset (forward, left) from its hip joint in the pelvis heading frame, the pelvis
+        height ``z``; clipped to the joints' ranges."""
+        T = self.T
         leg_ik = self._leg_ik
         for foot, fx, fy, bounds in ((left, du0, dv0, self._leg_bounds[LEFT]), (right, du1, dv1, self._leg_bounds[RIGHT])):
-            # path frame = pelvis heading frame (the pelvis keeps the path heading)
             roll, hip, knee = leg_ik(fx, fy, foot[2] - z)
             ankle = foot[3] - (hip - knee)
             (lo0, hi0), (lo1, hi1), (lo2, hi2), (lo, hi), (lo4, hi4) = bounds
@@ -891,3 +912,177 @@ class WalkerGait:
     def pelvis_pose(self, data: mujoco.MjData) -> tuple[np.ndarray, float]:
         """Pelvis world position and heading (rad)."""
         return data.xpos[self.pelvis_body].copy(), float(data.qpos[self._qpos_idx[3]])
+
+
+class TurningGait(WalkerGait):
+    """The scripted gait with a heading per footstep (SteppingStones, issue 13): a footstep may turn.
+
+    :meth:`set_next_footstep` takes a fourth value, ``turn`` (rad, + = left, clipped to
+    ``GaitParams.max_turn_deg``): the heading ``h[j]`` of the latched foothold ``j`` is ``h[j - 1] +
+    turn``, and the footstep's ``length`` and ``lateral`` count in *that* heading's frame (forward of the
+    previous foothold along ``h[j]``, the step width across it). With every turn 0 the footholds are
+    those of :class:`WalkerGait`. Footholds stay in the start's path frame (``u``, ``v``, so
+    :meth:`foothold_world` and the observation read them unchanged); ``h`` is relative to the start yaw.
+
+    * **Pelvis.** Its mid-stance waypoint over foothold ``j`` is placed in ``h[j]``'s frame (ahead of
+      the stance ankle along ``h[j]``, shifted toward it across), and its **yaw** is a third Catmull-Rom
+      channel through ``h[j]`` at the mid-stance of ``j`` (fixed when the segment starts, like the
+      position: C1, never replanned). So the pelvis faces foothold ``j``'s heading at its mid-stance and
+      turns smoothly between footholds (a 45 deg turn takes one 0.5 s step).
+    * **Feet.** The walker has no hip-yaw joint (``walker_body.xml``, shared with ObstacleWalk and
+      ObstacleDodge, is unchanged), so each foot points along the pelvis's yaw: at foothold ``j``'s
+      mid-stance, flat, it points along ``h[j]``; in double support the stance foot pivots about its sole
+      centre as the pelvis turns (modelling choice: the hip's internal/external rotation of a human step
+      turn, Hase & Stein 1999, lumped into a pivot of the foot). The heel and toe rockers and the swing's
+      start and end are placed along the foothold's heading (the foot's yaw differs from it by at most
+      ~40 % of the step's turn there: a few cm of heel or toe slide in the sharpest turns; the supports
+      only sense the feet). Legs follow by the same inverse kinematics, with each ankle taken into the
+      pelvis's heading frame.
+    """
+
+    def reset_plan(self, x: float, y: float, yaw: float) -> None:
+        super().reset_plan(x, y, yaw)
+        self.h = dict.fromkeys(range(-3, 2), 0.0)  # foothold -> heading (rad) relative to the start yaw
+        self.hc = dict.fromkeys(range(-3, 2), 1.0)  # its cosine and sine
+        self.hs = dict.fromkeys(range(-3, 2), 0.0)
+        self.pending_turn = 0.0
+
+    def set_next_footstep(self, length: float, lateral: float = 0.0, clearance: float | None = None,
+                          turn: float = 0.0) -> None:
+        """As :meth:`WalkerGait.set_next_footstep`, with ``turn`` (rad, + = left): the new foothold's
+        heading change from the previous foothold's, clipped to +-``max_turn_deg``."""
+        if turn is None or not math.isfinite(turn):
+            raise ValueError(f"footstep turn must be finite, got {turn}")
+        super().set_next_footstep(length, lateral, clearance)
+        lim = self.p.max_turn_deg * DEG
+        self.pending_turn = min(max(float(turn), -lim), lim)
+
+    def _latch(self) -> None:
+        p = self.p
+        k = (self.next_latch_tick - self.T_mid) // self.T
+        j = k + 2
+        if self.pending is None:
+            cmd, turn = (p.nominal_step_m, 0.0, p.nominal_clearance_m), 0.0
+        else:
+            cmd, turn = self.pending, self.pending_turn
+        self.pending, self.pending_turn = None, 0.0
+        length, lateral, clearance = cmd
+        sign = 1.0 if self.side_of(j) == LEFT else -1.0
+        width = sign * max(p.step_width_m + sign * lateral, p.min_step_width_m)
+        h = self.h[j - 1] + turn
+        c, s = math.cos(h), math.sin(h)
+        self.u[j] = self.u[j - 1] + c * length - s * width
+        self.v[j] = self.v[j - 1] + s * length + c * width
+        self.h[j], self.hc[j], self.hs[j] = h, c, s
+        self.clearance[j] = clearance
+        self.commanded[j] = (*cmd, turn)
+        self.next_latch_tick += self.T
+
+    def heading_of(self, j: int) -> float:
+        """Heading (rad, world) of planned foothold ``j``."""
+        return self.yaw + self.h[j]
+
+    # --- plan -------------------------------------------------------------------------------
+    def _pelvis_uvh(self, tick: int) -> tuple[float, float, float]:
+        """Pelvis (u, v) and yaw (relative to the start) at ``tick``: three Catmull-Rom channels."""
+        j = (tick - self.T_mid) // self.T
+        s = (tick - self.T_mid - j * self.T) / self.T
+        if self._seg_j != j:
+            self._seg_j, self._seg = j, self._pelvis_segment(j)
+        cu, cv, ch = self._seg
+        return (cu[0] + s * (cu[1] + s * (cu[2] + s * cu[3])), cv[0] + s * (cv[1] + s * (cv[2] + s * cv[3])),
+                ch[0] + s * (ch[1] + s * (ch[2] + s * ch[3])))
+
+    def _pelvis_uv(self, tick: int) -> tuple[float, float]:
+        pu, pv, _ = self._pelvis_uvh(tick)
+        return pu, pv
+
+    def pelvis_yaw_at(self, tick: int) -> float:
+        """Planned pelvis yaw (rad, world) at ``tick``."""
+        return self.yaw + self._pelvis_uvh(tick)[2]
+
+    def _pelvis_segment(self, j: int) -> tuple[tuple, tuple, tuple]:
+        p = self.p
+        pts = []
+        for i in (j - 1, j, j + 1, j + 2):
+            sign = 1.0 if self.side_of(i) == LEFT else -1.0
+            a, b = p.pelvis_lead_m, -sign * (0.5 * p.step_width_m - p.sway_m)
+            c, s = self.hc[i], self.hs[i]
+            pts.append((self.u[i] + c * a - s * b, self.v[i] + s * a + c * b, self.h[i]))
+        out = []
+        for a in range(3):
+            p0, p1, p2, p3 = pts[0][a], pts[1][a], pts[2][a], pts[3][a]
+            out.append((p1, 0.5 * (p2 - p0), 0.5 * (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3),
+                        0.5 * (3.0 * p1 - p0 - 3.0 * p2 + p3)))
+        return out[0], out[1], out[2]
+
+    def _stance(self, j: int, s_tick: int) -> tuple:
+        """(u, v, z, pitch, stance, sole_h) of the foot standing on foothold ``j``: the rockers along
+        the foothold's heading."""
+        if s_tick < self.T_ds:  # heel rocker
+            sm = _smooth(s_tick / self.T_ds)
+            pitch = self._heel_rad * (1.0 - sm)
+            c, s = cos(pitch), sin(pitch)
+            lh, ha = self.l_heel, self.h_ankle
+            d, z = -lh + lh * c - ha * s, lh * s + ha * c
+        elif s_tick < self.T_ho:
+            return (self.u[j], self.v[j], self.h_ankle, 0.0, True, 0.0)
+        else:  # toe rocker until toe-off
+            pitch = self._neg_toe_rad * _smooth((s_tick - self.T_ho) / self._toe_span)
+            c, s = cos(pitch), sin(pitch)
+            lt, ha = self.l_toe, self.h_ankle
+            d, z = lt - lt * c - ha * s, -lt * s + ha * c
+        return (self.u[j] + self.hc[j] * d, self.v[j] + self.hs[j] * d, z, pitch, True, 0.0)
+
+    def _swing(self, j_from: int, j_to: int, tau: float) -> tuple:
+        """The swing from foothold ``j_from`` to ``j_to``: as :meth:`WalkerGait._swing`, the ankle's
+        start and end offsets along each foothold's heading, its path a straight line between them."""
+        u, v, hc, hs = self.u, self.v, self.hc, self.hs
+        d0 = self.l_toe - self._a0c - self._a0s
+        d1 = -self.l_heel - self._a1c - self._a1s
+        a0u, a0v = u[j_from] + hc[j_from] * d0, v[j_from] + hs[j_from] * d0
+        a1u, a1v = u[j_to] + hc[j_to] * d1, v[j_to] + hs[j_to] * d1
+        prog = _smooth((tau - self._move0) / self._move_span)
+        au, av = a0u + (a1u - a0u) * prog, a0v + (a1v - a0v) * prog
+        s1, s2 = _smooth(tau / 0.4), _smooth((tau - 0.6) / 0.4)
+        pitch = (self._neg_toe_deg * (1.0 - s1) + self._heel_deg * s2) * DEG
+        p = self.p
+        if tau < p.swing_rise:
+            lift = _smooth(tau / p.swing_rise)
+        elif tau > p.swing_fall:
+            lift = _smooth((1.0 - tau) / self._fall_span)
+        else:
+            lift = 1.0
+        h = self.clearance[j_to] * lift
+        sp, cp = sin(pitch), cos(pitch)
+        lowest = min(self.l_toe * sp, -self.l_heel * sp) - self.h_ankle * cp
+        return (au, av, h - lowest, pitch, False, h)
+
+    def _targets(self, tick: int) -> list[float]:
+        T = self.T
+        pu, pv, ph = self._pelvis_uvh(tick)
+        phase = self._two_pi * ((tick - self.T_mid) % T) / T
+        z = self.p.pelvis_height_m - self._half_bob * (1.0 - cos(phase))
+        k = tick // T
+        s = tick - k * T
+        lead = self._stance(k, s)
+        if s < self.T_ds:
+            trail = self._stance(k - 1, s + T)
+        else:
+            trail = self._swing(k - 1, k + 1, (s - self.T_ds) / self._swing_ticks)
+        left, right = (lead, trail) if k % 2 == LEFT else (trail, lead)
+        # Each ankle in the pelvis's heading frame, from its hip joint.
+        cph, sph = cos(ph), sin(ph)
+        hy = self.hip_y
+        rel = []
+        for foot, off in ((left, hy), (right, -hy)):
+            du, dv = foot[0] - pu, foot[1] - pv
+            rel.append((cph * du + sph * dv, -sph * du + cph * dv - off))
+        (du0, dv0), (du1, dv1) = rel
+        d_max2 = self._d_max2  # lower the pelvis where a leg would otherwise over-reach
+        z = min(z, left[2] + sqrt(max(d_max2 - du0 * du0 - dv0 * dv0, 0.0)),
+                right[2] + sqrt(max(d_max2 - du1 * du1 - dv1 * dv1, 0.0)))
+        c, s = self._c, self._s
+        ox, oy = self.origin
+        out = [ox + c * pu - s * pv, oy + s * pu + c * pv, z, self.yaw + ph]
+        return self._leg_targets(out, left, du0, dv0, right, du1, dv1, z, tick)

@@ -8,17 +8,24 @@ the gait every control step and *read at each mid-stance* for the next step of t
 (:meth:`WalkerGait.set_next_footstep`); an action of 0 asks for a 0.60 m step, straight, with 0.235 m
 clearance (the middle of each range; modelling choice: linear maps, as the other bodies' actions).
 
+:class:`TurningWalkerBody` (SteppingStones) has a fourth footstep value, the **turn** of the new
+foothold's heading from the previous one's, linear onto +-45 deg (``GaitParams.max_turn_deg``; 0 =
+straight on), on :class:`~visuomotor_gym.body.walker.TurningGait`, and one more observation block,
+``foothold_headings``. ObstacleWalk and ObstacleDodge keep :class:`WalkerBody`.
+
 Observations are expressed in the pelvis frame (:class:`~visuomotor_gym.core.frames.RootFrame`:
 origin at the pelvis, x along its heading, z up).
 """
 
 from __future__ import annotations
 
+import math
+
 import mujoco
 import numpy as np
 
 from visuomotor_gym.body import walker_names as wn
-from visuomotor_gym.body.walker import GaitParams, WalkerGait
+from visuomotor_gym.body.walker import DEG, GaitParams, TurningGait, WalkerGait
 from visuomotor_gym.core.frames import RootFrame
 from visuomotor_gym.core.observation import Block
 
@@ -45,10 +52,11 @@ class WalkerBody:
     trace_step_fields = ("pelvis_pos", "feet_pos")
     action_structure = {"footstep": 3}
     n_action = 3
+    gait_class = WalkerGait
 
     def __init__(self, model: mujoco.MjModel, params: GaitParams | None = None) -> None:
         self.model = model
-        self.gait = WalkerGait(model, params)
+        self.gait = self.gait_class(model, params)
         self.p = self.gait.p
         self.frame = RootFrame(self.gait.pelvis_body)
         (l0, l1), (a0, a1), (c0, c1) = self.p.step_range_m, self.p.lateral_range_m, self.p.clearance_range_m
@@ -129,6 +137,49 @@ class WalkerBody:
             "step_phase": (tick % T) / T,
             "stride_phase": (tick % (2 * T)) / (2 * T),
         }
+
+
+TURNING_WALKER_BLOCKS = WALKER_BLOCKS + (
+    Block("foothold_headings", N_FOOTHOLDS_OBSERVED, "rad",
+          "heading of each of the three footholds of the footholds block (the direction its foot points "
+          "when flat on it and the frame of the next footstep), relative to the pelvis heading, + = left"),
+)
+
+
+class TurningWalkerBody(WalkerBody):
+    """The walker on :class:`~visuomotor_gym.body.walker.TurningGait` (SteppingStones): the footstep
+    block has a fourth value, the **turn** of the footstep's heading from the previous foothold's,
+    linear onto +-``GaitParams.max_turn_deg`` (0 = straight on), and the observation a
+    ``foothold_headings`` block after the walker's blocks. The first three footstep values are those of
+    :class:`WalkerBody`, counted in the new heading's frame."""
+
+    observation_blocks = TURNING_WALKER_BLOCKS
+    action_structure = {"footstep": 4}  # noqa: RUF012  (as WalkerBody's: a class-level description)
+    n_action = 4
+    gait_class = TurningGait
+
+    def __init__(self, model: mujoco.MjModel, params: GaitParams | None = None) -> None:
+        super().__init__(model, params)
+        self._turn = self.p.max_turn_deg * DEG
+        self._yaw_qpos = self.gait._qpos_idx[3]
+
+    @staticmethod
+    def action_from_turn(turn: float, p: GaitParams | None = None) -> float:
+        """The turn action in [-1, 1] for a heading change ``turn`` (rad)."""
+        p = p or GaitParams()
+        return min(max(turn / (p.max_turn_deg * DEG), -1.0), 1.0)
+
+    def command(self, data: mujoco.MjData, a: np.ndarray, al: list, dt: float) -> None:
+        self.gait.set_next_footstep(*self.footstep_from_action(al[0], al[1], al[2]), turn=al[3] * self._turn)
+        self.gait.advance(data, dt)
+
+    def observe(self, values: list, data: mujoco.MjData) -> None:
+        super().observe(values, data)
+        g = self.gait
+        n = (g.next_latch_tick - g.T_mid) // g.T + 2
+        yaw = float(data.qpos[self._yaw_qpos])
+        for j in range(n - N_FOOTHOLDS_OBSERVED, n):
+            values.append(math.remainder(g.yaw + g.h[j] - yaw, 2.0 * math.pi))
 
 
 def _as_slice(indices: list[int]):

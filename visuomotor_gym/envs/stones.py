@@ -1,9 +1,10 @@
 """SteppingStones: cross a gap on stones seen only through a foveated, saccading eye (issue 13; Eom et
 al. 2019 section 7, seed 001).
 
-``SteppingStonesEnv`` composes the embodiment core (:mod:`visuomotor_gym.core`), the walker
-(:mod:`visuomotor_gym.body.walker_body`, unchanged) on ``envs_assets/stones.xml`` and the stepping-stones
-task (:mod:`visuomotor_gym.tasks.stepping_stones`).
+``SteppingStonesEnv`` composes the embodiment core (:mod:`visuomotor_gym.core`), the turning walker
+(:class:`~visuomotor_gym.body.walker_body.TurningWalkerBody`: ObstacleWalk's body and gait with a turn
+per footstep) on ``envs_assets/stones.xml`` and the stepping-stones task
+(:mod:`visuomotor_gym.tasks.stepping_stones`).
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ from typing import Any
 from visuomotor_gym.body import names
 from visuomotor_gym.body import walker_names as wn
 from visuomotor_gym.body.walker import GaitParams
-from visuomotor_gym.body.walker_body import WALKER_BLOCKS, WalkerBody
+from visuomotor_gym.body.walker_body import TURNING_WALKER_BLOCKS, TurningWalkerBody
 from visuomotor_gym.core import args
 from visuomotor_gym.core.env import VisuomotorEnv
 from visuomotor_gym.core.eye import EYE_BLOCKS
@@ -37,7 +38,7 @@ from visuomotor_gym.vision.foveation import VisionParams
 __all__ = ["STONES_LAYOUT", "SteppingStonesEnv"]
 
 RENDER_CAMERAS = ("both", "side", "follow", "scene", "eye")
-STONES_LAYOUT = ObservationLayout(PERCEPT_BLOCKS + EYE_BLOCKS + HEAD_BLOCKS + WALKER_BLOCKS + TRAILING_BLOCKS)
+STONES_LAYOUT = ObservationLayout(PERCEPT_BLOCKS + EYE_BLOCKS + HEAD_BLOCKS + TURNING_WALKER_BLOCKS + TRAILING_BLOCKS)
 
 
 class SteppingStonesEnv(VisuomotorEnv):
@@ -56,31 +57,37 @@ class SteppingStonesEnv(VisuomotorEnv):
     next stone as the foot starts its swing (Eom et al. 2019 section 7).
 
     Walking is the scripted gait of ObstacleWalk with a **footstep-level action** (the next footstep's
-    length, lateral offset and toe clearance, read at each mid-stance; ``envs_assets/README.md``). The
+    length, lateral offset, toe clearance and **turn**, read at each mid-stance; ``envs_assets/README.md``).
+    A footstep may turn the walking heading by up to +-45 deg (``GaitParams.max_turn_deg``: between the
+    30 and 60 deg one-step turns of Patla et al. 1991; :class:`~visuomotor_gym.body.walker.TurningGait`):
+    the pelvis yaws to each foothold's heading by its mid-stance and the feet point along the pelvis
+    (the walker has no hip-yaw joint). The
     stones and the slab are MuJoCo geoms that sense the feet: when a foot is flat after its heel strike
     it must touch a support with its midfoot over the support's top, or the walker **falls** into the
-    gap. The walker keeps its heading (the gait does not turn), so the path stays within +-20 deg of the
-    slab's axis and every course is steppable (``visuomotor_gym.tasks.stepping_stones``). Physics
+    gap. The path's direction may drift up to +-60 deg from the slab's axis (``max_heading_deg``), and
+    every course is steppable with the gait's turns and step widths (``visuomotor_gym.tasks.stepping_stones``). Physics
     500 Hz, control 50 Hz. The rungs of the observability ladder are keyword arguments of this one
     class (``visuomotor_gym.registration``).
 
     ## Action Space
 
-    ``Box(-1, 1, (8,), float32)``; ``env.unwrapped.action_structure`` gives the blocks. Finite values
+    ``Box(-1, 1, (9,), float32)``; ``env.unwrapped.action_structure`` gives the blocks. Finite values
     outside [-1, 1] are clipped; NaN, inf and wrong shapes raise ``ValueError``.
 
     | index | block | meaning |
     |---|---|---|
-    | 0 | footstep | step length, linear onto [0.25, 0.95] m, forward of the other foot's foothold |
-    | 1 | footstep | lateral offset from the nominal 0.12 m step width, linear onto [-0.3, 0.3] m (+ = left) |
+    | 0 | footstep | step length, linear onto [0.25, 0.95] m, forward of the other foot's foothold along the new heading |
+    | 1 | footstep | lateral offset from the nominal 0.12 m step width (across the new heading), linear onto [-0.3, 0.3] m (+ = left) |
     | 2 | footstep | toe clearance (lowest sole point over the swing's carry phase), linear onto [0.02, 0.45] m |
-    | 3-4 | gaze | requested gaze change in retinal coordinates (azimuth, elevation) of the current eye frame, times ``gaze_action_range_deg`` (60 deg); 0 holds gaze fixed in the world |
-    | 5 | fixation | fixation (vergence) distance, log-mapped onto [0.1, 20] m; does not change the noise in v0 |
-    | 6-7 | head | head target: neck yaw in [-80, 80] deg and pitch in [-50, 40] deg (negative = down), reached at <= 300 deg/s |
+    | 3 | footstep | turn: the new foothold's heading minus the previous foothold's, linear onto [-45, 45] deg (+ = left; 0 = straight on) |
+    | 4-5 | gaze | requested gaze change in retinal coordinates (azimuth, elevation) of the current eye frame, times ``gaze_action_range_deg`` (60 deg); 0 holds gaze fixed in the world |
+    | 6 | fixation | fixation (vergence) distance, log-mapped onto [0.1, 20] m; does not change the noise in v0 |
+    | 7-8 | head | head target: neck yaw in [-80, 80] deg and pitch in [-50, 40] deg (negative = down), reached at <= 300 deg/s |
 
     The footstep is read at the mid-stance of each foot for the next step of that same foot (it lifts
     ~0.3 s later and lands ~0.7 s later): ``gait_phase[2]`` says how long until the next read. The
-    foothold is the sole point under the ankle; the foot's centre is 7 cm ahead of it.
+    foothold is the sole point under the ankle; the foot's centre is 7 cm ahead of it along the foothold's
+    heading (``foothold_headings`` in the observation).
 
     ## Observation Space
 
@@ -135,7 +142,9 @@ class SteppingStonesEnv(VisuomotorEnv):
 
     ## Version History
 
-    * v0: initial release (issue 13).
+    * v0: initial release (issue 13). Redefined in place (issue 13, ALLSTEPS' turns): the walker turns
+      (a fourth footstep value, the ``foothold_headings`` block) and the path may drift to +-60 deg, where
+      the first definition's walker kept its heading and the path stayed within +-20 deg (8 actions).
     """
 
     render_cameras = {
@@ -182,7 +191,7 @@ class SteppingStonesEnv(VisuomotorEnv):
 
         self._load_physics(STONES_SCENE, control_dt)
         self._set_visual_delay(visual_delay_s)
-        body = WalkerBody(self.model, self.gait_params)
+        body = TurningWalkerBody(self.model, self.gait_params)
         task = SteppingStonesTask(self.model, body, course_distribution=self.course_distribution,
                                   reward_weights=self.reward_weights)
         self._assemble_eye(body=body, task=task, obs_mode=obs_mode, width=width, height=height)

@@ -5,13 +5,17 @@ stones seen only through the foveated eye; a foot that lands off every support e
 gets the same course for a seed): the walker starts on a slab (``envs_assets/stones.xml``) whose far
 edge lies 2.3 m ahead of its first heel strike; ``n_stones`` stones follow, each ``spacing_m`` from the
 previous one (0.65-0.85 m, ALLSTEPS: Xie et al. 2020, REFERENCES.md) in a direction that turns by up to
-``heading_change_deg`` (+-30 deg, ALLSTEPS) from the previous step's. The first stone is spaced from
-the nominal centre of the walker's last foot on the slab. Our walker does not turn its pelvis (the gait
-of :mod:`visuomotor_gym.body.walker` keeps one heading), so the path's direction stays within
-``max_heading_deg`` of the slab's axis and every course is *steppable*: a sequence of footholds exists
-with alternating feet, each foot's centre within ``foot_margin_m`` of its stone's centre and every
-lateral step inside the gait's range less ``lateral_slack_m`` (interval propagation; a draw that
-breaks it is redrawn). These three are modelling choices (stated with each constant).
+``heading_change_deg`` (+-30 deg, ALLSTEPS) from the previous step's, so the path curves. The first
+stone is spaced from the nominal centre of the walker's last foot on the slab. The walker turns (the
+gait of :mod:`visuomotor_gym.body.walker` gives each footstep a heading, :class:`TurningGait`, turning
+by up to ``GaitParams.max_turn_deg`` = 45 deg a step), so the path's direction may drift up to
+``max_heading_deg`` = +-60 deg from the slab's axis (modelling choice: three times the +-20 deg of the
+walker that could not turn, and short of +-90 deg, so the path always leads away from the slab). Every
+course is *steppable*: a sequence of footholds exists with alternating feet, each foot's centre on its
+stone's centre, each step's heading within ``max_turn_deg - turn_slack_deg`` of the previous one's and
+its lateral width inside the gait's range less ``lateral_slack_m`` (interval propagation over the
+footsteps' headings; a draw that breaks it is redrawn). The slacks are modelling choices (stated with
+each constant).
 
 **Supports and falls.** The slab and the stones are MuJoCo geoms that sense the feet without pushing
 (``stones.xml``). When a foot is flat after its heel strike (the end of double support), it must touch a
@@ -46,6 +50,9 @@ SLAB = "start_slab"
 STONES_SCENE_CAMERA = "stones_scene"
 STONE_TOP_Z = -0.005  # stones.xml: tops 5 mm below the soles' planned height (sensing, not pushing)
 K_SLOTS = 4
+# A steppable step leaves at least this much freedom (rad, ~1 deg) in its heading (modelling choice: a
+# course steppable only through a sliver of headings would ask the agent for sub-degree precision).
+MIN_HEADING_FREEDOM = math.radians(1.0)
 FOOT_CENTRE_AHEAD_M = 0.07  # walker_body.xml: the foot box's centre is 7 cm ahead of the ankle (the foothold)
 REWARD_TERMS = ("finish", "fall", "stone", "progress")
 DEFAULT_REWARD_WEIGHTS = {"finish": 1.0, "fall": -1.0, "stone": 0.0, "progress": 0.0}
@@ -60,12 +67,13 @@ class CourseDistribution:
     n_stones: int = 14  # modelling choice: ~10 m of stones, 7 s of walking at 2 steps/s
     spacing_m: tuple[float, float] = (0.65, 0.85)  # ALLSTEPS (Xie et al. 2020): centre-to-centre distance
     heading_change_deg: float = 30.0  # ALLSTEPS: the path turns by up to +-30 deg from one step to the next
-    max_heading_deg: float = 20.0  # modelling choice: the walker keeps its heading; the path stays within +-20 deg
-    foot_margin_m: float = 0.12  # modelling choice: a steppable foot centre lies within 12 cm of the stone's centre
-    lateral_slack_m: float = 0.03  # modelling choice: the gait's lateral step range, less 3 cm each side
+    # Modelling choice: the path's direction stays within +-60 deg of the slab's axis (it leads away from
+    # the slab; three times the +-20 deg of the first version, whose walker could not turn).
+    max_heading_deg: float = 60.0
+    lateral_slack_m: float = 0.03  # modelling choice: the gait's step widths, less 3 cm at each end
+    turn_slack_deg: float = 5.0  # modelling choice: a steppable course needs turns 5 deg short of the gait's limit
     start_foot_x_m: float = 1.95 + FOOT_CENTRE_AHEAD_M  # nominal foot centre of the last foothold on the slab
     start_foot_y_m: float = -0.06  # ... (the right foot, half the 0.12 m nominal step width to the right)
-    start_foot_spread_m: float = 0.10  # the slab leaves that foot this much freedom either side (modelling choice)
 
 
 @dataclass(frozen=True)
@@ -75,29 +83,37 @@ class Course:
 
 
 def sample_course(rng: np.random.Generator, dist: CourseDistribution, lateral_range: tuple[float, float],
-                  step_width: tuple[float, float]) -> Course:
-    """One steppable course. ``lateral_range`` and ``step_width`` = (nominal, minimum) come from the
-    gait's parameters: a left foot lands ``max(nominal + lateral, minimum)`` left of the right foot."""
+                  step_width: tuple[float, float], max_turn_deg: float) -> Course:
+    """One steppable course. ``lateral_range``, ``step_width`` = (nominal, minimum) and ``max_turn_deg``
+    come from the gait's parameters: a footstep's heading turns by at most ``max_turn_deg`` from the
+    previous foothold's, and in its own heading's frame a left foot lands ``max(nominal + lateral,
+    minimum)`` left of the right foot."""
     nominal, minimum = step_width
-    lo = max(nominal + lateral_range[0], minimum) + dist.lateral_slack_m  # smallest lateral step
-    hi = nominal + lateral_range[1] - dist.lateral_slack_m  # largest
-    m, turn, cap = dist.foot_margin_m, math.radians(dist.heading_change_deg), math.radians(dist.max_heading_deg)
+    w_lo = max(nominal + lateral_range[0], minimum) + dist.lateral_slack_m  # narrowest step
+    w_hi = nominal + lateral_range[1] - dist.lateral_slack_m  # widest
+    turn, cap = math.radians(dist.heading_change_deg), math.radians(dist.max_heading_deg)
+    max_turn = math.radians(max_turn_deg - dist.turn_slack_deg)
     x, y, psi = dist.start_foot_x_m, dist.start_foot_y_m, 0.0
-    a, b = y - dist.start_foot_spread_m, y + dist.start_foot_spread_m  # where the previous foot can be
+    a, b = 0.0, 0.0  # the headings the previous foothold can have (the last slab foot: straight on)
     rows, heads = [], []
     for k in range(dist.n_stones):
-        left = k % 2 == 0  # stone 0 takes foothold 4, a left foot
-        ra, rb = (a + lo, b + hi) if left else (a - hi, b - lo)
+        sign = 1.0 if k % 2 == 0 else -1.0  # stone 0 takes foothold 4, a left foot
         for _ in range(100):
             new_psi = min(max(psi + float(rng.uniform(-turn, turn)), -cap), cap)
             s = float(rng.uniform(*dist.spacing_m))
-            nx, ny = x + s * math.cos(new_psi), y + s * math.sin(new_psi)
-            if max(ra, ny - m) <= min(rb, ny + m):
+            # Headings h whose frame puts this step at a width w in [w_lo, w_hi] to the foot's side:
+            # the step's direction less sign * asin(w / s).
+            lo_h = new_psi - sign * math.asin(w_hi / s) if sign > 0 else new_psi + math.asin(w_lo / s)
+            hi_h = new_psi - sign * math.asin(w_lo / s) if sign > 0 else new_psi + math.asin(w_hi / s)
+            na, nb = max(lo_h, a - max_turn), min(hi_h, b + max_turn)
+            if na + MIN_HEADING_FREEDOM <= nb:
                 break
-        else:  # no draw was steppable: move the last one sideways into reach
-            ny = min(max(ny, ra - m + 1e-3), rb + m - 1e-3)
-            new_psi = math.atan2(ny - y, nx - x)
-        a, b = max(ra, ny - m), min(rb, ny + m)
+        else:  # no draw was steppable (never seen with the defaults): the step straight along a heading reachable from the last
+            h = min(max(psi, a - max_turn), b + max_turn)
+            new_psi = h + sign * math.asin(nominal / s)
+            na = nb = h
+        a, b = na, nb
+        nx, ny = x + s * math.cos(new_psi), y + s * math.sin(new_psi)
         rows.append((nx, ny))
         heads.append(new_psi)
         x, y, psi = nx, ny, new_psi
@@ -170,7 +186,8 @@ class SteppingStonesTask:
     def reset_episode(self, data: mujoco.MjData, rng: np.random.Generator) -> None:
         """Draw the course and place the stones (the walker already stands at the start)."""
         m, d, p = self.model, data, self.gait.p
-        self.course = course = sample_course(rng, self.dist, p.lateral_range_m, (p.step_width_m, p.min_step_width_m))
+        self.course = course = sample_course(rng, self.dist, p.lateral_range_m, (p.step_width_m, p.min_step_width_m),
+                                             p.max_turn_deg)
         n = len(course.stones)
         for i, t in enumerate(self.all_targets):
             t.hidden = True
