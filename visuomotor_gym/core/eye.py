@@ -17,6 +17,7 @@ import math
 import mujoco
 import numpy as np
 
+from visuomotor_gym import _native
 from visuomotor_gym.body import names
 from visuomotor_gym.core.observation import Block
 from visuomotor_gym.geometry import rotate, rotate_t, unit_from_angles
@@ -76,7 +77,15 @@ class Eye:
         self._az_range = (params.eye_azimuth_range_deg[0] * DEG, params.eye_azimuth_range_deg[1] * DEG)
         self._el_range = (params.eye_elevation_range_deg[0] * DEG, params.eye_elevation_range_deg[1] * DEG)
         self._log_fix = (math.log(params.fixation_range_m[0]), math.log(params.fixation_range_m[1]))
+        # The compiled VOR (visuomotor_gym._native, _kernels.c: eye_apply), when built.
+        self._native = _native.enabled()
+        self._native_ranges = (*self._az_range, *self._el_range)
+        self._native_addresses = (self._qpos_az, self._qpos_el, self._fix_qpos, *dofs)
         self.reset_state()
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+        self._native = self._native and _native.enabled()  # unpickled where the extension is missing
 
     # --- episode ------------------------------------------------------------------------------
     def reset_state(self) -> None:
@@ -128,6 +137,14 @@ class Eye:
         the rotation's 9 numbers, row-major; ``pos_list``).
         """
         d = data
+        if self._native:  # this method, compiled
+            flat, self.pos_list, self.in_head, clamped = _native.kernels.eye_apply(
+                d.xmat, d.xpos, self.head_body, self.plant.gaze, self._offset_list, self._native_ranges, d.qpos,
+                d.qvel, self._native_addresses, self.fixation)
+            self.rot_flat = flat
+            if clamped:
+                self.plant.constrain(np.array(flat[0::3]))
+            return
         h0, h1, h2, h3, h4, h5, h6, h7, h8 = d.xmat[self.head_body].tolist()  # head rotation, row-major
         head = (h0, h1, h2, h3, h4, h5, h6, h7, h8)
         gx, gy, gz = rotate_t(head, *self.plant.gaze.tolist())  # gaze in head coordinates

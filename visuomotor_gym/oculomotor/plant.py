@@ -54,6 +54,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from visuomotor_gym import _native
 from visuomotor_gym.geometry import angle_between, cross, unit_from_angles
 
 DEG = math.pi / 180.0
@@ -227,6 +228,14 @@ class OculomotorPlant:
     def __init__(self, params: OculomotorParams | None = None, record: bool = False):
         self.params = params or OculomotorParams()
         self.record = record
+        # The compiled substep loop (visuomotor_gym._native), when built; not for the recorded trace.
+        self._native = _native.enabled() and not record
+        p = self.params
+        self._native_constants = np.array(
+            [p.saccade_threshold_deg * DEG, p.pursuit_latency_s, p.pursuit_accel_max_deg_s2 * DEG,
+             p.pursuit_max_deg_s, DEG, len(p.pursuit_gain_points), *(x for q in p.pursuit_gain_points for x in q)],
+            dtype=np.float64,
+        ).tobytes()
         self.reset(np.array([1.0, 0.0, 0.0]), time=0.0)
 
     def reset(self, gaze: np.ndarray, time: float = 0.0) -> None:
@@ -255,6 +264,10 @@ class OculomotorPlant:
         if self.record:
             self.trace_t.append(self.time)
             self.trace_gaze.append(self.gaze.copy())
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+        self._native = self._native and _native.enabled()  # unpickled where the extension is missing
 
     @property
     def angular_velocity(self) -> np.ndarray:
@@ -338,6 +351,11 @@ class OculomotorPlant:
         # A request that starts a saccade is a position command (it may aim ahead of the target):
         # like the steps with a saccade in flight, it carries no motion signal.
         self._suppressed = self._suppressed or started
+        if self._native:  # the rest of this method, compiled (_native/_kernels.c: plant_advance)
+            saccading = self.saccade is not None
+            self.gaze = np.array(_native.kernels.plant_advance(self, request, dt, n_substeps,
+                                                               self._native_constants, _ZERO))
+            return PlantStep(started, saccading, deferred)
         self._sample_target_motion(request, dt)
 
         saccading = self.saccade is not None

@@ -1,0 +1,601 @@
+/* Compiled mirrors of per-step hot loops (see visuomotor_gym/_native/__init__.py).
+ *
+ * Every kernel mirrors one Python function, named in its comment, operation for operation: the same
+ * additions and products in the same order, the same comparisons, libm's sqrt/sin/cos/atan2/pow (the
+ * functions Python's math module and float ** call). Built with -ffp-contract=off (no fused
+ * multiply-adds) and -fno-builtin (no sin+cos -> sincos, pow(x, 2) -> x*x), so the results are the
+ * Python path's bit for bit; tests/test_native.py and the golden digests check it. Python's
+ * math.hypot is not libm's hypot: it is called through the math module.
+ */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+#include <math.h>
+#include <string.h>
+
+static PyObject *math_hypot;  /* math.hypot */
+static PyObject *s_time, *s_suppressed, *s_prev_request, *s_last_sample, *s_drive_queue, *s_drive, *s_goal,
+    *s_pursuit_omega, *s_saccade, *s_omega, *s_onset, *s_duration, *s_amplitude, *s_arc, *s_axis, *s_gaze;
+
+/* ---- small helpers -------------------------------------------------------------------------- */
+
+/* n doubles from a tuple or list of floats. */
+static int seq_doubles(PyObject *seq, double *out, Py_ssize_t n)
+{
+    if (!(PyTuple_Check(seq) || PyList_Check(seq)) || PySequence_Fast_GET_SIZE(seq) != n) {
+        PyErr_Format(PyExc_TypeError, "expected a tuple or list of %zd floats", n);
+        return -1;
+    }
+    PyObject **items = PySequence_Fast_ITEMS(seq);
+    for (Py_ssize_t i = 0; i < n; i++) {
+        out[i] = PyFloat_AsDouble(items[i]);
+        if (out[i] == -1.0 && PyErr_Occurred())
+            return -1;
+    }
+    return 0;
+}
+
+/* A C-contiguous float64 buffer (a numpy array); the caller releases the view. */
+static int f64_buffer(PyObject *obj, Py_buffer *view, int writable)
+{
+    if (PyObject_GetBuffer(obj, view, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (writable ? PyBUF_WRITABLE : 0)) < 0)
+        return -1;
+    const char *f = view->format;
+    if (view->itemsize != 8 || f == NULL || !(strcmp(f, "d") == 0 || strcmp(f, "<d") == 0 || strcmp(f, "=d") == 0)) {
+        PyBuffer_Release(view);
+        PyErr_SetString(PyExc_TypeError, "expected a C-contiguous float64 array");
+        return -1;
+    }
+    return 0;
+}
+
+/* n doubles from a float64 array starting at element `start`. */
+static int array_doubles(PyObject *obj, Py_ssize_t start, double *out, Py_ssize_t n)
+{
+    Py_buffer view;
+    if (f64_buffer(obj, &view, 0) < 0)
+        return -1;
+    if (start < 0 || (start + n) * 8 > view.len) {
+        PyBuffer_Release(&view);
+        PyErr_SetString(PyExc_IndexError, "array too short");
+        return -1;
+    }
+    memcpy(out, (double *)view.buf + start, (size_t)n * sizeof(double));
+    PyBuffer_Release(&view);
+    return 0;
+}
+
+static PyObject *tuple3(double x, double y, double z) { return Py_BuildValue("(ddd)", x, y, z); }
+
+static PyObject *list_of(const double *v, Py_ssize_t n)
+{
+    PyObject *out = PyList_New(n);
+    if (out == NULL)
+        return NULL;
+    for (Py_ssize_t i = 0; i < n; i++) {
+        PyObject *f = PyFloat_FromDouble(v[i]);
+        if (f == NULL) {
+            Py_DECREF(out);
+            return NULL;
+        }
+        PyList_SET_ITEM(out, i, f);
+    }
+    return out;
+}
+
+/* Python's min(a, b) and max(a, b) for floats: the first argument unless the second is strictly
+ * smaller (larger); NaN and signed zeros behave as in Python. */
+static inline double py_min(double a, double b) { return b < a ? b : a; }
+static inline double py_max(double a, double b) { return b > a ? b : a; }
+
+static int set_attr_double(PyObject *obj, PyObject *name, double v)
+{
+    PyObject *f = PyFloat_FromDouble(v);
+    if (f == NULL)
+        return -1;
+    int rc = PyObject_SetAttr(obj, name, f);
+    Py_DECREF(f);
+    return rc;
+}
+
+static int get_attr_double(PyObject *obj, PyObject *name, double *out)
+{
+    PyObject *v = PyObject_GetAttr(obj, name);
+    if (v == NULL)
+        return -1;
+    *out = PyFloat_AsDouble(v);
+    Py_DECREF(v);
+    return (*out == -1.0 && PyErr_Occurred()) ? -1 : 0;
+}
+
+/* ---- the oculomotor plant (visuomotor_gym/oculomotor/plant.py) -------------------------------- */
+
+/* The plant's constants, packed by OculomotorPlant._native_constants:
+ * [saccade threshold (rad), pursuit latency (s), pursuit acceleration bound (rad/s^2),
+ *  pursuit cap (deg/s), DEG, number of gain points, then (deg/s, gain) pairs]. */
+typedef struct {
+    double threshold, latency, accel, vmax, deg;
+    Py_ssize_t npts;
+    const double *pts;
+} PlantConsts;
+
+static int plant_consts(PyObject *packed, PlantConsts *c)
+{
+    if (!PyBytes_Check(packed) || PyBytes_GET_SIZE(packed) < 6 * 8) {
+        PyErr_SetString(PyExc_TypeError, "plant constants: expected the packed bytes");
+        return -1;
+    }
+    const double *v = (const double *)PyBytes_AS_STRING(packed);
+    c->threshold = v[0];
+    c->latency = v[1];
+    c->accel = v[2];
+    c->vmax = v[3];
+    c->deg = v[4];
+    c->npts = (Py_ssize_t)v[5];
+    c->pts = v + 6;
+    if (c->npts < 1 || PyBytes_GET_SIZE(packed) != (6 + 2 * c->npts) * 8) {
+        PyErr_SetString(PyExc_ValueError, "plant constants: bad size");
+        return -1;
+    }
+    return 0;
+}
+
+/* OculomotorParams.pursuit_gain */
+static double pursuit_gain(const PlantConsts *c, double s)
+{
+    const double *p = c->pts;
+    if (s <= p[0])
+        return p[1];
+    for (Py_ssize_t k = 0; k + 1 < c->npts; k++) {
+        double s0 = p[2 * k], g0 = p[2 * k + 1], s1 = p[2 * k + 2], g1 = p[2 * k + 3];
+        if (s <= s1)
+            return g0 + (g1 - g0) * (s - s0) / (s1 - s0);
+    }
+    return p[2 * c->npts - 1];
+}
+
+/* OculomotorParams.pursuit_velocity */
+static double pursuit_velocity(const PlantConsts *c, double s) { return py_min(pursuit_gain(c, s) * s, c->vmax); }
+
+/* The drive queue's head time, or inf (``queue[0][0] if queue else math.inf``). */
+static int queue_due(PyObject *queue, double *due)
+{
+    if (PyList_GET_SIZE(queue) == 0) {
+        *due = INFINITY;
+        return 0;
+    }
+    PyObject *head = PyList_GET_ITEM(queue, 0);
+    if (!PyTuple_Check(head) || PyTuple_GET_SIZE(head) != 4) {
+        PyErr_SetString(PyExc_TypeError, "drive queue entries must be (time, wx, wy, wz)");
+        return -1;
+    }
+    *due = PyFloat_AsDouble(PyTuple_GET_ITEM(head, 0));
+    return (*due == -1.0 && PyErr_Occurred()) ? -1 : 0;
+}
+
+/* The pursuit state the substep loop carries: the drive sample driving the eye and its goal. */
+typedef struct {
+    double drive[3];
+    double goal[3];
+    int goal_zero; /* ``goal is _ZERO`` */
+} Pursuit;
+
+/* OculomotorPlant._pursuit_goal(t) */
+static int pursuit_goal(const PlantConsts *c, PyObject *queue, Pursuit *ps, double t)
+{
+    double due;
+    if (queue_due(queue, &due) < 0)
+        return -1;
+    if (PyList_GET_SIZE(queue) == 0 || due > t + 1e-9)
+        return 0;
+    while (PyList_GET_SIZE(queue) > 0) {
+        if (queue_due(queue, &due) < 0)
+            return -1;
+        if (!(due <= t + 1e-9))
+            break;
+        double entry[4];
+        if (seq_doubles(PyList_GET_ITEM(queue, 0), entry, 4) < 0)
+            return -1;
+        ps->drive[0] = entry[1];
+        ps->drive[1] = entry[2];
+        ps->drive[2] = entry[3];
+        if (PyList_SetSlice(queue, 0, 1, NULL) < 0) /* queue.pop(0) */
+            return -1;
+    }
+    double wx = ps->drive[0], wy = ps->drive[1], wz = ps->drive[2];
+    double speed = sqrt(wx * wx + wy * wy + wz * wz);
+    if (speed < 1e-12) {
+        ps->goal_zero = 1;
+        ps->goal[0] = ps->goal[1] = ps->goal[2] = 0.0;
+    } else {
+        double k = pursuit_velocity(c, speed / c->deg) * c->deg / speed;
+        ps->goal_zero = 0;
+        ps->goal[0] = wx * k;
+        ps->goal[1] = wy * k;
+        ps->goal[2] = wz * k;
+    }
+    return 0;
+}
+
+/* OculomotorPlant._sample_target_motion(target, dt) */
+static int sample_target_motion(PyObject *plant, const PlantConsts *c, PyObject *queue, PyObject *request,
+                                const double *b, double dt, int suppressed, double now)
+{
+    PyObject *prev = PyObject_GetAttr(plant, s_prev_request);
+    if (prev == NULL)
+        return -1;
+    PyObject *sample = PyObject_GetAttr(plant, s_last_sample); /* held without a motion signal */
+    if (sample == NULL) {
+        Py_DECREF(prev);
+        return -1;
+    }
+    double a[3];
+    if (prev != Py_None && !suppressed) {
+        if (seq_doubles(prev, a, 3) < 0)
+            goto fail;
+        double cx = a[1] * b[2] - a[2] * b[1], cy = a[2] * b[0] - a[0] * b[2], cz = a[0] * b[1] - a[1] * b[0];
+        double s = sqrt(cx * cx + cy * cy + cz * cz);
+        double jump = atan2(s, a[0] * b[0] + a[1] * b[1] + a[2] * b[2]); /* geometry.angle_between */
+        if (jump <= c->threshold) {
+            double k = s > 1e-15 ? jump / dt / s : 0.0;
+            Py_DECREF(sample);
+            sample = tuple3(cx * k, cy * k, cz * k);
+            if (sample == NULL)
+                goto fail;
+        }
+    }
+    double smp[3];
+    if (seq_doubles(sample, smp, 3) < 0 || PyObject_SetAttr(plant, s_last_sample, sample) < 0
+        || PyObject_SetAttr(plant, s_prev_request, request) < 0)
+        goto fail;
+    PyObject *entry = Py_BuildValue("(dddd)", now + c->latency, smp[0], smp[1], smp[2]);
+    if (entry == NULL || PyList_Append(queue, entry) < 0) {
+        Py_XDECREF(entry);
+        goto fail;
+    }
+    Py_DECREF(entry);
+    Py_DECREF(prev);
+    Py_DECREF(sample);
+    return 0;
+fail:
+    Py_DECREF(prev);
+    Py_XDECREF(sample);
+    return -1;
+}
+
+/* The saccade in flight: Saccade.onset, duration, amplitude and its arc (start, tangent). */
+typedef struct {
+    double onset, duration, amplitude, a[3], w[3];
+} Flight;
+
+static int read_saccade(PyObject *sac, Flight *f)
+{
+    if (get_attr_double(sac, s_onset, &f->onset) < 0 || get_attr_double(sac, s_duration, &f->duration) < 0
+        || get_attr_double(sac, s_amplitude, &f->amplitude) < 0)
+        return -1;
+    PyObject *arc = PyObject_GetAttr(sac, s_arc);
+    if (arc == NULL)
+        return -1;
+    int rc = -1;
+    if (PyTuple_Check(arc) && PyTuple_GET_SIZE(arc) == 2)
+        rc = (seq_doubles(PyTuple_GET_ITEM(arc, 0), f->a, 3) < 0 || seq_doubles(PyTuple_GET_ITEM(arc, 1), f->w, 3) < 0)
+                 ? -1 : 0;
+    else
+        PyErr_SetString(PyExc_TypeError, "Saccade._arc must be (start, tangent)");
+    Py_DECREF(arc);
+    return rc;
+}
+
+/* Saccade.direction(minimum_jerk(u)) */
+static void saccade_point(const Flight *f, double u, double *g)
+{
+    double s_u = u * u * u * (10.0 + u * (-15.0 + 6.0 * u)); /* minimum_jerk */
+    double t = s_u * f->amplitude;
+    double c = cos(t), s = sin(t);
+    g[0] = c * f->a[0] + s * f->w[0];
+    g[1] = c * f->a[1] + s * f->w[1];
+    g[2] = c * f->a[2] + s * f->w[2];
+}
+
+/* plant_advance(plant, request, dt, n_substeps, constants, zero) -> (gx, gy, gz)
+ *
+ * Mirrors the part of OculomotorPlant.step after the saccade decision, for record=False: the
+ * target-motion sample (_sample_target_motion), the substep loop (pursuit velocity with
+ * _pursuit_goal, the saccade profile, the Rodrigues rotation) and the end-of-step state. It reads
+ * and writes the plant's attributes as the Python does, except ``gaze``: it returns the new gaze
+ * for the caller to store. ``zero`` is plant.py's _ZERO, the goal the Python compares by identity. */
+static PyObject *plant_advance(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    if (nargs != 6) {
+        PyErr_SetString(PyExc_TypeError, "plant_advance(plant, request, dt, n_substeps, constants, zero)");
+        return NULL;
+    }
+    PyObject *plant = args[0], *request = args[1], *zero = args[5];
+    PlantConsts c;
+    double req[3];
+    double dt = PyFloat_AsDouble(args[2]);
+    long n_substeps = PyLong_AsLong(args[3]);
+    if ((dt == -1.0 || n_substeps == -1) && PyErr_Occurred())
+        return NULL;
+    if (plant_consts(args[4], &c) < 0 || seq_doubles(request, req, 3) < 0)
+        return NULL;
+
+    PyObject *queue = NULL, *goal_obj = NULL, *sac = NULL, *tmp = NULL, *result = NULL;
+    double t0, g[3], v[3];
+    Pursuit ps;
+    Flight f;
+    int suppressed;
+    if ((tmp = PyObject_GetAttr(plant, s_suppressed)) == NULL || (suppressed = PyObject_IsTrue(tmp)) < 0)
+        goto done;
+    Py_CLEAR(tmp);
+    if (get_attr_double(plant, s_time, &t0) < 0 || (queue = PyObject_GetAttr(plant, s_drive_queue)) == NULL)
+        goto done;
+    if (!PyList_CheckExact(queue)) {
+        PyErr_SetString(PyExc_TypeError, "plant._drive_queue must be a list");
+        goto done;
+    }
+    if (sample_target_motion(plant, &c, queue, request, req, dt, suppressed, t0) < 0)
+        goto done;
+
+    if ((tmp = PyObject_GetAttr(plant, s_drive)) == NULL || seq_doubles(tmp, ps.drive, 3) < 0)
+        goto done;
+    Py_CLEAR(tmp);
+    if ((goal_obj = PyObject_GetAttr(plant, s_goal)) == NULL || seq_doubles(goal_obj, ps.goal, 3) < 0)
+        goto done;
+    ps.goal_zero = goal_obj == zero;
+    if ((tmp = PyObject_GetAttr(plant, s_pursuit_omega)) == NULL || seq_doubles(tmp, v, 3) < 0)
+        goto done;
+    Py_CLEAR(tmp);
+    if ((tmp = PyObject_GetAttr(plant, s_gaze)) == NULL || array_doubles(tmp, 0, g, 3) < 0)
+        goto done;
+    Py_CLEAR(tmp);
+    if ((sac = PyObject_GetAttr(plant, s_saccade)) == NULL)
+        goto done;
+    int saccading = sac != Py_None;
+    int in_flight = saccading; /* the loop's ``sac is not None`` */
+    if (saccading && read_saccade(sac, &f) < 0)
+        goto done;
+
+    /* --- the substep loop of OculomotorPlant.step --- */
+    double h = dt / n_substeps;
+    double a_max = c.accel * h; /* c.accel = pursuit_accel_max_deg_s2 * DEG */
+    double vx = v[0], vy = v[1], vz = v[2], gx = g[0], gy = g[1], gz = g[2];
+    int in_saccade_last = 0;
+    double due;
+    if (queue_due(queue, &due) < 0)
+        goto done;
+    int still = ps.goal_zero && vx == 0.0 && vy == 0.0 && vz == 0.0;
+    for (long i = 1; i <= n_substeps; i++) {
+        double t = t0 + h * (double)i;
+        if (due <= (t - h) + 1e-9) {
+            if (pursuit_goal(&c, queue, &ps, t - h) < 0 || queue_due(queue, &due) < 0)
+                goto done;
+            still = ps.goal_zero && vx == 0.0 && vy == 0.0 && vz == 0.0;
+        }
+        if (!still) {
+            double ex = ps.goal[0] - vx, ey = ps.goal[1] - vy, ez = ps.goal[2] - vz;
+            double e = sqrt(ex * ex + ey * ey + ez * ez);
+            if (e > a_max) {
+                ex = ex * a_max / e;
+                ey = ey * a_max / e;
+                ez = ez * a_max / e;
+            }
+            vx = vx + ex;
+            vy = vy + ey;
+            vz = vz + ez;
+            still = ps.goal_zero && vx == 0.0 && vy == 0.0 && vz == 0.0;
+        }
+        if (in_flight) {
+            double u = (t - f.onset) / f.duration;
+            if (u >= 1.0)
+                u = 1.0;
+            else if (u < 0.0)
+                u = 0.0;
+            in_saccade_last = u < 1.0;
+            if (u >= 1.0 || i == n_substeps) {
+                double p[3];
+                saccade_point(&f, u, p);
+                gx = p[0];
+                gy = p[1];
+                gz = p[2];
+            }
+            if (u >= 1.0)
+                in_flight = 0;
+        } else if (!still) {
+            in_saccade_last = 0;
+            double d = vx * gx + vy * gy + vz * gz;
+            double wx = vx - d * gx, wy = vy - d * gy, wz = vz - d * gz;
+            double w = sqrt(wx * wx + wy * wy + wz * wz);
+            if (w > 1e-15) {
+                double ang = w * h;
+                double co = cos(ang), si = sin(ang);
+                double kx = wx / w, ky = wy / w, kz = wz / w;
+                double cx = ky * gz - kz * gy, cy = kz * gx - kx * gz, cz = kx * gy - ky * gx;
+                gx = co * gx + si * cx;
+                gy = co * gy + si * cy;
+                gz = co * gz + si * cz;
+                double m = sqrt(gx * gx + gy * gy + gz * gz);
+                gx = gx / m;
+                gy = gy / m;
+                gz = gz / m;
+            }
+        } else {
+            in_saccade_last = 0;
+        }
+    }
+
+    /* --- the end of OculomotorPlant.step: angular velocity, state --- */
+    PyObject *omega = NULL;
+    if (saccading && in_saccade_last) {
+        double u = py_min(py_max((t0 + dt - f.onset) / f.duration, 0.0), 1.0);
+        double speed = f.amplitude * 30.0 * pow(u, 2.0) * pow(1.0 - u, 2.0) / f.duration; /* Eq. 15 */
+        PyObject *axis = PyObject_GetAttr(sac, s_axis);
+        if (axis == NULL)
+            goto done;
+        omega = Py_BuildValue("(ONd)", Py_None, axis, speed);
+    } else {
+        if (saccading && PyObject_SetAttr(plant, s_saccade, Py_None) < 0)
+            goto done;
+        double d = vx * gx + vy * gy + vz * gz;
+        omega = Py_BuildValue("(N(ddd)d)", Py_NewRef(Py_None), vx - d * gx, vy - d * gy, vz - d * gz, 1.0);
+    }
+    if (omega == NULL)
+        goto done;
+    int rc = PyObject_SetAttr(plant, s_omega, omega);
+    Py_DECREF(omega);
+    if (rc < 0)
+        goto done;
+    /* the drive and goal _pursuit_goal left (unchanged objects when it did not run) */
+    if ((tmp = tuple3(ps.drive[0], ps.drive[1], ps.drive[2])) == NULL || PyObject_SetAttr(plant, s_drive, tmp) < 0)
+        goto done;
+    Py_CLEAR(tmp);
+    if (ps.goal_zero)
+        tmp = Py_NewRef(zero);
+    else
+        tmp = tuple3(ps.goal[0], ps.goal[1], ps.goal[2]);
+    if (tmp == NULL || PyObject_SetAttr(plant, s_goal, tmp) < 0)
+        goto done;
+    Py_CLEAR(tmp);
+    if ((tmp = tuple3(vx, vy, vz)) == NULL || PyObject_SetAttr(plant, s_pursuit_omega, tmp) < 0)
+        goto done;
+    Py_CLEAR(tmp);
+    if (PyObject_SetAttr(plant, s_suppressed, saccading ? Py_True : Py_False) < 0
+        || set_attr_double(plant, s_time, t0 + dt) < 0)
+        goto done;
+    result = tuple3(gx, gy, gz);
+done:
+    Py_XDECREF(queue);
+    Py_XDECREF(goal_obj);
+    Py_XDECREF(sac);
+    Py_XDECREF(tmp);
+    return result;
+}
+
+/* ---- the eye (visuomotor_gym/core/eye.py) ----------------------------------------------------- */
+
+/* eye_apply(xmat, xpos, head_body, gaze, offset, ranges, qpos, qvel, addresses, fixation)
+ *   -> (rot_flat, pos_list, (az, el), clamped)
+ *
+ * Mirrors Eye.apply (the vestibulo-ocular reflex): the world gaze in head coordinates, the clamped
+ * eye-in-head angles, the eye frame (head rotation @ Rz(az) Ry(-el)) and the eye's centre; writes
+ * the eye joints into qpos (the clamped angles, the fixation) and zeros their qvel.
+ * ``ranges`` = (az_lo, az_hi, el_lo, el_hi); ``addresses`` = (qpos az, qpos el, qpos fixation,
+ * dof az, dof el). The caller hands a clamped gaze to OculomotorPlant.constrain. */
+static PyObject *eye_apply(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    if (nargs != 10) {
+        PyErr_SetString(PyExc_TypeError,
+                        "eye_apply(xmat, xpos, head_body, gaze, offset, ranges, qpos, qvel, addresses, fixation)");
+        return NULL;
+    }
+    Py_ssize_t body = PyLong_AsSsize_t(args[2]);
+    double fixation = PyFloat_AsDouble(args[9]);
+    if ((body == -1 || fixation == -1.0) && PyErr_Occurred())
+        return NULL;
+    double hm[9], hp[3], gw[3], off[3], rng[4], adr[5];
+    if (array_doubles(args[0], 9 * body, hm, 9) < 0 || array_doubles(args[1], 3 * body, hp, 3) < 0
+        || array_doubles(args[3], 0, gw, 3) < 0 || seq_doubles(args[4], off, 3) < 0
+        || seq_doubles(args[5], rng, 4) < 0 || seq_doubles(args[8], adr, 5) < 0)
+        return NULL;
+    double h0 = hm[0], h1 = hm[1], h2 = hm[2], h3 = hm[3], h4 = hm[4], h5 = hm[5], h6 = hm[6], h7 = hm[7],
+           h8 = hm[8];
+    /* geometry.rotate_t(head, *gaze) */
+    double gx = h0 * gw[0] + h3 * gw[1] + h6 * gw[2];
+    double gy = h1 * gw[0] + h4 * gw[1] + h7 * gw[2];
+    double gz = h2 * gw[0] + h5 * gw[1] + h8 * gw[2];
+    double az = atan2(gy, gx);
+    PyObject *hyp = PyObject_CallFunction(math_hypot, "dd", gx, gy);
+    if (hyp == NULL)
+        return NULL;
+    double hxy = PyFloat_AsDouble(hyp);
+    Py_DECREF(hyp);
+    if (hxy == -1.0 && PyErr_Occurred())
+        return NULL;
+    double el = atan2(gz, hxy);
+    double az_c = py_min(py_max(az, rng[0]), rng[1]);
+    double el_c = py_min(py_max(el, rng[2]), rng[3]);
+    double ca = cos(az_c), sa = sin(az_c), ce = cos(el_c), se = sin(el_c);
+    double e00 = ca * ce, e01 = -sa, e02 = -ca * se, e10 = sa * ce, e11 = ca, e12 = -sa * se, e20 = se, e22 = ce;
+    double flat[9] = {
+        h0 * e00 + h1 * e10 + h2 * e20, h0 * e01 + h1 * e11, h0 * e02 + h1 * e12 + h2 * e22,
+        h3 * e00 + h4 * e10 + h5 * e20, h3 * e01 + h4 * e11, h3 * e02 + h4 * e12 + h5 * e22,
+        h6 * e00 + h7 * e10 + h8 * e20, h6 * e01 + h7 * e11, h6 * e02 + h7 * e12 + h8 * e22,
+    };
+    int clamped = az_c != az || el_c != el;
+    /* geometry.rotate(head, *offset) */
+    double ox = h0 * off[0] + h1 * off[1] + h2 * off[2];
+    double oy = h3 * off[0] + h4 * off[1] + h5 * off[2];
+    double oz = h6 * off[0] + h7 * off[1] + h8 * off[2];
+    double pos[3] = {hp[0] + ox, hp[1] + oy, hp[2] + oz};
+
+    Py_buffer qp, qv;
+    if (f64_buffer(args[6], &qp, 1) < 0)
+        return NULL;
+    if (f64_buffer(args[7], &qv, 1) < 0) {
+        PyBuffer_Release(&qp);
+        return NULL;
+    }
+    Py_ssize_t nq = qp.len / 8, nv = qv.len / 8;
+    Py_ssize_t ia = (Py_ssize_t)adr[0], ie = (Py_ssize_t)adr[1], ifx = (Py_ssize_t)adr[2], da = (Py_ssize_t)adr[3],
+               de = (Py_ssize_t)adr[4];
+    int ok = ia >= 0 && ia < nq && ie >= 0 && ie < nq && ifx >= 0 && ifx < nq && da >= 0 && da < nv && de >= 0
+             && de < nv;
+    if (ok) {
+        double *q = (double *)qp.buf, *qd = (double *)qv.buf;
+        q[ia] = az_c;
+        q[ie] = el_c;
+        q[ifx] = fixation;
+        qd[da] = 0.0;
+        qd[de] = 0.0;
+    }
+    PyBuffer_Release(&qp);
+    PyBuffer_Release(&qv);
+    if (!ok) {
+        PyErr_SetString(PyExc_IndexError, "eye_apply: joint address out of range");
+        return NULL;
+    }
+    return Py_BuildValue("(NN(dd)O)", list_of(flat, 9), list_of(pos, 3), az_c, el_c, clamped ? Py_True : Py_False);
+}
+
+/* ---- module ----------------------------------------------------------------------------------- */
+
+static PyMethodDef kernel_methods[] = {
+    {"plant_advance", (PyCFunction)(void (*)(void))plant_advance, METH_FASTCALL,
+     "OculomotorPlant.step after the saccade decision (see _kernels.c)."},
+    {"eye_apply", (PyCFunction)(void (*)(void))eye_apply, METH_FASTCALL, "Eye.apply (see _kernels.c)."},
+    {NULL, NULL, 0, NULL},
+};
+
+static struct PyModuleDef kernel_module = {PyModuleDef_HEAD_INIT, "_kernels",
+                                           "Compiled mirrors of per-step hot loops.", -1, kernel_methods};
+
+PyMODINIT_FUNC PyInit__kernels(void)
+{
+    PyObject *math = PyImport_ImportModule("math");
+    if (math == NULL)
+        return NULL;
+    math_hypot = PyObject_GetAttrString(math, "hypot");
+    Py_DECREF(math);
+    if (math_hypot == NULL)
+        return NULL;
+#define INTERN(var, name)                                                                                             \
+    if ((var = PyUnicode_InternFromString(name)) == NULL)                                                             \
+        return NULL;
+    INTERN(s_time, "time")
+    INTERN(s_suppressed, "_suppressed")
+    INTERN(s_prev_request, "_prev_request")
+    INTERN(s_last_sample, "_last_sample")
+    INTERN(s_drive_queue, "_drive_queue")
+    INTERN(s_drive, "_drive")
+    INTERN(s_goal, "_goal")
+    INTERN(s_pursuit_omega, "pursuit_omega")
+    INTERN(s_saccade, "saccade")
+    INTERN(s_omega, "_omega")
+    INTERN(s_onset, "onset")
+    INTERN(s_duration, "duration")
+    INTERN(s_amplitude, "amplitude")
+    INTERN(s_arc, "_arc")
+    INTERN(s_axis, "axis")
+    INTERN(s_gaze, "gaze")
+#undef INTERN
+    return PyModule_Create(&kernel_module);
+}
