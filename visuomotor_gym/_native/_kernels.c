@@ -14,7 +14,7 @@
 
 static PyObject *math_hypot;  /* math.hypot */
 static PyObject *s_time, *s_suppressed, *s_prev_request, *s_last_sample, *s_drive_queue, *s_drive, *s_goal,
-    *s_pursuit_omega, *s_saccade, *s_omega, *s_onset, *s_duration, *s_amplitude, *s_arc, *s_axis, *s_gaze;
+    *s_pursuit_omega, *s_saccade, *s_omega, *s_onset, *s_duration, *s_amplitude, *s_arc, *s_axis, *s_gaze, *s_hidden, *s_state;
 
 /* ---- small helpers -------------------------------------------------------------------------- */
 
@@ -556,12 +556,212 @@ static PyObject *eye_apply(PyObject *self, PyObject *const *args, Py_ssize_t nar
     return Py_BuildValue("(NN(dd)O)", list_of(flat, 9), list_of(pos, 3), az_c, el_c, clamped ? Py_True : Py_False);
 }
 
+/* ---- the retina (visuomotor_gym/core/retina.py, vision/foveation.py) --------------------------- */
+
+/* A 3-vector from a target's state: a float64 array read directly, anything else through .tolist(). */
+static int vec3(PyObject *obj, double *out)
+{
+    Py_buffer view;
+    if (PyObject_GetBuffer(obj, &view, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) == 0) {
+        const char *f = view.format;
+        int ok = view.itemsize == 8 && view.len == 24 && f != NULL
+                 && (strcmp(f, "d") == 0 || strcmp(f, "<d") == 0 || strcmp(f, "=d") == 0);
+        if (ok)
+            memcpy(out, view.buf, 3 * sizeof(double));
+        PyBuffer_Release(&view);
+        if (ok)
+            return 0;
+    } else {
+        PyErr_Clear();
+    }
+    PyObject *list = PyObject_CallMethod(obj, "tolist", NULL);
+    if (list == NULL)
+        return -1;
+    int rc = seq_doubles(list, out, 3);
+    Py_DECREF(list);
+    return rc;
+}
+
+/* The vision constants, packed by Retina._native_constants (see there for the order). */
+typedef struct {
+    double foveated, cos_fov, fov, noise_scale, pos_std_arcmin, arcmin, weber, floor, depth, depth_rate, e2, knee;
+} VisionConsts;
+
+/* retina.nothing() */
+static PyObject *nothing(void)
+{
+    return Py_BuildValue("([ddd][ddd]O)", 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, Py_False);
+}
+
+/* Eye.retinal_speed; ``eye`` = the eye's pos_list, prev_pos, prev_gaze and rot_flat, in that order. */
+static double retinal_speed(const double *eye, double rx, double ry, double rz, double vx, double vy, double vz,
+                            double dt)
+{
+    const double *e = eye, *p = eye + 3, *a = eye + 6, *r = eye + 9;
+    double inv_dt = 1.0 / dt;
+    double ux = vx - (e[0] - p[0]) / dt, uy = vy - (e[1] - p[1]) / dt, uz = vz - (e[2] - p[2]) / dt;
+    double r0 = r[0], r3 = r[3], r6 = r[6];
+    double wx = (a[1] * r6 - a[2] * r3) * inv_dt, wy = (a[2] * r0 - a[0] * r6) * inv_dt,
+           wz = (a[0] * r3 - a[1] * r0) * inv_dt;
+    double dist2 = rx * rx + ry * ry + rz * rz;
+    double sx = (ry * uz - rz * uy) / dist2 - wx;
+    double sy = (rz * ux - rx * uz) / dist2 - wy;
+    double sz = (rx * uy - ry * ux) / dist2 - wz;
+    double along = (sx * rx + sy * ry + sz * rz) / dist2;
+    sx = sx - along * rx;
+    sy = sy - along * ry;
+    sz = sz - along * rz;
+    return sqrt(sx * sx + sy * sy + sz * sz);
+}
+
+/* foveation._sigmas (with acuity and slip_factor) */
+static void sigmas(const VisionConsts *c, double distance, double ecc, double speed, double *s)
+{
+    double alpha = c->foveated ? c->e2 / (c->e2 + ecc) : 1.0;                    /* acuity */
+    double slip = c->foveated ? py_max(1.0, fabs(speed) / c->knee) : 1.0;        /* slip_factor */
+    double k = distance * c->noise_scale / alpha;
+    double lateral = k * c->pos_std_arcmin * c->arcmin * slip;
+    double lateral_rate = k * (c->weber * fabs(speed) + c->floor);
+    s[0] = k * c->depth;
+    s[1] = lateral;
+    s[2] = lateral;
+    s[3] = k * c->depth_rate;
+    s[4] = lateral_rate;
+    s[5] = lateral_rate;
+}
+
+/* foveation._los_rows */
+static void los_rows(double ux, double uy, double uz, double *r)
+{
+    double c = ux;
+    if (c < -1.0 + 1e-12) {
+        const double behind[9] = {-1.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0, 0.0, 1.0};
+        memcpy(r, behind, sizeof(behind));
+        return;
+    }
+    double f = 1.0 / (1.0 + c);
+    r[0] = c, r[1] = -uy, r[2] = -uz;
+    r[3] = uy, r[4] = 1.0 - f * uy * uy, r[5] = -f * uy * uz;
+    r[6] = uz, r[7] = -f * uy * uz, r[8] = 1.0 - f * uz * uz;
+}
+
+/* foveation.perceive (with _draw_at): one look at a point of the eye frame. */
+static PyObject *perceive(const VisionConsts *c, const double *pe, const double *ve, double speed, PyObject *rng)
+{
+    double x = pe[0], y = pe[1], z = pe[2];
+    double d = sqrt(x * x + y * y + z * z);
+    if (d <= 0.0)
+        return Py_BuildValue("([ddd][ddd]O)", x, y, z, ve[0], ve[1], ve[2], Py_True);
+    double ecc = acos(py_max(-1.0, py_min(1.0, x / d)));
+    if (c->foveated && ecc > c->fov)
+        return nothing();
+    double s[6], e[6], r[9];
+    sigmas(c, d, ecc, speed, s);
+    PyObject *draw = PyObject_CallMethod(rng, "standard_normal", "i", 6);
+    if (draw == NULL)
+        return NULL;
+    int rc = array_doubles(draw, 0, e, 6);
+    Py_DECREF(draw);
+    if (rc < 0)
+        return NULL;
+    double n0 = s[0] * e[0], n1 = s[1] * e[1], n2 = s[2] * e[2], n3 = s[3] * e[3], n4 = s[4] * e[4], n5 = s[5] * e[5];
+    los_rows(x / d, y / d, z / d, r);
+    return Py_BuildValue("([ddd][ddd]O)",
+                         x + r[0] * n0 + r[1] * n1 + r[2] * n2, y + r[3] * n0 + r[4] * n1 + r[5] * n2,
+                         z + r[6] * n0 + r[7] * n1 + r[8] * n2, ve[0] + r[0] * n3 + r[1] * n4 + r[2] * n5,
+                         ve[1] + r[3] * n3 + r[4] * n4 + r[5] * n5, ve[2] + r[6] * n3 + r[7] * n4 + r[8] * n5,
+                         Py_True);
+}
+
+/* retina_see_all(targets, data, eye, dt, constants, rng) -> [sample per target]
+ *
+ * Mirrors Retina._see_all: for each target, nothing() when hidden or outside the field of view,
+ * else its position and velocity in the eye frame, the retinal slip (Eye.retinal_speed) and one
+ * noisy look (foveation.perceive), drawing rng.standard_normal(6) as the Python does.
+ * ``eye`` = pos_list + prev_pos + prev_gaze + rot_flat (18 floats). */
+static PyObject *retina_see_all(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    if (nargs != 6) {
+        PyErr_SetString(PyExc_TypeError, "retina_see_all(targets, data, eye, dt, constants, rng)");
+        return NULL;
+    }
+    PyObject *targets = args[0], *data = args[1], *rng = args[5];
+    double eye[18];
+    double dt = PyFloat_AsDouble(args[3]);
+    if (dt == -1.0 && PyErr_Occurred())
+        return NULL;
+    if (seq_doubles(args[2], eye, 18) < 0)
+        return NULL;
+    if (!PyBytes_Check(args[4]) || PyBytes_GET_SIZE(args[4]) != sizeof(VisionConsts)) {
+        PyErr_SetString(PyExc_TypeError, "retina_see_all: bad vision constants");
+        return NULL;
+    }
+    VisionConsts c;
+    memcpy(&c, PyBytes_AS_STRING(args[4]), sizeof(VisionConsts));
+    const double *r = eye + 9;
+    PyObject *seq = PySequence_Fast(targets, "targets must be a sequence");
+    if (seq == NULL)
+        return NULL;
+    Py_ssize_t n = PySequence_Fast_GET_SIZE(seq);
+    PyObject *out = PyList_New(n);
+    if (out == NULL)
+        goto fail;
+    for (Py_ssize_t i = 0; i < n; i++) {
+        PyObject *target = PySequence_Fast_GET_ITEM(seq, i), *sample = NULL;
+        PyObject *hidden = PyObject_GetAttr(target, s_hidden);
+        if (hidden == NULL)
+            goto fail;
+        int is_hidden = PyObject_IsTrue(hidden);
+        Py_DECREF(hidden);
+        if (is_hidden < 0)
+            goto fail;
+        if (is_hidden) {
+            sample = nothing();
+        } else {
+            double b[3], v[3];
+            PyObject *state = PyObject_CallMethodOneArg(target, s_state, data);
+            if (state == NULL)
+                goto fail;
+            int rc = -1;
+            if (PyTuple_Check(state) && PyTuple_GET_SIZE(state) == 2)
+                rc = (vec3(PyTuple_GET_ITEM(state, 0), b) < 0 || vec3(PyTuple_GET_ITEM(state, 1), v) < 0) ? -1 : 0;
+            else
+                PyErr_SetString(PyExc_TypeError, "VisualTarget.state must return (position, velocity)");
+            Py_DECREF(state);
+            if (rc < 0)
+                goto fail;
+            double rx = b[0] - eye[0], ry = b[1] - eye[1], rz = b[2] - eye[2];
+            double px = r[0] * rx + r[3] * ry + r[6] * rz;
+            if (c.foveated && px < c.cos_fov * sqrt(rx * rx + ry * ry + rz * rz)) {
+                sample = nothing(); /* outside the field of view */
+            } else {
+                double pe[3] = {px, r[1] * rx + r[4] * ry + r[7] * rz, r[2] * rx + r[5] * ry + r[8] * rz};
+                double ve[3] = {r[0] * v[0] + r[3] * v[1] + r[6] * v[2], r[1] * v[0] + r[4] * v[1] + r[7] * v[2],
+                                r[2] * v[0] + r[5] * v[1] + r[8] * v[2]};
+                double speed = retinal_speed(eye, rx, ry, rz, v[0], v[1], v[2], dt);
+                sample = perceive(&c, pe, ve, speed, rng);
+            }
+        }
+        if (sample == NULL)
+            goto fail;
+        PyList_SET_ITEM(out, i, sample);
+    }
+    Py_DECREF(seq);
+    return out;
+fail:
+    Py_DECREF(seq);
+    Py_XDECREF(out);
+    return NULL;
+}
+
 /* ---- module ----------------------------------------------------------------------------------- */
 
 static PyMethodDef kernel_methods[] = {
     {"plant_advance", (PyCFunction)(void (*)(void))plant_advance, METH_FASTCALL,
      "OculomotorPlant.step after the saccade decision (see _kernels.c)."},
     {"eye_apply", (PyCFunction)(void (*)(void))eye_apply, METH_FASTCALL, "Eye.apply (see _kernels.c)."},
+    {"retina_see_all", (PyCFunction)(void (*)(void))retina_see_all, METH_FASTCALL,
+     "Retina._see_all (see _kernels.c)."},
     {NULL, NULL, 0, NULL},
 };
 
@@ -596,6 +796,8 @@ PyMODINIT_FUNC PyInit__kernels(void)
     INTERN(s_arc, "_arc")
     INTERN(s_axis, "axis")
     INTERN(s_gaze, "gaze")
+    INTERN(s_hidden, "hidden")
+    INTERN(s_state, "state")
 #undef INTERN
     return PyModule_Create(&kernel_module);
 }
