@@ -14,7 +14,8 @@
 
 static PyObject *math_hypot;  /* math.hypot */
 static PyObject *s_time, *s_suppressed, *s_prev_request, *s_last_sample, *s_drive_queue, *s_drive, *s_goal,
-    *s_pursuit_omega, *s_saccade, *s_omega, *s_onset, *s_duration, *s_amplitude, *s_arc, *s_axis, *s_gaze, *s_hidden, *s_state;
+    *s_pursuit_omega, *s_saccade, *s_omega, *s_onset, *s_duration, *s_amplitude, *s_arc, *s_axis, *s_gaze, *s_hidden, *s_state, *s_last_onset;
+static PyObject *np_array; /* numpy.array */
 
 /* ---- small helpers -------------------------------------------------------------------------- */
 
@@ -107,20 +108,47 @@ static int get_attr_double(PyObject *obj, PyObject *name, double *out)
     return (*out == -1.0 && PyErr_Occurred()) ? -1 : 0;
 }
 
+/* A 3-vector: a tuple or list of floats, a float64 array read directly, another array through .tolist(). */
+static int vec3(PyObject *obj, double *out)
+{
+    if (PyTuple_Check(obj) || PyList_Check(obj))
+        return seq_doubles(obj, out, 3);
+    Py_buffer view;
+    if (PyObject_GetBuffer(obj, &view, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) == 0) {
+        const char *f = view.format;
+        int ok = view.itemsize == 8 && view.len == 24 && f != NULL
+                 && (strcmp(f, "d") == 0 || strcmp(f, "<d") == 0 || strcmp(f, "=d") == 0);
+        if (ok)
+            memcpy(out, view.buf, 3 * sizeof(double));
+        PyBuffer_Release(&view);
+        if (ok)
+            return 0;
+    } else {
+        PyErr_Clear();
+    }
+    PyObject *list = PyObject_CallMethod(obj, "tolist", NULL);
+    if (list == NULL)
+        return -1;
+    int rc = seq_doubles(list, out, 3);
+    Py_DECREF(list);
+    return rc;
+}
+
 /* ---- the oculomotor plant (visuomotor_gym/oculomotor/plant.py) -------------------------------- */
 
 /* The plant's constants, packed by OculomotorPlant._native_constants:
  * [saccade threshold (rad), pursuit latency (s), pursuit acceleration bound (rad/s^2),
- *  pursuit cap (deg/s), DEG, number of gain points, then (deg/s, gain) pairs]. */
+ *  pursuit cap (deg/s), DEG, saccade refractory period (s), number of gain points, then
+ *  (deg/s, gain) pairs]. */
 typedef struct {
-    double threshold, latency, accel, vmax, deg;
+    double threshold, latency, accel, vmax, deg, refractory;
     Py_ssize_t npts;
     const double *pts;
 } PlantConsts;
 
 static int plant_consts(PyObject *packed, PlantConsts *c)
 {
-    if (!PyBytes_Check(packed) || PyBytes_GET_SIZE(packed) < 6 * 8) {
+    if (!PyBytes_Check(packed) || PyBytes_GET_SIZE(packed) < 7 * 8) {
         PyErr_SetString(PyExc_TypeError, "plant constants: expected the packed bytes");
         return -1;
     }
@@ -130,9 +158,10 @@ static int plant_consts(PyObject *packed, PlantConsts *c)
     c->accel = v[2];
     c->vmax = v[3];
     c->deg = v[4];
-    c->npts = (Py_ssize_t)v[5];
-    c->pts = v + 6;
-    if (c->npts < 1 || PyBytes_GET_SIZE(packed) != (6 + 2 * c->npts) * 8) {
+    c->refractory = v[5];
+    c->npts = (Py_ssize_t)v[6];
+    c->pts = v + 7;
+    if (c->npts < 1 || PyBytes_GET_SIZE(packed) != (7 + 2 * c->npts) * 8) {
         PyErr_SetString(PyExc_ValueError, "plant constants: bad size");
         return -1;
     }
@@ -296,30 +325,17 @@ static void saccade_point(const Flight *f, double u, double *g)
     g[2] = c * f->a[2] + s * f->w[2];
 }
 
-/* plant_advance(plant, request, dt, n_substeps, constants, zero) -> (gx, gy, gz)
- *
- * Mirrors the part of OculomotorPlant.step after the saccade decision, for record=False: the
- * target-motion sample (_sample_target_motion), the substep loop (pursuit velocity with
- * _pursuit_goal, the saccade profile, the Rodrigues rotation) and the end-of-step state. It reads
- * and writes the plant's attributes as the Python does, except ``gaze``: it returns the new gaze
- * for the caller to store. ``zero`` is plant.py's _ZERO, the goal the Python compares by identity. */
-static PyObject *plant_advance(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+/* The part of OculomotorPlant.step after the saccade decision, for record=False: the target-motion
+ * sample (_sample_target_motion), the substep loop (pursuit velocity with _pursuit_goal, the saccade
+ * profile, the Rodrigues rotation) and the end-of-step state, read from and written to the plant's
+ * attributes as the Python does. ``zero`` is plant.py's _ZERO, the goal the Python compares by
+ * identity. Returns ``saccading`` (0/1), or -1 with an exception set. */
+static int plant_advance(PyObject *plant, const PlantConsts *cp, PyObject *request, const double *req, double dt,
+                         long n_substeps, PyObject *zero)
 {
-    if (nargs != 6) {
-        PyErr_SetString(PyExc_TypeError, "plant_advance(plant, request, dt, n_substeps, constants, zero)");
-        return NULL;
-    }
-    PyObject *plant = args[0], *request = args[1], *zero = args[5];
-    PlantConsts c;
-    double req[3];
-    double dt = PyFloat_AsDouble(args[2]);
-    long n_substeps = PyLong_AsLong(args[3]);
-    if ((dt == -1.0 || n_substeps == -1) && PyErr_Occurred())
-        return NULL;
-    if (plant_consts(args[4], &c) < 0 || seq_doubles(request, req, 3) < 0)
-        return NULL;
-
-    PyObject *queue = NULL, *goal_obj = NULL, *sac = NULL, *tmp = NULL, *result = NULL;
+    const PlantConsts c = *cp;
+    PyObject *queue = NULL, *goal_obj = NULL, *sac = NULL, *tmp = NULL;
+    int result = -1;
     double t0, g[3], v[3];
     Pursuit ps;
     Flight f;
@@ -461,7 +477,15 @@ static PyObject *plant_advance(PyObject *self, PyObject *const *args, Py_ssize_t
     if (PyObject_SetAttr(plant, s_suppressed, saccading ? Py_True : Py_False) < 0
         || set_attr_double(plant, s_time, t0 + dt) < 0)
         goto done;
-    result = tuple3(gx, gy, gz);
+    /* self.gaze = np.array([gx, gy, gz]) */
+    PyObject *gaze = Py_BuildValue("[ddd]", gx, gy, gz);
+    if (gaze == NULL)
+        goto done;
+    tmp = PyObject_CallOneArg(np_array, gaze);
+    Py_DECREF(gaze);
+    if (tmp == NULL || PyObject_SetAttr(plant, s_gaze, tmp) < 0)
+        goto done;
+    result = saccading;
 done:
     Py_XDECREF(queue);
     Py_XDECREF(goal_obj);
@@ -470,7 +494,121 @@ done:
     return result;
 }
 
+
+/* The start of OculomotorPlant.step, then plant_advance: the request normalised, and the saccade
+ * decision. Returns 0 (stepped; *saccading and *deferred set), 1 when a saccade starts now (nothing
+ * was changed: the caller runs the Python step, which builds the Saccade), -1 on error. */
+static int plant_step_impl(PyObject *plant, const PlantConsts *c, const double *target, double dt, long n_substeps,
+                           PyObject *zero, int *saccading, int *deferred)
+{
+    double tx = target[0], ty = target[1], tz = target[2];
+    double n = sqrt(tx * tx + ty * ty + tz * tz);
+    double req[3] = {tx / n, ty / n, tz / n};
+    *deferred = 0;
+    PyObject *sac = PyObject_GetAttr(plant, s_saccade);
+    if (sac == NULL)
+        return -1;
+    int idle = sac == Py_None;
+    Py_DECREF(sac);
+    if (idle) {
+        double g[3], now, last;
+        PyObject *gaze = PyObject_GetAttr(plant, s_gaze);
+        if (gaze == NULL)
+            return -1;
+        int rc = array_doubles(gaze, 0, g, 3);
+        Py_DECREF(gaze);
+        if (rc < 0)
+            return -1;
+        /* geometry.angle_between(self.gaze, request) */
+        double cx = g[1] * req[2] - g[2] * req[1], cy = g[2] * req[0] - g[0] * req[2], cz = g[0] * req[1] - g[1] * req[0];
+        double amplitude = atan2(sqrt(cx * cx + cy * cy + cz * cz), g[0] * req[0] + g[1] * req[1] + g[2] * req[2]);
+        if (amplitude > c->threshold) {
+            if (get_attr_double(plant, s_time, &now) < 0 || get_attr_double(plant, s_last_onset, &last) < 0)
+                return -1;
+            if (now - last >= c->refractory - 1e-9) /* ready_for_saccade */
+                return 1;
+            *deferred = 1; /* waits for the generator; not executed as pursuit */
+        }
+    }
+    PyObject *request = tuple3(req[0], req[1], req[2]);
+    if (request == NULL)
+        return -1;
+    *saccading = plant_advance(plant, c, request, req, dt, n_substeps, zero);
+    Py_DECREF(request);
+    return *saccading < 0 ? -1 : 0;
+}
+
+/* plant_step(plant, target, dt, n_substeps, constants, zero) -> (saccading, deferred) or None
+ *
+ * OculomotorPlant.step for record=False, except a step that starts a saccade: None, and nothing
+ * changed (the Python step runs it). ``target``: a 3-tuple of floats or a float64 array. */
+static PyObject *plant_step(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    if (nargs != 6) {
+        PyErr_SetString(PyExc_TypeError, "plant_step(plant, target, dt, n_substeps, constants, zero)");
+        return NULL;
+    }
+    PlantConsts c;
+    double target[3];
+    double dt = PyFloat_AsDouble(args[2]);
+    long n_substeps = PyLong_AsLong(args[3]);
+    if ((dt == -1.0 || n_substeps == -1) && PyErr_Occurred())
+        return NULL;
+    if (plant_consts(args[4], &c) < 0)
+        return NULL;
+    if ((PyTuple_Check(args[1]) ? seq_doubles(args[1], target, 3) : vec3(args[1], target)) < 0)
+        return NULL;
+    int saccading, deferred;
+    int rc = plant_step_impl(args[0], &c, target, dt, n_substeps, args[5], &saccading, &deferred);
+    if (rc < 0)
+        return NULL;
+    if (rc == 1)
+        Py_RETURN_NONE;
+    return Py_BuildValue("(OO)", saccading ? Py_True : Py_False, deferred ? Py_True : Py_False);
+}
+
 /* ---- the eye (visuomotor_gym/core/eye.py) ----------------------------------------------------- */
+
+/* eye_command(rot_flat, plant, plant constants, zero, eye constants, g_az, g_el, g_fix, dt, n_substeps,
+ *             fixation) -> (saccading, deferred, fixation) or None
+ *
+ * Mirrors Eye.command: the requested gaze (unit_from_angles in the eye frame, rotated to the world),
+ * the plant's step (plant_step: None when a saccade starts, nothing changed, and the caller runs the
+ * Python method) and the rate-limited vergence. ``eye constants`` = (gaze action range, log of the
+ * fixation range's ends, vergence rate limit). */
+static PyObject *eye_command(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    if (nargs != 11) {
+        PyErr_SetString(PyExc_TypeError, "eye_command(rot_flat, plant, plant_constants, zero, eye_constants, "
+                                         "g_az, g_el, g_fix, dt, n_substeps, fixation)");
+        return NULL;
+    }
+    double r[9], ec[4];
+    PlantConsts c;
+    double g_az = PyFloat_AsDouble(args[5]), g_el = PyFloat_AsDouble(args[6]), g_fix = PyFloat_AsDouble(args[7]);
+    double dt = PyFloat_AsDouble(args[8]), fixation = PyFloat_AsDouble(args[10]);
+    long n_substeps = PyLong_AsLong(args[9]);
+    if (PyErr_Occurred() || seq_doubles(args[0], r, 9) < 0 || plant_consts(args[2], &c) < 0
+        || seq_doubles(args[4], ec, 4) < 0)
+        return NULL;
+    /* geometry.unit_from_angles, then geometry.rotate(self.rot_flat, *u) */
+    double az = g_az * ec[0], el = g_el * ec[0];
+    double ce = cos(el);
+    double ux = ce * cos(az), uy = ce * sin(az), uz = sin(el);
+    double target[3] = {r[0] * ux + r[1] * uy + r[2] * uz, r[3] * ux + r[4] * uy + r[5] * uz,
+                        r[6] * ux + r[7] * uy + r[8] * uz};
+    int saccading, deferred;
+    int rc = plant_step_impl(args[1], &c, target, dt, n_substeps, args[3], &saccading, &deferred);
+    if (rc < 0)
+        return NULL;
+    if (rc == 1)
+        Py_RETURN_NONE;
+    double lo = ec[1], hi = ec[2];
+    double fix_target = exp(lo + (g_fix + 1.0) * 0.5 * (hi - lo));
+    double vergence = ec[3] * dt; /* rate limit in diopters */
+    double inv = py_min(py_max(1.0 / fix_target, 1.0 / fixation - vergence), 1.0 / fixation + vergence);
+    return Py_BuildValue("(OOd)", saccading ? Py_True : Py_False, deferred ? Py_True : Py_False, 1.0 / inv);
+}
 
 /* eye_apply(xmat, xpos, head_body, gaze, offset, ranges, qpos, qvel, addresses, fixation)
  *   -> (rot_flat, pos_list, (az, el), clamped)
@@ -557,30 +695,6 @@ static PyObject *eye_apply(PyObject *self, PyObject *const *args, Py_ssize_t nar
 }
 
 /* ---- the retina (visuomotor_gym/core/retina.py, vision/foveation.py) --------------------------- */
-
-/* A 3-vector from a target's state: a float64 array read directly, anything else through .tolist(). */
-static int vec3(PyObject *obj, double *out)
-{
-    Py_buffer view;
-    if (PyObject_GetBuffer(obj, &view, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) == 0) {
-        const char *f = view.format;
-        int ok = view.itemsize == 8 && view.len == 24 && f != NULL
-                 && (strcmp(f, "d") == 0 || strcmp(f, "<d") == 0 || strcmp(f, "=d") == 0);
-        if (ok)
-            memcpy(out, view.buf, 3 * sizeof(double));
-        PyBuffer_Release(&view);
-        if (ok)
-            return 0;
-    } else {
-        PyErr_Clear();
-    }
-    PyObject *list = PyObject_CallMethod(obj, "tolist", NULL);
-    if (list == NULL)
-        return -1;
-    int rc = seq_doubles(list, out, 3);
-    Py_DECREF(list);
-    return rc;
-}
 
 /* The vision constants, packed by Retina._native_constants (see there for the order). */
 typedef struct {
@@ -757,8 +871,9 @@ fail:
 /* ---- module ----------------------------------------------------------------------------------- */
 
 static PyMethodDef kernel_methods[] = {
-    {"plant_advance", (PyCFunction)(void (*)(void))plant_advance, METH_FASTCALL,
-     "OculomotorPlant.step after the saccade decision (see _kernels.c)."},
+    {"plant_step", (PyCFunction)(void (*)(void))plant_step, METH_FASTCALL,
+     "OculomotorPlant.step unless a saccade starts (see _kernels.c)."},
+    {"eye_command", (PyCFunction)(void (*)(void))eye_command, METH_FASTCALL, "Eye.command (see _kernels.c)."},
     {"eye_apply", (PyCFunction)(void (*)(void))eye_apply, METH_FASTCALL, "Eye.apply (see _kernels.c)."},
     {"retina_see_all", (PyCFunction)(void (*)(void))retina_see_all, METH_FASTCALL,
      "Retina._see_all (see _kernels.c)."},
@@ -776,6 +891,13 @@ PyMODINIT_FUNC PyInit__kernels(void)
     math_hypot = PyObject_GetAttrString(math, "hypot");
     Py_DECREF(math);
     if (math_hypot == NULL)
+        return NULL;
+    PyObject *numpy = PyImport_ImportModule("numpy");
+    if (numpy == NULL)
+        return NULL;
+    np_array = PyObject_GetAttrString(numpy, "array");
+    Py_DECREF(numpy);
+    if (np_array == NULL)
         return NULL;
 #define INTERN(var, name)                                                                                             \
     if ((var = PyUnicode_InternFromString(name)) == NULL)                                                             \
@@ -798,6 +920,7 @@ PyMODINIT_FUNC PyInit__kernels(void)
     INTERN(s_gaze, "gaze")
     INTERN(s_hidden, "hidden")
     INTERN(s_state, "state")
+    INTERN(s_last_onset, "last_onset")
 #undef INTERN
     return PyModule_Create(&kernel_module);
 }

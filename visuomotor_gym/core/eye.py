@@ -22,6 +22,7 @@ from visuomotor_gym.body import names
 from visuomotor_gym.core.observation import Block
 from visuomotor_gym.geometry import rotate, rotate_t, unit_from_angles
 from visuomotor_gym.oculomotor.plant import (
+    _ZERO,
     DEG,
     OculomotorParams,
     OculomotorPlant,
@@ -77,8 +78,9 @@ class Eye:
         self._az_range = (params.eye_azimuth_range_deg[0] * DEG, params.eye_azimuth_range_deg[1] * DEG)
         self._el_range = (params.eye_elevation_range_deg[0] * DEG, params.eye_elevation_range_deg[1] * DEG)
         self._log_fix = (math.log(params.fixation_range_m[0]), math.log(params.fixation_range_m[1]))
-        # The compiled VOR (visuomotor_gym._native, _kernels.c: eye_apply), when built.
-        self._native = _native.enabled()
+        # The compiled command and VOR (visuomotor_gym._native, _kernels.c: eye_command, eye_apply), when built.
+        self._native = _native.enabled() and not record
+        self._native_constants = (self.gaze_action_range, *self._log_fix, params.vergence_max_diopter_s)
         self._native_ranges = (*self._az_range, *self._el_range)
         self._native_addresses = (self._qpos_az, self._qpos_el, self._fix_qpos, *dofs)
         self.reset_state()
@@ -119,6 +121,14 @@ class Eye:
         """Run the plant for one control step toward the requested gaze change (retinal azimuth and
         elevation of the current eye frame, in action units) and move vergence toward the fixation
         action (log-mapped onto the fixation range, rate-limited in diopters)."""
+        if self._native:  # this method, compiled, unless a saccade starts
+            plant = self.plant
+            stepped = _native.kernels.eye_command(self.rot_flat, plant, plant._native_constants, _ZERO,
+                                                  self._native_constants, g_az, g_el, g_fix, dt, n_substeps,
+                                                  self.fixation)
+            if stepped is not None:
+                saccading, deferred, self.fixation = stepped
+                return PlantStep(False, saccading, deferred)
         u = unit_from_angles(g_az * self.gaze_action_range, g_el * self.gaze_action_range)  # eye frame
         target = rotate(self.rot_flat, *u)  # world, a tuple (the plant takes one as it is)
         plant_step = self.plant.step(target, dt, n_substeps, rng)

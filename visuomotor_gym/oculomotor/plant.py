@@ -228,12 +228,13 @@ class OculomotorPlant:
     def __init__(self, params: OculomotorParams | None = None, record: bool = False):
         self.params = params or OculomotorParams()
         self.record = record
-        # The compiled substep loop (visuomotor_gym._native), when built; not for the recorded trace.
+        # The compiled step (visuomotor_gym._native), when built; not for the recorded trace. Its
+        # constants in the order of _kernels.c's PlantConsts.
         self._native = _native.enabled() and not record
         p = self.params
         self._native_constants = np.array(
             [p.saccade_threshold_deg * DEG, p.pursuit_latency_s, p.pursuit_accel_max_deg_s2 * DEG,
-             p.pursuit_max_deg_s, DEG, len(p.pursuit_gain_points), *(x for q in p.pursuit_gain_points for x in q)],
+             p.pursuit_max_deg_s, DEG, p.saccade_refractory_s, len(p.pursuit_gain_points), *(x for q in p.pursuit_gain_points for x in q)],
             dtype=np.float64,
         ).tobytes()
         self.reset(np.array([1.0, 0.0, 0.0]), time=0.0)
@@ -325,6 +326,10 @@ class OculomotorPlant:
 
         ``rng`` draws the optional saccade endpoint noise (only used when that noise is > 0).
         """
+        if self._native:  # this method, compiled (_native/_kernels.c: plant_step), unless a saccade starts
+            stepped = _native.kernels.plant_step(self, target, dt, n_substeps, self._native_constants, _ZERO)
+            if stepped is not None:
+                return PlantStep(False, *stepped)
         p = self.params
         t0 = self.time
         tx, ty, tz = target if type(target) is tuple else np.asarray(target, dtype=float).tolist()
@@ -351,11 +356,6 @@ class OculomotorPlant:
         # A request that starts a saccade is a position command (it may aim ahead of the target):
         # like the steps with a saccade in flight, it carries no motion signal.
         self._suppressed = self._suppressed or started
-        if self._native:  # the rest of this method, compiled (_native/_kernels.c: plant_advance)
-            saccading = self.saccade is not None
-            self.gaze = np.array(_native.kernels.plant_advance(self, request, dt, n_substeps,
-                                                               self._native_constants, _ZERO))
-            return PlantStep(started, saccading, deferred)
         self._sample_target_motion(request, dt)
 
         saccading = self.saccade is not None
