@@ -868,6 +868,192 @@ fail:
     return NULL;
 }
 
+/* ---- the hand (visuomotor_gym/control/hand.py) ---------------------------------------------------
+ * HandController.setpoints keeps its three matrix products (numpy's BLAS, whose summation order C
+ * cannot reproduce); these kernels do the element-wise work around them, into arrays the controller
+ * allocated. */
+
+/* Float64 buffers for a kernel: up to 12, writable ones flagged; all released by release_all. */
+typedef struct {
+    Py_buffer view[12];
+    int n;
+} Buffers;
+
+static double *buf(Buffers *b, PyObject *obj, int writable, Py_ssize_t min_len)
+{
+    if (f64_buffer(obj, &b->view[b->n], writable) < 0)
+        return NULL;
+    Py_buffer *v = &b->view[b->n++];
+    if (v->len / 8 < min_len) {
+        PyErr_SetString(PyExc_IndexError, "array too short");
+        return NULL;
+    }
+    return (double *)v->buf;
+}
+
+static void release_all(Buffers *b)
+{
+    for (int i = 0; i < b->n; i++)
+        PyBuffer_Release(&b->view[i]);
+    b->n = 0;
+}
+
+/* n indices from a tuple of ints, each in [0, bound). */
+static int indices(PyObject *tuple, Py_ssize_t *out, Py_ssize_t n, Py_ssize_t bound)
+{
+    if (!PyTuple_Check(tuple) || PyTuple_GET_SIZE(tuple) != n) {
+        PyErr_SetString(PyExc_TypeError, "expected a tuple of indices");
+        return -1;
+    }
+    for (Py_ssize_t i = 0; i < n; i++) {
+        out[i] = PyLong_AsSsize_t(PyTuple_GET_ITEM(tuple, i));
+        if (out[i] == -1 && PyErr_Occurred())
+            return -1;
+        if (out[i] < 0 || out[i] >= bound) {
+            PyErr_SetString(PyExc_IndexError, "index out of range");
+            return -1;
+        }
+    }
+    return 0;
+}
+
+#define HAND_MAX_JOINTS 64
+
+/* hand_gather(jacp, qpos, setpoint, dof_ids, qpos_ids, nominal, weights, posture_gain, jac, jw, posture, x)
+ *
+ * The element-wise start of HandController.setpoints: ``jac = jacp[:, dof_ids]``,
+ * ``posture = posture_gain * (nominal - setpoint)``, ``x = setpoint - qpos[qpos_ids] + posture``
+ * (what jac.dot takes) and ``jw = jac * weights`` (per column). */
+static PyObject *hand_gather(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    if (nargs != 12) {
+        PyErr_SetString(PyExc_TypeError, "hand_gather takes 12 arguments");
+        return NULL;
+    }
+    Py_ssize_t n = PyTuple_Check(args[3]) ? PyTuple_GET_SIZE(args[3]) : -1;
+    double gain = PyFloat_AsDouble(args[7]);
+    if (gain == -1.0 && PyErr_Occurred())
+        return NULL;
+    if (n < 1 || n > HAND_MAX_JOINTS) {
+        PyErr_SetString(PyExc_ValueError, "hand_gather: bad number of joints");
+        return NULL;
+    }
+    Buffers b = {.n = 0};
+    Py_ssize_t dof[HAND_MAX_JOINTS], qid[HAND_MAX_JOINTS];
+    double *jacp = buf(&b, args[0], 0, 3), *q = jacp ? buf(&b, args[1], 0, 1) : NULL;
+    double *sp = q ? buf(&b, args[2], 0, n) : NULL;
+    if (sp == NULL)
+        goto fail;
+    Py_ssize_t nv = b.view[0].len / 8 / 3, nq = b.view[1].len / 8;
+    double *nominal = buf(&b, args[5], 0, n), *w = nominal ? buf(&b, args[6], 0, n) : NULL;
+    double *jac = w ? buf(&b, args[8], 1, 3 * n) : NULL, *jw = jac ? buf(&b, args[9], 1, 3 * n) : NULL;
+    double *posture = jw ? buf(&b, args[10], 1, n) : NULL, *x = posture ? buf(&b, args[11], 1, n) : NULL;
+    if (x == NULL || indices(args[3], dof, n, nv) < 0 || indices(args[4], qid, n, nq) < 0)
+        goto fail;
+    for (Py_ssize_t r = 0; r < 3; r++)
+        for (Py_ssize_t k = 0; k < n; k++) {
+            jac[r * n + k] = jacp[r * nv + dof[k]];
+            jw[r * n + k] = jac[r * n + k] * w[k];
+        }
+    for (Py_ssize_t k = 0; k < n; k++) {
+        posture[k] = gain * (nominal[k] - sp[k]);
+        x[k] = sp[k] - q[qid[k]] + posture[k];
+    }
+    release_all(&b);
+    Py_RETURN_NONE;
+fail:
+    release_all(&b);
+    return NULL;
+}
+
+/* hand_solve(jj, j, reference, site_xpos, site_id, damping2, y)
+ *
+ * The 3x3 middle of HandController.setpoints: the error of the hand the setpoints would give
+ * (``reference - site - j``, j = jac.dot(x)), the damped system ``jj + l^2 I`` (jj = jw.dot(jw.T);
+ * "+ 0.0" off the diagonal as in the Python) and its solution by geometry.solve3, into ``y``. */
+static PyObject *hand_solve(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    if (nargs != 7) {
+        PyErr_SetString(PyExc_TypeError, "hand_solve(jj, j, reference, site_xpos, site_id, damping2, y)");
+        return NULL;
+    }
+    double m[9], jv[3], ref[3], site[3];
+    Py_ssize_t sid = PyLong_AsSsize_t(args[4]);
+    double l2 = PyFloat_AsDouble(args[5]);
+    if (PyErr_Occurred() || array_doubles(args[0], 0, m, 9) < 0 || array_doubles(args[1], 0, jv, 3) < 0
+        || array_doubles(args[2], 0, ref, 3) < 0 || array_doubles(args[3], 3 * sid, site, 3) < 0)
+        return NULL;
+    double x = (ref[0] - site[0]) - jv[0], y = (ref[1] - site[1]) - jv[1], z = (ref[2] - site[2]) - jv[2];
+    double a = m[0] + l2, b_ = m[1] + 0.0, c = m[2] + 0.0, d = m[3] + 0.0, e = m[4] + l2, f = m[5] + 0.0,
+           g = m[6] + 0.0, h = m[7] + 0.0, i = m[8] + l2;
+    /* geometry.solve3 */
+    double ei_fh = e * i - f * h, fg_di = f * g - d * i, dh_eg = d * h - e * g;
+    double det = a * ei_fh + b_ * fg_di + c * dh_eg;
+    double sol[3] = {
+        (x * ei_fh + b_ * (f * z - y * i) + c * (y * h - e * z)) / det,
+        (a * (y * i - f * z) + x * fg_di + c * (d * z - y * g)) / det,
+        (a * (e * z - y * h) + b_ * (y * g - d * z) + x * dh_eg) / det,
+    };
+    Buffers bf = {.n = 0};
+    double *out = buf(&bf, args[6], 1, 3);
+    if (out != NULL)
+        memcpy(out, sol, sizeof(sol));
+    release_all(&bf);
+    if (out == NULL)
+        return NULL;
+    Py_RETURN_NONE;
+}
+
+/* hand_finish(z, weights, posture, setpoint, max_joint_step, lower, upper, out)
+ *
+ * The end of HandController.setpoints: ``dq = weights * z + posture`` (z = y.dot(jw)), scaled down
+ * if its largest step exceeds ``max_joint_step``, plus the setpoint, clipped as
+ * np.maximum(dq, lower) then np.minimum(dq, upper); into ``out``. */
+static PyObject *hand_finish(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    if (nargs != 8) {
+        PyErr_SetString(PyExc_TypeError, "hand_finish(z, weights, posture, setpoint, max_step, lower, upper, out)");
+        return NULL;
+    }
+    double max_step = PyFloat_AsDouble(args[4]);
+    if (max_step == -1.0 && PyErr_Occurred())
+        return NULL;
+    Buffers b = {.n = 0};
+    double *z = buf(&b, args[0], 0, 1);
+    if (z == NULL)
+        goto fail;
+    Py_ssize_t n = b.view[0].len / 8;
+    double *w = buf(&b, args[1], 0, n), *posture = w ? buf(&b, args[2], 0, n) : NULL;
+    double *sp = posture ? buf(&b, args[3], 0, n) : NULL, *lo = sp ? buf(&b, args[5], 0, n) : NULL;
+    double *hi = lo ? buf(&b, args[6], 0, n) : NULL, *dq = hi ? buf(&b, args[7], 1, n) : NULL;
+    if (dq == NULL)
+        goto fail;
+    double mx = 0.0, mn = 0.0;
+    for (Py_ssize_t k = 0; k < n; k++) {
+        dq[k] = w[k] * z[k] + posture[k];
+        if (k == 0 || dq[k] > mx) /* Python's max() and min() of the list */
+            mx = dq[k];
+        if (k == 0 || dq[k] < mn)
+            mn = dq[k];
+    }
+    double step = py_max(mx, -mn);
+    if (step > max_step) {
+        double scale = max_step / step;
+        for (Py_ssize_t k = 0; k < n; k++)
+            dq[k] *= scale;
+    }
+    for (Py_ssize_t k = 0; k < n; k++) {
+        double v = dq[k] + sp[k];
+        v = (v >= lo[k] || isnan(v)) ? v : lo[k]; /* np.maximum */
+        dq[k] = (v <= hi[k] || isnan(v)) ? v : hi[k]; /* np.minimum */
+    }
+    release_all(&b);
+    Py_RETURN_NONE;
+fail:
+    release_all(&b);
+    return NULL;
+}
+
 /* ---- module ----------------------------------------------------------------------------------- */
 
 static PyMethodDef kernel_methods[] = {
@@ -875,6 +1061,9 @@ static PyMethodDef kernel_methods[] = {
      "OculomotorPlant.step unless a saccade starts (see _kernels.c)."},
     {"eye_command", (PyCFunction)(void (*)(void))eye_command, METH_FASTCALL, "Eye.command (see _kernels.c)."},
     {"eye_apply", (PyCFunction)(void (*)(void))eye_apply, METH_FASTCALL, "Eye.apply (see _kernels.c)."},
+    {"hand_gather", (PyCFunction)(void (*)(void))hand_gather, METH_FASTCALL, "HandController.setpoints, start."},
+    {"hand_solve", (PyCFunction)(void (*)(void))hand_solve, METH_FASTCALL, "HandController.setpoints, 3x3 solve."},
+    {"hand_finish", (PyCFunction)(void (*)(void))hand_finish, METH_FASTCALL, "HandController.setpoints, end."},
     {"retina_see_all", (PyCFunction)(void (*)(void))retina_see_all, METH_FASTCALL,
      "Retina._see_all (see _kernels.c)."},
     {NULL, NULL, 0, NULL},
