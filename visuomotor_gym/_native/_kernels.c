@@ -16,6 +16,7 @@ static PyObject *math_hypot;  /* math.hypot */
 static PyObject *s_time, *s_suppressed, *s_prev_request, *s_last_sample, *s_drive_queue, *s_drive, *s_goal,
     *s_pursuit_omega, *s_saccade, *s_omega, *s_onset, *s_duration, *s_amplitude, *s_arc, *s_axis, *s_gaze, *s_hidden, *s_state, *s_last_onset;
 static PyObject *np_array; /* numpy.array */
+static PyObject *s_standard_normal, *int_six;
 
 /* ---- small helpers -------------------------------------------------------------------------- */
 
@@ -771,7 +772,8 @@ static PyObject *perceive(const VisionConsts *c, const double *pe, const double 
         return nothing();
     double s[6], e[6], r[9];
     sigmas(c, d, ecc, speed, s);
-    PyObject *draw = PyObject_CallMethod(rng, "standard_normal", "i", 6);
+    PyObject *call[2] = {rng, int_six};
+    PyObject *draw = PyObject_VectorcallMethod(s_standard_normal, call, 2 | PY_VECTORCALL_ARGUMENTS_OFFSET, NULL);
     if (draw == NULL)
         return NULL;
     int rc = array_doubles(draw, 0, e, 6);
@@ -1054,6 +1056,67 @@ fail:
     return NULL;
 }
 
+/* ---- the step skeleton (visuomotor_gym/core/env.py) ------------------------------------------------ */
+
+/* action_values(a) -> list or None
+ *
+ * The common case of VisuomotorEnv._check_action after ``a = action.astype(np.float64)``:
+ * ``a.tolist()`` when every value is finite and in [-1, 1]; None otherwise (the Python then raises
+ * or clips). */
+static PyObject *action_values(PyObject *self, PyObject *arg)
+{
+    Py_buffer view;
+    if (f64_buffer(arg, &view, 0) < 0)
+        return NULL;
+    Py_ssize_t n = view.len / 8;
+    const double *v = (const double *)view.buf;
+    int fine = 1;
+    for (Py_ssize_t i = 0; i < n && fine; i++)
+        fine = isfinite(v[i]) && v[i] >= -1.0 && v[i] <= 1.0;
+    PyObject *out = fine ? list_of(v, n) : Py_NewRef(Py_None);
+    PyBuffer_Release(&view);
+    return out;
+}
+
+/* to_float32(values, out) -> bool
+ *
+ * ``np.array(values, dtype=np.float32)`` of VisuomotorEnv._observe, into ``out`` (an empty float32
+ * array of the list's length): each value as a double, rounded to float32 as numpy casts. Only
+ * floats and ints (bools) are taken; anything else returns False (the Python builds the array). */
+static PyObject *to_float32(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    if (nargs != 2 || !PyList_Check(args[0])) {
+        PyErr_SetString(PyExc_TypeError, "to_float32(values: list, out)");
+        return NULL;
+    }
+    Py_buffer view;
+    if (PyObject_GetBuffer(args[1], &view, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | PyBUF_WRITABLE) < 0)
+        return NULL;
+    PyObject *values = args[0];
+    Py_ssize_t n = PyList_GET_SIZE(values);
+    int ok = view.itemsize == 4 && view.format != NULL
+             && (strcmp(view.format, "f") == 0 || strcmp(view.format, "<f") == 0 || strcmp(view.format, "=f") == 0)
+             && view.len == 4 * n;
+    float *out = (float *)view.buf;
+    for (Py_ssize_t i = 0; i < n && ok; i++) {
+        PyObject *x = PyList_GET_ITEM(values, i);
+        double v = 0.0;
+        if (PyFloat_Check(x))
+            v = PyFloat_AS_DOUBLE(x);
+        else if (PyLong_Check(x)) {
+            v = PyLong_AsDouble(x);
+            if (v == -1.0 && PyErr_Occurred()) {
+                PyErr_Clear();
+                ok = 0;
+            }
+        } else
+            ok = 0;
+        out[i] = (float)v;
+    }
+    PyBuffer_Release(&view);
+    return Py_NewRef(ok ? Py_True : Py_False);
+}
+
 /* ---- module ----------------------------------------------------------------------------------- */
 
 static PyMethodDef kernel_methods[] = {
@@ -1064,6 +1127,8 @@ static PyMethodDef kernel_methods[] = {
     {"hand_gather", (PyCFunction)(void (*)(void))hand_gather, METH_FASTCALL, "HandController.setpoints, start."},
     {"hand_solve", (PyCFunction)(void (*)(void))hand_solve, METH_FASTCALL, "HandController.setpoints, 3x3 solve."},
     {"hand_finish", (PyCFunction)(void (*)(void))hand_finish, METH_FASTCALL, "HandController.setpoints, end."},
+    {"action_values", (PyCFunction)action_values, METH_O, "VisuomotorEnv._check_action, common case."},
+    {"to_float32", (PyCFunction)(void (*)(void))to_float32, METH_FASTCALL, "np.array(values, dtype=np.float32)."},
     {"retina_see_all", (PyCFunction)(void (*)(void))retina_see_all, METH_FASTCALL,
      "Retina._see_all (see _kernels.c)."},
     {NULL, NULL, 0, NULL},
@@ -1110,6 +1175,9 @@ PyMODINIT_FUNC PyInit__kernels(void)
     INTERN(s_hidden, "hidden")
     INTERN(s_state, "state")
     INTERN(s_last_onset, "last_onset")
+    INTERN(s_standard_normal, "standard_normal")
+    if ((int_six = PyLong_FromLong(6)) == NULL)
+        return NULL;
 #undef INTERN
     return PyModule_Create(&kernel_module);
 }

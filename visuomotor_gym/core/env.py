@@ -27,6 +27,7 @@ import gymnasium as gym
 import mujoco
 import numpy as np
 
+from visuomotor_gym import _native
 from visuomotor_gym.assets import asset_path
 from visuomotor_gym.core import args
 from visuomotor_gym.core.eye import EYE_ACTION_STRUCTURE, EYE_BLOCKS, Eye
@@ -159,6 +160,7 @@ class VisuomotorEnv(gym.Env):
         self._viewer = None
         self._warned_human = False
         self._needs_reset = True  # step() before the first reset() is an error
+        self._native = _native.enabled()  # compiled action check and observation array (_kernels.c)
         self._warned_after_end = False
         self._reset_parts()
 
@@ -274,6 +276,7 @@ class VisuomotorEnv(gym.Env):
 
     def __setstate__(self, state):
         self.__dict__.update(state)
+        self._native = state.get("_native", False) and _native.enabled()  # unpickled without the extension
         if "_warning_total" in state:
             self._warning_stats = [self.data.warning[i] for i in self._bad_warnings]
 
@@ -287,6 +290,10 @@ class VisuomotorEnv(gym.Env):
         """The action as float64, clipped to [-1, 1], and the same values as a list; errors say why not."""
         if type(action) is np.ndarray and action.shape == self.action_space.shape and action.dtype.kind == "f":
             a = action.astype(np.float64)  # the common case: a float array of the right shape
+            if self._native:  # compiled: the values when all are finite and in [-1, 1], else None
+                values = _native.kernels.action_values(a)
+                if values is not None:
+                    return a, values
         else:
             try:
                 a = np.asarray(action)
@@ -341,6 +348,10 @@ class VisuomotorEnv(gym.Env):
         self.head.observe(values, d)
         self.body.observe(values, d)
         self.task.observe_trailing(values, samples, d)
+        if self._native:  # compiled np.array(values, dtype=np.float32) (floats and ints only, else False)
+            obs = np.empty(len(values), dtype=np.float32)
+            if _native.kernels.to_float32(values, obs):
+                return obs
         return np.array(values, dtype=np.float32)
 
     def _format(self, obs: np.ndarray):
