@@ -921,6 +921,37 @@ static int indices(PyObject *tuple, Py_ssize_t *out, Py_ssize_t n, Py_ssize_t bo
 
 #define HAND_MAX_JOINTS 64
 
+/* hand_advance(reference, target, max_speed, dt) -> new reference (an array)
+ *
+ * Mirrors HandController.advance_reference: the reference moved toward ``target`` by at most
+ * ``max_speed * dt``, as a new array (np.array of the three values). */
+static PyObject *hand_advance(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    if (nargs != 4) {
+        PyErr_SetString(PyExc_TypeError, "hand_advance(reference, target, max_speed, dt)");
+        return NULL;
+    }
+    double r[3], t[3];
+    double max_speed = PyFloat_AsDouble(args[2]), dt = PyFloat_AsDouble(args[3]);
+    if (PyErr_Occurred() || array_doubles(args[0], 0, r, 3) < 0 || vec3(args[1], t) < 0)
+        return NULL;
+    double dx = t[0] - r[0], dy = t[1] - r[1], dz = t[2] - r[2];
+    double dist = sqrt(dx * dx + dy * dy + dz * dz);
+    double limit = max_speed * dt;
+    if (dist > limit) {
+        double k = limit / dist;
+        dx = dx * k;
+        dy = dy * k;
+        dz = dz * k;
+    }
+    PyObject *list = Py_BuildValue("[ddd]", r[0] + dx, r[1] + dy, r[2] + dz);
+    if (list == NULL)
+        return NULL;
+    PyObject *out = PyObject_CallOneArg(np_array, list);
+    Py_DECREF(list);
+    return out;
+}
+
 /* hand_gather(jacp, qpos, setpoint, dof_ids, qpos_ids, nominal, weights, posture_gain, jac, jw, posture, x)
  *
  * The element-wise start of HandController.setpoints: ``jac = jacp[:, dof_ids]``,
@@ -1124,6 +1155,7 @@ static PyMethodDef kernel_methods[] = {
      "OculomotorPlant.step unless a saccade starts (see _kernels.c)."},
     {"eye_command", (PyCFunction)(void (*)(void))eye_command, METH_FASTCALL, "Eye.command (see _kernels.c)."},
     {"eye_apply", (PyCFunction)(void (*)(void))eye_apply, METH_FASTCALL, "Eye.apply (see _kernels.c)."},
+    {"hand_advance", (PyCFunction)(void (*)(void))hand_advance, METH_FASTCALL, "HandController.advance_reference."},
     {"hand_gather", (PyCFunction)(void (*)(void))hand_gather, METH_FASTCALL, "HandController.setpoints, start."},
     {"hand_solve", (PyCFunction)(void (*)(void))hand_solve, METH_FASTCALL, "HandController.setpoints, 3x3 solve."},
     {"hand_finish", (PyCFunction)(void (*)(void))hand_finish, METH_FASTCALL, "HandController.setpoints, end."},

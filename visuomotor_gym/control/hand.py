@@ -90,6 +90,9 @@ class HandController:
 
     def advance_reference(self, target, dt: float) -> np.ndarray:
         """Move the reference toward ``target`` (a 3-vector) by at most ``max_speed * dt``; return it."""
+        if self._native:  # this method, compiled (_kernels.c: hand_advance)
+            self.reference = _native.kernels.hand_advance(self.reference, target, self.params.max_speed_m_s, dt)
+            return self.reference
         tx, ty, tz = target.tolist() if isinstance(target, np.ndarray) else target
         rx, ry, rz = self.reference.tolist()
         dx, dy, dz = tx - rx, ty - ry, tz - rz

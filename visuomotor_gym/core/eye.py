@@ -83,7 +83,11 @@ class Eye:
         self._native_constants = (self.gaze_action_range, *self._log_fix, params.vergence_max_diopter_s)
         self._native_ranges = (*self._az_range, *self._el_range)
         self._native_addresses = (self._qpos_az, self._qpos_el, self._fix_qpos, *dofs)
+        self._views = None  # (data, its xmat, xpos, qpos, qvel): views of the data last applied to
         self.reset_state()
+
+    def __getstate__(self) -> dict:
+        return {**self.__dict__, "_views": None}  # views into an MjData: rebuilt after unpickling
 
     def __setstate__(self, state: dict) -> None:
         self.__dict__.update(state)
@@ -148,9 +152,13 @@ class Eye:
         """
         d = data
         if self._native:  # this method, compiled
+            views = self._views
+            if views is None or views[0] is not d:  # MjData's arrays, read once per data object
+                views = self._views = (d, d.xmat, d.xpos, d.qpos, d.qvel)
+            _, xmat, xpos, qpos, qvel = views
             flat, self.pos_list, self.in_head, clamped = _native.kernels.eye_apply(
-                d.xmat, d.xpos, self.head_body, self.plant.gaze, self._offset_list, self._native_ranges, d.qpos,
-                d.qvel, self._native_addresses, self.fixation)
+                xmat, xpos, self.head_body, self.plant.gaze, self._offset_list, self._native_ranges, qpos, qvel,
+                self._native_addresses, self.fixation)
             self.rot_flat = flat
             if clamped:
                 self.plant.constrain(np.array(flat[0::3]))
