@@ -1,13 +1,14 @@
 """The optional compiled kernels (visuomotor_gym/_native) give the pure-Python path's numbers bit for bit.
 
-Each case runs the same episode twice, once with the kernels and once with ``_native.kernels = None``
-(what ``VISUOMOTOR_GYM_PURE_PYTHON=1`` or a missing build gives), and compares the episode digests
+Each case runs the same episode twice, once with the kernels and once without
+(``_native.disabled()``: what ``VISUOMOTOR_GYM_PURE_PYTHON=1`` or a missing build gives), and compares the episode digests
 (observations, rewards, flags, info; tests/golden/digests.py). The golden digests themselves are
 checked on whichever path is active, so running the suite with and without the variable covers both.
 """
 
 from __future__ import annotations
 
+import contextlib
 import os
 import pickle
 import subprocess
@@ -22,18 +23,16 @@ from visuomotor_gym import _native
 needs_kernels = pytest.mark.skipif(not _native.enabled(), reason="compiled kernels not built (pure-Python path)")
 
 
-def _digest(env_id: str, seed: int, agent: str | None, native: bool, monkeypatch, **kwargs) -> str:
+def _digest(env_id: str, seed: int, agent: str | None, native: bool, **kwargs) -> str:
     import gymnasium as gym
 
     import visuomotor_gym  # noqa: F401
 
-    with monkeypatch.context() as m:
-        if not native:
-            m.setattr(_native, "kernels", None)
+    with contextlib.nullcontext() if native else _native.disabled():
         env = gym.make(env_id, **kwargs)  # objects choose their path when built
-        policy = _agent_policy(agent, env_id, env) if agent else _random_policy(env, seed)
-        digest = episode_digest(env, seed, policy)
-        env.close()
+    policy = _agent_policy(agent, env_id, env) if agent else _random_policy(env, seed)
+    digest = episode_digest(env, seed, policy)
+    env.close()
     return digest
 
 
@@ -57,21 +56,19 @@ CASES = [
 
 @needs_kernels
 @pytest.mark.parametrize("env_id,seed,agent,kwargs", CASES, ids=[f"{c[0]}-{c[1]}-{c[2]}" for c in CASES])
-def test_compiled_and_python_paths_give_identical_episodes(env_id, seed, agent, kwargs, monkeypatch):
-    compiled = _digest(env_id, seed, agent, True, monkeypatch, **kwargs)
-    python = _digest(env_id, seed, agent, False, monkeypatch, **kwargs)
+def test_compiled_and_python_paths_give_identical_episodes(env_id, seed, agent, kwargs):
+    compiled = _digest(env_id, seed, agent, True, **kwargs)
+    python = _digest(env_id, seed, agent, False, **kwargs)
     assert compiled == python
 
 
 @needs_kernels
-def test_the_plant_alone_is_identical_on_both_paths(monkeypatch):
+def test_the_plant_alone_is_identical_on_both_paths():
     """Saccades (with endpoint noise), deferred saccades, pursuit of a moving request, array and tuple targets."""
     from visuomotor_gym.oculomotor.plant import OculomotorParams, OculomotorPlant
 
     def run(native: bool):
-        with monkeypatch.context() as m:
-            if not native:
-                m.setattr(_native, "kernels", None)
+        with contextlib.nullcontext() if native else _native.disabled():
             plant = OculomotorPlant(OculomotorParams(saccade_endpoint_noise=0.05))
         assert plant._native == native
         rng = np.random.default_rng(5)

@@ -11,6 +11,7 @@ Objects decide once, at construction, through :func:`enabled`; ``kernels`` is th
 
 from __future__ import annotations
 
+import contextlib
 import os
 
 kernels = None
@@ -26,4 +27,15 @@ def enabled() -> bool:
     return kernels is not None
 
 
-__all__ = ["enabled", "kernels"]
+@contextlib.contextmanager
+def disabled():
+    """Objects built inside this block use the pure-Python path (for comparisons: tests, benchmarks)."""
+    global kernels
+    saved, kernels = kernels, None
+    try:
+        yield
+    finally:
+        kernels = saved
+
+
+__all__ = ["disabled", "enabled", "kernels"]
