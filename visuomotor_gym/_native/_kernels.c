@@ -15,7 +15,7 @@
 static PyObject *math_hypot;  /* math.hypot */
 static PyObject *s_time, *s_suppressed, *s_prev_request, *s_last_sample, *s_drive_queue, *s_drive, *s_goal,
     *s_pursuit_omega, *s_saccade, *s_omega, *s_onset, *s_duration, *s_amplitude, *s_arc, *s_axis, *s_gaze, *s_hidden, *s_state, *s_last_onset;
-static PyObject *np_array; /* numpy.array */
+static PyObject *np_empty, *int_three; /* numpy.empty, 3 */
 static PyObject *s_standard_normal, *int_six;
 
 /* ---- small helpers -------------------------------------------------------------------------- */
@@ -66,7 +66,32 @@ static int array_doubles(PyObject *obj, Py_ssize_t start, double *out, Py_ssize_
     return 0;
 }
 
-static PyObject *tuple3(double x, double y, double z) { return Py_BuildValue("(ddd)", x, y, z); }
+static PyObject *tuple3(double x, double y, double z)
+{
+    PyObject *fx = PyFloat_FromDouble(x), *fy = PyFloat_FromDouble(y), *fz = PyFloat_FromDouble(z);
+    PyObject *out = (fx && fy && fz) ? PyTuple_Pack(3, fx, fy, fz) : NULL;
+    Py_XDECREF(fx);
+    Py_XDECREF(fy);
+    Py_XDECREF(fz);
+    return out;
+}
+
+/* ``np.array([x, y, z])`` (a new float64 array), made as np.empty(3) and filled. */
+static PyObject *array3(double x, double y, double z)
+{
+    PyObject *out = PyObject_CallOneArg(np_empty, int_three);
+    if (out == NULL)
+        return NULL;
+    Py_buffer view;
+    if (f64_buffer(out, &view, 1) < 0) {
+        Py_DECREF(out);
+        return NULL;
+    }
+    double *v = (double *)view.buf;
+    v[0] = x, v[1] = y, v[2] = z;
+    PyBuffer_Release(&view);
+    return out;
+}
 
 static PyObject *list_of(const double *v, Py_ssize_t n)
 {
@@ -479,12 +504,7 @@ static int plant_advance(PyObject *plant, const PlantConsts *cp, PyObject *reque
         || set_attr_double(plant, s_time, t0 + dt) < 0)
         goto done;
     /* self.gaze = np.array([gx, gy, gz]) */
-    PyObject *gaze = Py_BuildValue("[ddd]", gx, gy, gz);
-    if (gaze == NULL)
-        goto done;
-    tmp = PyObject_CallOneArg(np_array, gaze);
-    Py_DECREF(gaze);
-    if (tmp == NULL || PyObject_SetAttr(plant, s_gaze, tmp) < 0)
+    if ((tmp = array3(gx, gy, gz)) == NULL || PyObject_SetAttr(plant, s_gaze, tmp) < 0)
         goto done;
     result = saccading;
 done:
@@ -900,27 +920,6 @@ static void release_all(Buffers *b)
     b->n = 0;
 }
 
-/* n indices from a tuple of ints, each in [0, bound). */
-static int indices(PyObject *tuple, Py_ssize_t *out, Py_ssize_t n, Py_ssize_t bound)
-{
-    if (!PyTuple_Check(tuple) || PyTuple_GET_SIZE(tuple) != n) {
-        PyErr_SetString(PyExc_TypeError, "expected a tuple of indices");
-        return -1;
-    }
-    for (Py_ssize_t i = 0; i < n; i++) {
-        out[i] = PyLong_AsSsize_t(PyTuple_GET_ITEM(tuple, i));
-        if (out[i] == -1 && PyErr_Occurred())
-            return -1;
-        if (out[i] < 0 || out[i] >= bound) {
-            PyErr_SetString(PyExc_IndexError, "index out of range");
-            return -1;
-        }
-    }
-    return 0;
-}
-
-#define HAND_MAX_JOINTS 64
-
 /* hand_advance(reference, target, max_speed, dt) -> new reference (an array)
  *
  * Mirrors HandController.advance_reference: the reference moved toward ``target`` by at most
@@ -944,53 +943,69 @@ static PyObject *hand_advance(PyObject *self, PyObject *const *args, Py_ssize_t 
         dy = dy * k;
         dz = dz * k;
     }
-    PyObject *list = Py_BuildValue("[ddd]", r[0] + dx, r[1] + dy, r[2] + dz);
-    if (list == NULL)
-        return NULL;
-    PyObject *out = PyObject_CallOneArg(np_array, list);
-    Py_DECREF(list);
-    return out;
+    return array3(r[0] + dx, r[1] + dy, r[2] + dz);
 }
 
-/* hand_gather(jacp, qpos, setpoint, dof_ids, qpos_ids, nominal, weights, posture_gain, jac, jw, posture, x)
+/* The controller's joint indices, packed by HandController._native_indices (float64):
+ * [n, dof ids (n), qpos ids (n)]. The arrays a body may replace (nominal, weights, limits) are
+ * arguments. */
+typedef struct {
+    Py_ssize_t n;
+    const double *dof, *qid;
+} HandConsts;
+
+static int hand_consts(PyObject *packed, HandConsts *c)
+{
+    Py_ssize_t size = PyBytes_Check(packed) ? PyBytes_GET_SIZE(packed) / 8 : 0;
+    const double *v = size ? (const double *)PyBytes_AS_STRING(packed) : NULL;
+    c->n = v ? (Py_ssize_t)v[0] : 0;
+    if (c->n < 1 || size != 1 + 2 * c->n) {
+        PyErr_SetString(PyExc_TypeError, "hand indices: expected the packed bytes");
+        return -1;
+    }
+    c->dof = v + 1, c->qid = v + 1 + c->n;
+    return 0;
+}
+
+/* hand_gather(indices, jacp, qpos, setpoint, nominal, weights, posture_gain, jac, jw, posture, x)
  *
  * The element-wise start of HandController.setpoints: ``jac = jacp[:, dof_ids]``,
  * ``posture = posture_gain * (nominal - setpoint)``, ``x = setpoint - qpos[qpos_ids] + posture``
  * (what jac.dot takes) and ``jw = jac * weights`` (per column). */
 static PyObject *hand_gather(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
-    if (nargs != 12) {
-        PyErr_SetString(PyExc_TypeError, "hand_gather takes 12 arguments");
+    HandConsts c;
+    if (nargs != 11) {
+        PyErr_SetString(PyExc_TypeError, "hand_gather(indices, jacp, qpos, setpoint, nominal, weights, posture_gain, "
+                                         "jac, jw, posture, x)");
         return NULL;
     }
-    Py_ssize_t n = PyTuple_Check(args[3]) ? PyTuple_GET_SIZE(args[3]) : -1;
-    double gain = PyFloat_AsDouble(args[7]);
-    if (gain == -1.0 && PyErr_Occurred())
+    double gain = PyFloat_AsDouble(args[6]);
+    if ((gain == -1.0 && PyErr_Occurred()) || hand_consts(args[0], &c) < 0)
         return NULL;
-    if (n < 1 || n > HAND_MAX_JOINTS) {
-        PyErr_SetString(PyExc_ValueError, "hand_gather: bad number of joints");
-        return NULL;
-    }
+    Py_ssize_t n = c.n;
     Buffers b = {.n = 0};
-    Py_ssize_t dof[HAND_MAX_JOINTS], qid[HAND_MAX_JOINTS];
-    double *jacp = buf(&b, args[0], 0, 3), *q = jacp ? buf(&b, args[1], 0, 1) : NULL;
-    double *sp = q ? buf(&b, args[2], 0, n) : NULL;
-    if (sp == NULL)
+    double *jacp = buf(&b, args[1], 0, 3), *q = jacp ? buf(&b, args[2], 0, 1) : NULL;
+    double *sp = q ? buf(&b, args[3], 0, n) : NULL, *nominal = sp ? buf(&b, args[4], 0, n) : NULL;
+    double *w = nominal ? buf(&b, args[5], 0, n) : NULL, *jac = w ? buf(&b, args[7], 1, 3 * n) : NULL;
+    double *jw = jac ? buf(&b, args[8], 1, 3 * n) : NULL, *posture = jw ? buf(&b, args[9], 1, n) : NULL;
+    double *x = posture ? buf(&b, args[10], 1, n) : NULL;
+    if (x == NULL)
         goto fail;
     Py_ssize_t nv = b.view[0].len / 8 / 3, nq = b.view[1].len / 8;
-    double *nominal = buf(&b, args[5], 0, n), *w = nominal ? buf(&b, args[6], 0, n) : NULL;
-    double *jac = w ? buf(&b, args[8], 1, 3 * n) : NULL, *jw = jac ? buf(&b, args[9], 1, 3 * n) : NULL;
-    double *posture = jw ? buf(&b, args[10], 1, n) : NULL, *x = posture ? buf(&b, args[11], 1, n) : NULL;
-    if (x == NULL || indices(args[3], dof, n, nv) < 0 || indices(args[4], qid, n, nq) < 0)
-        goto fail;
+    for (Py_ssize_t k = 0; k < n; k++)
+        if (!(c.dof[k] >= 0 && c.dof[k] < nv && c.qid[k] >= 0 && c.qid[k] < nq)) {
+            PyErr_SetString(PyExc_IndexError, "hand_gather: index out of range");
+            goto fail;
+        }
     for (Py_ssize_t r = 0; r < 3; r++)
         for (Py_ssize_t k = 0; k < n; k++) {
-            jac[r * n + k] = jacp[r * nv + dof[k]];
+            jac[r * n + k] = jacp[r * nv + (Py_ssize_t)c.dof[k]];
             jw[r * n + k] = jac[r * n + k] * w[k];
         }
     for (Py_ssize_t k = 0; k < n; k++) {
         posture[k] = gain * (nominal[k] - sp[k]);
-        x[k] = sp[k] - q[qid[k]] + posture[k];
+        x[k] = sp[k] - q[(Py_ssize_t)c.qid[k]] + posture[k];
     }
     release_all(&b);
     Py_RETURN_NONE;
@@ -1077,7 +1092,7 @@ static PyObject *hand_finish(PyObject *self, PyObject *const *args, Py_ssize_t n
     }
     for (Py_ssize_t k = 0; k < n; k++) {
         double v = dq[k] + sp[k];
-        v = (v >= lo[k] || isnan(v)) ? v : lo[k]; /* np.maximum */
+        v = (v >= lo[k] || isnan(v)) ? v : lo[k];     /* np.maximum */
         dq[k] = (v <= hi[k] || isnan(v)) ? v : hi[k]; /* np.minimum */
     }
     release_all(&b);
@@ -1088,6 +1103,15 @@ fail:
 }
 
 /* ---- the step skeleton (visuomotor_gym/core/env.py) ------------------------------------------------ */
+
+/* vector3(values) -> np.array(values) for a list or tuple of three floats (a new float64 array). */
+static PyObject *vector3(PyObject *self, PyObject *arg)
+{
+    double v[3];
+    if (seq_doubles(arg, v, 3) < 0)
+        return NULL;
+    return array3(v[0], v[1], v[2]);
+}
 
 /* action_values(a) -> list or None
  *
@@ -1159,6 +1183,7 @@ static PyMethodDef kernel_methods[] = {
     {"hand_gather", (PyCFunction)(void (*)(void))hand_gather, METH_FASTCALL, "HandController.setpoints, start."},
     {"hand_solve", (PyCFunction)(void (*)(void))hand_solve, METH_FASTCALL, "HandController.setpoints, 3x3 solve."},
     {"hand_finish", (PyCFunction)(void (*)(void))hand_finish, METH_FASTCALL, "HandController.setpoints, end."},
+    {"vector3", (PyCFunction)vector3, METH_O, "np.array of three floats."},
     {"action_values", (PyCFunction)action_values, METH_O, "VisuomotorEnv._check_action, common case."},
     {"to_float32", (PyCFunction)(void (*)(void))to_float32, METH_FASTCALL, "np.array(values, dtype=np.float32)."},
     {"retina_see_all", (PyCFunction)(void (*)(void))retina_see_all, METH_FASTCALL,
@@ -1181,9 +1206,9 @@ PyMODINIT_FUNC PyInit__kernels(void)
     PyObject *numpy = PyImport_ImportModule("numpy");
     if (numpy == NULL)
         return NULL;
-    np_array = PyObject_GetAttrString(numpy, "array");
+    np_empty = PyObject_GetAttrString(numpy, "empty");
     Py_DECREF(numpy);
-    if (np_array == NULL)
+    if (np_empty == NULL || (int_three = PyLong_FromLong(3)) == NULL)
         return NULL;
 #define INTERN(var, name)                                                                                             \
     if ((var = PyUnicode_InternFromString(name)) == NULL)                                                             \

@@ -77,7 +77,8 @@ class HandController:
         # the arrays they fill; the matrix products stay numpy's.
         self._native = _native.enabled()
         n = len(joint_ranges)
-        self._native_ids = (tuple(np.arange(model.nv)[dof_ids].tolist()), tuple(np.arange(model.nq)[qpos_ids].tolist()))
+        self._native_indices = np.concatenate(  # the order of _kernels.c's HandConsts
+            [[n], np.arange(model.nv)[dof_ids], np.arange(model.nq)[qpos_ids]]).astype(np.float64).tobytes()
         self._native_work = (np.empty((3, n)), np.empty((3, n)), np.empty(n), np.empty(n), np.empty(3))
 
     def __setstate__(self, state: dict) -> None:
@@ -144,9 +145,9 @@ class HandController:
         k = _native.kernels
         p = self.params
         jac, jw, posture, x, y = self._native_work
-        k.hand_gather(self._jacp, data.qpos, setpoint, *self._native_ids, self.nominal, self.weights, p.posture_gain,
+        k.hand_gather(self._native_indices, self._jacp, data.qpos, setpoint, self.nominal, self.weights, p.posture_gain,
                       jac, jw, posture, x)
         k.hand_solve(jw.dot(jw.T), jac.dot(x), self.reference, data.site_xpos, self.site_id, self._damping2, y)
-        dq = np.empty(len(self.weights))
+        dq = np.empty(len(posture))
         k.hand_finish(y.dot(jw), self.weights, posture, setpoint, p.max_joint_step_rad, self.lower, self.upper, dq)
         return dq

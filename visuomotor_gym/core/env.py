@@ -370,7 +370,7 @@ class VisuomotorEnv(gym.Env):
             "saccade_onset": False,
             "time": float(d.time),
             "gaze_dir": plant.gaze.copy(),
-            "eye_pos": np.array(self.eye.pos_list),
+            "eye_pos": _native.kernels.vector3(self.eye.pos_list) if self._native else np.array(self.eye.pos_list),
         }
         info.update(self.head.info(d))
         info.update(self.body.info(d))
