@@ -15,7 +15,7 @@
 static PyObject *math_hypot;  /* math.hypot */
 static PyObject *s_time, *s_suppressed, *s_prev_request, *s_last_sample, *s_drive_queue, *s_drive, *s_goal,
     *s_pursuit_omega, *s_saccade, *s_omega, *s_onset, *s_duration, *s_amplitude, *s_arc, *s_axis, *s_gaze, *s_hidden, *s_state, *s_last_onset;
-static PyObject *np_empty, *int_three; /* numpy.empty, 3 */
+static PyObject *np_empty, *np_ndarray, *int_three; /* numpy.empty, numpy.ndarray, 3 */
 static PyObject *s_standard_normal, *int_six;
 
 /* ---- small helpers -------------------------------------------------------------------------- */
@@ -232,6 +232,7 @@ typedef struct {
     double drive[3];
     double goal[3];
     int goal_zero; /* ``goal is _ZERO`` */
+    int changed;   /* _pursuit_goal set a new drive and goal (else the plant keeps its objects) */
 } Pursuit;
 
 /* OculomotorPlant._pursuit_goal(t) */
@@ -256,6 +257,7 @@ static int pursuit_goal(const PlantConsts *c, PyObject *queue, Pursuit *ps, doub
         if (PyList_SetSlice(queue, 0, 1, NULL) < 0) /* queue.pop(0) */
             return -1;
     }
+    ps->changed = 1;
     double wx = ps->drive[0], wy = ps->drive[1], wz = ps->drive[2];
     double speed = sqrt(wx * wx + wy * wy + wz * wz);
     if (speed < 1e-12) {
@@ -384,6 +386,7 @@ static int plant_advance(PyObject *plant, const PlantConsts *cp, PyObject *reque
     if ((goal_obj = PyObject_GetAttr(plant, s_goal)) == NULL || seq_doubles(goal_obj, ps.goal, 3) < 0)
         goto done;
     ps.goal_zero = goal_obj == zero;
+    ps.changed = 0;
     if ((tmp = PyObject_GetAttr(plant, s_pursuit_omega)) == NULL || seq_doubles(tmp, v, 3) < 0)
         goto done;
     Py_CLEAR(tmp);
@@ -486,17 +489,18 @@ static int plant_advance(PyObject *plant, const PlantConsts *cp, PyObject *reque
     Py_DECREF(omega);
     if (rc < 0)
         goto done;
-    /* the drive and goal _pursuit_goal left (unchanged objects when it did not run) */
-    if ((tmp = tuple3(ps.drive[0], ps.drive[1], ps.drive[2])) == NULL || PyObject_SetAttr(plant, s_drive, tmp) < 0)
-        goto done;
-    Py_CLEAR(tmp);
-    if (ps.goal_zero)
-        tmp = Py_NewRef(zero);
-    else
-        tmp = tuple3(ps.goal[0], ps.goal[1], ps.goal[2]);
-    if (tmp == NULL || PyObject_SetAttr(plant, s_goal, tmp) < 0)
-        goto done;
-    Py_CLEAR(tmp);
+    if (ps.changed) { /* the drive and goal _pursuit_goal left */
+        if ((tmp = tuple3(ps.drive[0], ps.drive[1], ps.drive[2])) == NULL || PyObject_SetAttr(plant, s_drive, tmp) < 0)
+            goto done;
+        Py_CLEAR(tmp);
+        if (ps.goal_zero)
+            tmp = Py_NewRef(zero);
+        else
+            tmp = tuple3(ps.goal[0], ps.goal[1], ps.goal[2]);
+        if (tmp == NULL || PyObject_SetAttr(plant, s_goal, tmp) < 0)
+            goto done;
+        Py_CLEAR(tmp);
+    }
     if ((tmp = tuple3(vx, vy, vz)) == NULL || PyObject_SetAttr(plant, s_pursuit_omega, tmp) < 0)
         goto done;
     Py_CLEAR(tmp);
@@ -1113,24 +1117,57 @@ static PyObject *vector3(PyObject *self, PyObject *arg)
     return array3(v[0], v[1], v[2]);
 }
 
-/* action_values(a) -> list or None
+/* check_action(action, n) -> (a, values) or None
  *
- * The common case of VisuomotorEnv._check_action after ``a = action.astype(np.float64)``:
- * ``a.tolist()`` when every value is finite and in [-1, 1]; None otherwise (the Python then raises
- * or clips). */
-static PyObject *action_values(PyObject *self, PyObject *arg)
+ * The common case of VisuomotorEnv._check_action: a float32 or float64 numpy array of shape (n,)
+ * whose values are all finite and in [-1, 1] gives ``a = action.astype(np.float64)`` (a new
+ * array; float32 -> float64 is exact) and ``a.tolist()``. Anything else gives None: the Python
+ * method then checks, raises or clips. */
+static PyObject *check_action(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
-    Py_buffer view;
-    if (f64_buffer(arg, &view, 0) < 0)
+    if (nargs != 2) {
+        PyErr_SetString(PyExc_TypeError, "check_action(action, n)");
         return NULL;
-    Py_ssize_t n = view.len / 8;
-    const double *v = (const double *)view.buf;
-    int fine = 1;
-    for (Py_ssize_t i = 0; i < n && fine; i++)
+    }
+    Py_ssize_t n = PyLong_AsSsize_t(args[1]);
+    if (n == -1 && PyErr_Occurred())
+        return NULL;
+    if (Py_TYPE(args[0]) != (PyTypeObject *)np_ndarray || n < 1 || n > 64)
+        Py_RETURN_NONE;
+    Py_buffer view;
+    if (PyObject_GetBuffer(args[0], &view, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) {
+        PyErr_Clear();
+        Py_RETURN_NONE;
+    }
+    double v[64];
+    const char *f = view.format ? view.format : "";
+    int is_f32 = strcmp(f, "f") == 0 || strcmp(f, "<f") == 0 || strcmp(f, "=f") == 0;
+    int is_f64 = strcmp(f, "d") == 0 || strcmp(f, "<d") == 0 || strcmp(f, "=d") == 0;
+    int fine = view.ndim == 1 && view.shape != NULL && view.shape[0] == n && (is_f32 || is_f64);
+    for (Py_ssize_t i = 0; i < n && fine; i++) {
+        v[i] = is_f32 ? (double)((const float *)view.buf)[i] : ((const double *)view.buf)[i];
         fine = isfinite(v[i]) && v[i] >= -1.0 && v[i] <= 1.0;
-    PyObject *out = fine ? list_of(v, n) : Py_NewRef(Py_None);
+    }
     PyBuffer_Release(&view);
-    return out;
+    if (!fine)
+        Py_RETURN_NONE;
+    PyObject *len = PyLong_FromSsize_t(n), *a = len ? PyObject_CallOneArg(np_empty, len) : NULL;
+    Py_XDECREF(len);
+    if (a == NULL)
+        return NULL;
+    Py_buffer out;
+    if (f64_buffer(a, &out, 1) < 0) {
+        Py_DECREF(a);
+        return NULL;
+    }
+    memcpy(out.buf, v, (size_t)n * sizeof(double));
+    PyBuffer_Release(&out);
+    PyObject *values = list_of(v, n);
+    if (values == NULL) {
+        Py_DECREF(a);
+        return NULL;
+    }
+    return Py_BuildValue("(NN)", a, values);
 }
 
 /* to_float32(values, out) -> bool
@@ -1184,7 +1221,8 @@ static PyMethodDef kernel_methods[] = {
     {"hand_solve", (PyCFunction)(void (*)(void))hand_solve, METH_FASTCALL, "HandController.setpoints, 3x3 solve."},
     {"hand_finish", (PyCFunction)(void (*)(void))hand_finish, METH_FASTCALL, "HandController.setpoints, end."},
     {"vector3", (PyCFunction)vector3, METH_O, "np.array of three floats."},
-    {"action_values", (PyCFunction)action_values, METH_O, "VisuomotorEnv._check_action, common case."},
+    {"check_action", (PyCFunction)(void (*)(void))check_action, METH_FASTCALL,
+     "VisuomotorEnv._check_action, common case."},
     {"to_float32", (PyCFunction)(void (*)(void))to_float32, METH_FASTCALL, "np.array(values, dtype=np.float32)."},
     {"retina_see_all", (PyCFunction)(void (*)(void))retina_see_all, METH_FASTCALL,
      "Retina._see_all (see _kernels.c)."},
@@ -1207,7 +1245,10 @@ PyMODINIT_FUNC PyInit__kernels(void)
     if (numpy == NULL)
         return NULL;
     np_empty = PyObject_GetAttrString(numpy, "empty");
+    np_ndarray = PyObject_GetAttrString(numpy, "ndarray");
     Py_DECREF(numpy);
+    if (np_ndarray == NULL)
+        return NULL;
     if (np_empty == NULL || (int_three = PyLong_FromLong(3)) == NULL)
         return NULL;
 #define INTERN(var, name)                                                                                             \

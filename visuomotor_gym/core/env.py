@@ -148,6 +148,7 @@ class VisuomotorEnv(gym.Env):
         self.action_structure = {**body.action_structure, **EYE_ACTION_STRUCTURE, **HEAD_ACTION_STRUCTURE}
         self._n_body_act = body.n_action
         self.action_space = gym.spaces.Box(-1.0, 1.0, shape=(sum(self.action_structure.values()),), dtype=np.float32)
+        self._n_action = self.action_space.shape[0]
         self.layout = ObservationLayout(
             tuple(task.leading_blocks) + EYE_BLOCKS + HEAD_BLOCKS + tuple(body.observation_blocks)
             + tuple(task.trailing_blocks)
@@ -288,12 +289,12 @@ class VisuomotorEnv(gym.Env):
 
     def _check_action(self, action) -> tuple[np.ndarray, list]:
         """The action as float64, clipped to [-1, 1], and the same values as a list; errors say why not."""
+        if self._native:  # compiled: a float32/64 array of the right shape, finite, in [-1, 1]; else None
+            checked = _native.kernels.check_action(action, self._n_action)
+            if checked is not None:
+                return checked
         if type(action) is np.ndarray and action.shape == self.action_space.shape and action.dtype.kind == "f":
             a = action.astype(np.float64)  # the common case: a float array of the right shape
-            if self._native:  # compiled: the values when all are finite and in [-1, 1], else None
-                values = _native.kernels.action_values(a)
-                if values is not None:
-                    return a, values
         else:
             try:
                 a = np.asarray(action)
@@ -324,7 +325,7 @@ class VisuomotorEnv(gym.Env):
         t_expected = d.time + self.dt
         task = self.task
         if not task.needs_substep_checks(d):
-            mujoco.mj_step(m, d, nstep=self.n_substeps)
+            mujoco.mj_step(m, d, self.n_substeps)  # nstep (positional: cheaper to pass)
         else:  # the task's event (a catch) may happen within this step: check every substep
             for _ in range(self.n_substeps):
                 mujoco.mj_step(m, d)
