@@ -15,7 +15,7 @@
 static PyObject *math_hypot;  /* math.hypot */
 static PyObject *s_time, *s_suppressed, *s_prev_request, *s_last_sample, *s_drive_queue, *s_drive, *s_goal,
     *s_pursuit_omega, *s_saccade, *s_omega, *s_onset, *s_duration, *s_amplitude, *s_arc, *s_axis, *s_gaze, *s_hidden, *s_state, *s_last_onset;
-static PyObject *np_empty, *np_ndarray, *int_three; /* numpy.empty, numpy.ndarray, 3 */
+static PyObject *np_empty, *np_ndarray, *np_float32, *int_three; /* numpy.empty, .ndarray, .float32, 3 */
 static PyObject *s_standard_normal, *int_six;
 
 /* ---- small helpers -------------------------------------------------------------------------- */
@@ -380,9 +380,7 @@ static int plant_advance(PyObject *plant, const PlantConsts *cp, PyObject *reque
     if (sample_target_motion(plant, &c, queue, request, req, dt, suppressed, t0) < 0)
         goto done;
 
-    if ((tmp = PyObject_GetAttr(plant, s_drive)) == NULL || seq_doubles(tmp, ps.drive, 3) < 0)
-        goto done;
-    Py_CLEAR(tmp);
+    ps.drive[0] = ps.drive[1] = ps.drive[2] = 0.0; /* _pursuit_goal sets it before any use */
     if ((goal_obj = PyObject_GetAttr(plant, s_goal)) == NULL || seq_doubles(goal_obj, ps.goal, 3) < 0)
         goto done;
     ps.goal_zero = goal_obj == zero;
@@ -1170,22 +1168,31 @@ static PyObject *check_action(PyObject *self, PyObject *const *args, Py_ssize_t 
     return Py_BuildValue("(NN)", a, values);
 }
 
-/* to_float32(values, out) -> bool
+/* float32_array(values) -> array or None
  *
- * ``np.array(values, dtype=np.float32)`` of VisuomotorEnv._observe, into ``out`` (an empty float32
- * array of the list's length): each value as a double, rounded to float32 as numpy casts. Only
- * floats and ints (bools) are taken; anything else returns False (the Python builds the array). */
-static PyObject *to_float32(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+ * ``np.array(values, dtype=np.float32)`` of VisuomotorEnv._observe: each value as a double,
+ * rounded to float32 as numpy casts. Only floats and ints (bools) are taken; anything else gives
+ * None (the Python builds the array). */
+static PyObject *float32_array(PyObject *self, PyObject *values)
 {
-    if (nargs != 2 || !PyList_Check(args[0])) {
-        PyErr_SetString(PyExc_TypeError, "to_float32(values: list, out)");
+    if (!PyList_Check(values)) {
+        PyErr_SetString(PyExc_TypeError, "float32_array(values: list)");
         return NULL;
     }
-    Py_buffer view;
-    if (PyObject_GetBuffer(args[1], &view, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | PyBUF_WRITABLE) < 0)
-        return NULL;
-    PyObject *values = args[0];
     Py_ssize_t n = PyList_GET_SIZE(values);
+    PyObject *len = PyLong_FromSsize_t(n);
+    if (len == NULL)
+        return NULL;
+    PyObject *call[2] = {len, np_float32};
+    PyObject *array = PyObject_Vectorcall(np_empty, call, 2, NULL); /* np.empty(n, np.float32) */
+    Py_DECREF(len);
+    if (array == NULL)
+        return NULL;
+    Py_buffer view;
+    if (PyObject_GetBuffer(array, &view, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | PyBUF_WRITABLE) < 0) {
+        Py_DECREF(array);
+        return NULL;
+    }
     int ok = view.itemsize == 4 && view.format != NULL
              && (strcmp(view.format, "f") == 0 || strcmp(view.format, "<f") == 0 || strcmp(view.format, "=f") == 0)
              && view.len == 4 * n;
@@ -1206,7 +1213,10 @@ static PyObject *to_float32(PyObject *self, PyObject *const *args, Py_ssize_t na
         out[i] = (float)v;
     }
     PyBuffer_Release(&view);
-    return Py_NewRef(ok ? Py_True : Py_False);
+    if (ok)
+        return array;
+    Py_DECREF(array);
+    Py_RETURN_NONE;
 }
 
 /* ---- module ----------------------------------------------------------------------------------- */
@@ -1223,7 +1233,7 @@ static PyMethodDef kernel_methods[] = {
     {"vector3", (PyCFunction)vector3, METH_O, "np.array of three floats."},
     {"check_action", (PyCFunction)(void (*)(void))check_action, METH_FASTCALL,
      "VisuomotorEnv._check_action, common case."},
-    {"to_float32", (PyCFunction)(void (*)(void))to_float32, METH_FASTCALL, "np.array(values, dtype=np.float32)."},
+    {"float32_array", (PyCFunction)float32_array, METH_O, "np.array(values, dtype=np.float32)."},
     {"retina_see_all", (PyCFunction)(void (*)(void))retina_see_all, METH_FASTCALL,
      "Retina._see_all (see _kernels.c)."},
     {NULL, NULL, 0, NULL},
@@ -1246,8 +1256,9 @@ PyMODINIT_FUNC PyInit__kernels(void)
         return NULL;
     np_empty = PyObject_GetAttrString(numpy, "empty");
     np_ndarray = PyObject_GetAttrString(numpy, "ndarray");
+    np_float32 = PyObject_GetAttrString(numpy, "float32");
     Py_DECREF(numpy);
-    if (np_ndarray == NULL)
+    if (np_ndarray == NULL || np_float32 == NULL)
         return NULL;
     if (np_empty == NULL || (int_three = PyLong_FromLong(3)) == NULL)
         return NULL;

@@ -349,9 +349,9 @@ class VisuomotorEnv(gym.Env):
         self.head.observe(values, d)
         self.body.observe(values, d)
         self.task.observe_trailing(values, samples, d)
-        if self._native:  # compiled np.array(values, dtype=np.float32) (floats and ints only, else False)
-            obs = np.empty(len(values), dtype=np.float32)
-            if _native.kernels.to_float32(values, obs):
+        if self._native:  # compiled np.array(values, dtype=np.float32) (floats and ints only, else None)
+            obs = _native.kernels.float32_array(values)
+            if obs is not None:
                 return obs
         return np.array(values, dtype=np.float32)
 
