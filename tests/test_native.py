@@ -16,8 +16,8 @@ import sys
 
 import numpy as np
 import pytest
-
 from golden.digests import _agent_policy, _random_policy, episode_digest
+
 from visuomotor_gym import _native
 
 needs_kernels = pytest.mark.skipif(not _native.enabled(), reason="compiled kernels not built (pure-Python path)")
