@@ -234,7 +234,8 @@ class OculomotorPlant:
         p = self.params
         self._native_constants = np.array(
             [p.saccade_threshold_deg * DEG, p.pursuit_latency_s, p.pursuit_accel_max_deg_s2 * DEG,
-             p.pursuit_max_deg_s, DEG, p.saccade_refractory_s, len(p.pursuit_gain_points), *(x for q in p.pursuit_gain_points for x in q)],
+             p.pursuit_max_deg_s, DEG, p.saccade_refractory_s, len(p.pursuit_gain_points),
+             *(x for q in p.pursuit_gain_points for x in q)],
             dtype=np.float64,
         ).tobytes()
         self.reset(np.array([1.0, 0.0, 0.0]), time=0.0)
