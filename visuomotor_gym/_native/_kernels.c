@@ -13,10 +13,12 @@
 #include <string.h>
 
 static PyObject *math_hypot;  /* math.hypot */
+/* attribute names, interned once */
 static PyObject *s_time, *s_suppressed, *s_prev_request, *s_last_sample, *s_drive_queue, *s_drive, *s_goal,
-    *s_pursuit_omega, *s_saccade, *s_omega, *s_onset, *s_duration, *s_amplitude, *s_arc, *s_axis, *s_gaze, *s_hidden, *s_state, *s_last_onset;
+    *s_pursuit_omega, *s_saccade, *s_omega, *s_onset, *s_duration, *s_amplitude, *s_arc, *s_axis, *s_gaze,
+    *s_hidden, *s_state, *s_last_onset, *s_standard_normal;
 static PyObject *np_empty, *np_ndarray, *np_float32, *int_three; /* numpy.empty, .ndarray, .float32, 3 */
-static PyObject *s_standard_normal, *int_six;
+static PyObject *int_six;
 
 /* ---- small helpers -------------------------------------------------------------------------- */
 
