@@ -105,3 +105,14 @@ def test_the_environment_variable_forces_pure_python():
     env = {**os.environ, "VISUOMOTOR_GYM_PURE_PYTHON": "1"}
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"
+
+
+def test_one_normal_draw_of_6k_is_k_draws_of_6():
+    """retina_see_all draws the noise of the k seen targets in one rng.standard_normal(6 k); the Python
+    draws standard_normal(6) per target. numpy's Generator gives the same stream either way."""
+    for seed in range(50):
+        a, b = np.random.default_rng(seed), np.random.default_rng(seed)
+        k = 1 + seed % 17
+        one = b.standard_normal(6 * k)
+        assert np.concatenate([a.standard_normal(6) for _ in range(k)]).tobytes() == one.tobytes()
+        assert a.standard_normal() == b.standard_normal()  # and the streams stay in step

@@ -18,7 +18,7 @@ static PyObject *s_time, *s_suppressed, *s_prev_request, *s_last_sample, *s_driv
     *s_pursuit_omega, *s_saccade, *s_omega, *s_onset, *s_duration, *s_amplitude, *s_arc, *s_axis, *s_gaze,
     *s_hidden, *s_state, *s_last_onset, *s_standard_normal;
 static PyObject *np_empty, *np_ndarray, *np_float32, *int_three; /* numpy.empty, .ndarray, .float32, 3 */
-static PyObject *int_six;
+
 
 /* ---- small helpers -------------------------------------------------------------------------- */
 
@@ -784,32 +784,46 @@ static void los_rows(double ux, double uy, double uz, double *r)
     r[6] = uz, r[7] = -f * uy * uz, r[8] = 1.0 - f * uz * uz;
 }
 
-/* foveation.perceive (with _draw_at): one look at a point of the eye frame. */
-static PyObject *perceive(const VisionConsts *c, const double *pe, const double *ve, double speed, PyObject *rng)
+/* One target's look, between foveation.perceive's checks and _draw_at's noise. */
+typedef struct {
+    int kind; /* 0: not seen (nothing()), 1: at the eye's centre (the true state), 2: seen, noise to draw */
+    double p[3], v[3], s[6], r[9];
+} Look;
+
+/* foveation.perceive up to the draw: the field-of-view check, then _sigmas and _los_rows. */
+static void perceive_prepare(const VisionConsts *c, const double *pe, const double *ve, double speed, Look *lk)
 {
     double x = pe[0], y = pe[1], z = pe[2];
+    memcpy(lk->p, pe, sizeof(lk->p));
+    memcpy(lk->v, ve, sizeof(lk->v));
     double d = sqrt(x * x + y * y + z * z);
-    if (d <= 0.0)
-        return Py_BuildValue("([ddd][ddd]O)", x, y, z, ve[0], ve[1], ve[2], Py_True);
+    if (d <= 0.0) {
+        lk->kind = 1;
+        return;
+    }
     double ecc = acos(py_max(-1.0, py_min(1.0, x / d)));
-    if (c->foveated && ecc > c->fov)
+    if (c->foveated && ecc > c->fov) {
+        lk->kind = 0;
+        return;
+    }
+    lk->kind = 2;
+    sigmas(c, d, ecc, speed, lk->s);
+    los_rows(x / d, y / d, z / d, lk->r);
+}
+
+/* The sample of a look (foveation._draw_at with the six standard normals ``e``). */
+static PyObject *look_sample(const Look *lk, const double *e)
+{
+    if (lk->kind == 0)
         return nothing();
-    double s[6], e[6], r[9];
-    sigmas(c, d, ecc, speed, s);
-    PyObject *call[2] = {rng, int_six};
-    PyObject *draw = PyObject_VectorcallMethod(s_standard_normal, call, 2 | PY_VECTORCALL_ARGUMENTS_OFFSET, NULL);
-    if (draw == NULL)
-        return NULL;
-    int rc = array_doubles(draw, 0, e, 6);
-    Py_DECREF(draw);
-    if (rc < 0)
-        return NULL;
+    if (lk->kind == 1)
+        return Py_BuildValue("([ddd][ddd]O)", lk->p[0], lk->p[1], lk->p[2], lk->v[0], lk->v[1], lk->v[2], Py_True);
+    const double *s = lk->s, *r = lk->r, *p = lk->p, *v = lk->v;
     double n0 = s[0] * e[0], n1 = s[1] * e[1], n2 = s[2] * e[2], n3 = s[3] * e[3], n4 = s[4] * e[4], n5 = s[5] * e[5];
-    los_rows(x / d, y / d, z / d, r);
     return Py_BuildValue("([ddd][ddd]O)",
-                         x + r[0] * n0 + r[1] * n1 + r[2] * n2, y + r[3] * n0 + r[4] * n1 + r[5] * n2,
-                         z + r[6] * n0 + r[7] * n1 + r[8] * n2, ve[0] + r[0] * n3 + r[1] * n4 + r[2] * n5,
-                         ve[1] + r[3] * n3 + r[4] * n4 + r[5] * n5, ve[2] + r[6] * n3 + r[7] * n4 + r[8] * n5,
+                         p[0] + r[0] * n0 + r[1] * n1 + r[2] * n2, p[1] + r[3] * n0 + r[4] * n1 + r[5] * n2,
+                         p[2] + r[6] * n0 + r[7] * n1 + r[8] * n2, v[0] + r[0] * n3 + r[1] * n4 + r[2] * n5,
+                         v[1] + r[3] * n3 + r[4] * n4 + r[5] * n5, v[2] + r[6] * n3 + r[7] * n4 + r[8] * n5,
                          Py_True);
 }
 
@@ -817,8 +831,10 @@ static PyObject *perceive(const VisionConsts *c, const double *pe, const double 
  *
  * Mirrors Retina._see_all: for each target, nothing() when hidden or outside the field of view,
  * else its position and velocity in the eye frame, the retinal slip (Eye.retinal_speed) and one
- * noisy look (foveation.perceive), drawing rng.standard_normal(6) as the Python does.
- * ``eye`` = pos_list + prev_pos + prev_gaze + rot_flat (18 floats). */
+ * noisy look (foveation.perceive). The Python draws rng.standard_normal(6) per seen target, in
+ * target order; this draws the same numbers in one rng.standard_normal(6 k) for the k seen targets
+ * (numpy's Generator fills an array one normal after the other: the same stream, checked by
+ * tests/test_native.py). ``eye`` = pos_list + prev_pos + prev_gaze + rot_flat (18 floats). */
 static PyObject *retina_see_all(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
     if (nargs != 6) {
@@ -842,12 +858,17 @@ static PyObject *retina_see_all(PyObject *self, PyObject *const *args, Py_ssize_
     PyObject *seq = PySequence_Fast(targets, "targets must be a sequence");
     if (seq == NULL)
         return NULL;
-    Py_ssize_t n = PySequence_Fast_GET_SIZE(seq);
-    PyObject *out = PyList_New(n);
-    if (out == NULL)
+    Py_ssize_t n = PySequence_Fast_GET_SIZE(seq), seen = 0;
+    PyObject *out = NULL, *draw = NULL;
+    Look *looks = PyMem_Malloc((size_t)(n > 0 ? n : 1) * sizeof(Look));
+    if (looks == NULL) {
+        PyErr_NoMemory();
         goto fail;
-    for (Py_ssize_t i = 0; i < n; i++) {
-        PyObject *target = PySequence_Fast_GET_ITEM(seq, i), *sample = NULL;
+    }
+    for (Py_ssize_t i = 0; i < n; i++) { /* every target up to its noise draw */
+        PyObject *target = PySequence_Fast_GET_ITEM(seq, i);
+        Look *lk = &looks[i];
+        lk->kind = 0;
         PyObject *hidden = PyObject_GetAttr(target, s_hidden);
         if (hidden == NULL)
             goto fail;
@@ -855,42 +876,71 @@ static PyObject *retina_see_all(PyObject *self, PyObject *const *args, Py_ssize_
         Py_DECREF(hidden);
         if (is_hidden < 0)
             goto fail;
-        if (is_hidden) {
-            sample = nothing();
-        } else {
-            double b[3], v[3];
-            PyObject *state = PyObject_CallMethodOneArg(target, s_state, data);
-            if (state == NULL)
-                goto fail;
-            int rc = -1;
-            if (PyTuple_Check(state) && PyTuple_GET_SIZE(state) == 2)
-                rc = (vec3(PyTuple_GET_ITEM(state, 0), b) < 0 || vec3(PyTuple_GET_ITEM(state, 1), v) < 0) ? -1 : 0;
-            else
-                PyErr_SetString(PyExc_TypeError, "VisualTarget.state must return (position, velocity)");
-            Py_DECREF(state);
-            if (rc < 0)
-                goto fail;
-            double rx = b[0] - eye[0], ry = b[1] - eye[1], rz = b[2] - eye[2];
-            double px = r[0] * rx + r[3] * ry + r[6] * rz;
-            if (c.foveated && px < c.cos_fov * sqrt(rx * rx + ry * ry + rz * rz)) {
-                sample = nothing(); /* outside the field of view */
-            } else {
-                double pe[3] = {px, r[1] * rx + r[4] * ry + r[7] * rz, r[2] * rx + r[5] * ry + r[8] * rz};
-                double ve[3] = {r[0] * v[0] + r[3] * v[1] + r[6] * v[2], r[1] * v[0] + r[4] * v[1] + r[7] * v[2],
-                                r[2] * v[0] + r[5] * v[1] + r[8] * v[2]};
-                double speed = retinal_speed(eye, rx, ry, rz, v[0], v[1], v[2], dt);
-                sample = perceive(&c, pe, ve, speed, rng);
-            }
-        }
-        if (sample == NULL)
+        if (is_hidden)
+            continue;
+        double b[3], v[3];
+        PyObject *state = PyObject_CallMethodOneArg(target, s_state, data);
+        if (state == NULL)
             goto fail;
-        PyList_SET_ITEM(out, i, sample);
+        int rc = -1;
+        if (PyTuple_Check(state) && PyTuple_GET_SIZE(state) == 2)
+            rc = (vec3(PyTuple_GET_ITEM(state, 0), b) < 0 || vec3(PyTuple_GET_ITEM(state, 1), v) < 0) ? -1 : 0;
+        else
+            PyErr_SetString(PyExc_TypeError, "VisualTarget.state must return (position, velocity)");
+        Py_DECREF(state);
+        if (rc < 0)
+            goto fail;
+        double rx = b[0] - eye[0], ry = b[1] - eye[1], rz = b[2] - eye[2];
+        double px = r[0] * rx + r[3] * ry + r[6] * rz;
+        if (c.foveated && px < c.cos_fov * sqrt(rx * rx + ry * ry + rz * rz))
+            continue; /* outside the field of view */
+        double pe[3] = {px, r[1] * rx + r[4] * ry + r[7] * rz, r[2] * rx + r[5] * ry + r[8] * rz};
+        double ve[3] = {r[0] * v[0] + r[3] * v[1] + r[6] * v[2], r[1] * v[0] + r[4] * v[1] + r[7] * v[2],
+                        r[2] * v[0] + r[5] * v[1] + r[8] * v[2]};
+        perceive_prepare(&c, pe, ve, retinal_speed(eye, rx, ry, rz, v[0], v[1], v[2], dt), lk);
+        seen += lk->kind == 2;
     }
+    const double *e = NULL;
+    Py_buffer normals = {.buf = NULL};
+    if (seen > 0) { /* rng.standard_normal(6 * seen) */
+        PyObject *size = PyLong_FromSsize_t(6 * seen);
+        if (size == NULL)
+            goto fail;
+        PyObject *call[2] = {rng, size};
+        draw = PyObject_VectorcallMethod(s_standard_normal, call, 2 | PY_VECTORCALL_ARGUMENTS_OFFSET, NULL);
+        Py_DECREF(size);
+        if (draw == NULL || f64_buffer(draw, &normals, 0) < 0)
+            goto fail;
+        if (normals.len != 48 * seen) {
+            PyBuffer_Release(&normals);
+            PyErr_SetString(PyExc_ValueError, "rng.standard_normal gave the wrong size");
+            goto fail;
+        }
+        e = (const double *)normals.buf;
+    }
+    out = PyList_New(n);
+    for (Py_ssize_t i = 0; out != NULL && i < n; i++) {
+        PyObject *sample = look_sample(&looks[i], e);
+        if (sample == NULL) {
+            Py_CLEAR(out);
+            break;
+        }
+        PyList_SET_ITEM(out, i, sample);
+        if (looks[i].kind == 2)
+            e += 6;
+    }
+    if (seen > 0)
+        PyBuffer_Release(&normals);
+    if (out == NULL)
+        goto fail;
+    Py_XDECREF(draw);
+    PyMem_Free(looks);
     Py_DECREF(seq);
     return out;
 fail:
+    Py_XDECREF(draw);
+    PyMem_Free(looks);
     Py_DECREF(seq);
-    Py_XDECREF(out);
     return NULL;
 }
 
@@ -1287,8 +1337,7 @@ PyMODINIT_FUNC PyInit__kernels(void)
     INTERN(s_state, "state")
     INTERN(s_last_onset, "last_onset")
     INTERN(s_standard_normal, "standard_normal")
-    if ((int_six = PyLong_FromLong(6)) == NULL)
-        return NULL;
+
 #undef INTERN
     return PyModule_Create(&kernel_module);
 }
