@@ -18,6 +18,7 @@ static PyObject *s_time, *s_suppressed, *s_prev_request, *s_last_sample, *s_driv
     *s_pursuit_omega, *s_saccade, *s_omega, *s_onset, *s_duration, *s_amplitude, *s_arc, *s_axis, *s_gaze,
     *s_hidden, *s_state, *s_last_onset, *s_standard_normal;
 static PyObject *np_empty, *np_ndarray, *np_float32, *int_three; /* numpy.empty, .ndarray, .float32, 3 */
+static PyObject *np_float64_dtype, *s_dtype, *float_zero; /* numpy.dtype("float64"), "dtype" */
 
 
 /* ---- small helpers -------------------------------------------------------------------------- */
@@ -38,18 +39,37 @@ static int seq_doubles(PyObject *seq, double *out, Py_ssize_t n)
     return 0;
 }
 
-/* A C-contiguous float64 buffer (a numpy array); the caller releases the view. */
+/* Whether ``obj`` is a numpy array (not a subclass) of native float64. */
+static int is_f64_array(PyObject *obj)
+{
+    if (Py_TYPE(obj) != (PyTypeObject *)np_ndarray)
+        return 0;
+    PyObject *dtype = PyObject_GetAttr(obj, s_dtype);
+    if (dtype == NULL) {
+        PyErr_Clear();
+        return 0;
+    }
+    int same = dtype == np_float64_dtype;
+    if (!same) { /* an equal but distinct descriptor */
+        same = PyObject_RichCompareBool(dtype, np_float64_dtype, Py_EQ);
+        if (same < 0) {
+            PyErr_Clear();
+            same = 0;
+        }
+    }
+    Py_DECREF(dtype);
+    return same;
+}
+
+/* A C-contiguous float64 buffer of a numpy array; the caller releases the view. (The dtype is
+ * checked first: numpy's buffer export is cheaper without a format string.) */
 static int f64_buffer(PyObject *obj, Py_buffer *view, int writable)
 {
-    if (PyObject_GetBuffer(obj, view, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (writable ? PyBUF_WRITABLE : 0)) < 0)
-        return -1;
-    const char *f = view->format;
-    if (view->itemsize != 8 || f == NULL || !(strcmp(f, "d") == 0 || strcmp(f, "<d") == 0 || strcmp(f, "=d") == 0)) {
-        PyBuffer_Release(view);
-        PyErr_SetString(PyExc_TypeError, "expected a C-contiguous float64 array");
+    if (!is_f64_array(obj)) {
+        PyErr_SetString(PyExc_TypeError, "expected a float64 numpy array");
         return -1;
     }
-    return 0;
+    return PyObject_GetBuffer(obj, view, PyBUF_C_CONTIGUOUS | (writable ? PyBUF_WRITABLE : 0));
 }
 
 /* n doubles from a float64 array starting at element `start`. */
@@ -142,17 +162,17 @@ static int vec3(PyObject *obj, double *out)
     if (PyTuple_Check(obj) || PyList_Check(obj))
         return seq_doubles(obj, out, 3);
     Py_buffer view;
-    if (PyObject_GetBuffer(obj, &view, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) == 0) {
-        const char *f = view.format;
-        int ok = view.itemsize == 8 && view.len == 24 && f != NULL
-                 && (strcmp(f, "d") == 0 || strcmp(f, "<d") == 0 || strcmp(f, "=d") == 0);
-        if (ok)
-            memcpy(out, view.buf, 3 * sizeof(double));
-        PyBuffer_Release(&view);
-        if (ok)
-            return 0;
-    } else {
-        PyErr_Clear();
+    if (is_f64_array(obj)) {
+        if (PyObject_GetBuffer(obj, &view, PyBUF_C_CONTIGUOUS) == 0) {
+            int ok = view.len == 24;
+            if (ok)
+                memcpy(out, view.buf, 3 * sizeof(double));
+            PyBuffer_Release(&view);
+            if (ok)
+                return 0;
+        } else {
+            PyErr_Clear();
+        }
     }
     PyObject *list = PyObject_CallMethod(obj, "tolist", NULL);
     if (list == NULL)
@@ -726,10 +746,28 @@ typedef struct {
     double foveated, cos_fov, fov, noise_scale, pos_std_arcmin, arcmin, weber, floor, depth, depth_rate, e2, knee;
 } VisionConsts;
 
-/* retina.nothing() */
+/* A sample: ([px, py, pz], [vx, vy, vz], visible), built directly (cheaper than Py_BuildValue). */
+static PyObject *sample_of(const double *p, const double *v, int visible)
+{
+    PyObject *pos = list_of(p, 3), *vel = list_of(v, 3);
+    PyObject *out = (pos && vel) ? PyTuple_Pack(3, pos, vel, visible ? Py_True : Py_False) : NULL;
+    Py_XDECREF(pos);
+    Py_XDECREF(vel);
+    return out;
+}
+
+/* retina.nothing(): new lists holding one shared 0.0 (as the Python's literal constants do) */
 static PyObject *nothing(void)
 {
-    return Py_BuildValue("([ddd][ddd]O)", 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, Py_False);
+    PyObject *pos = PyList_New(3), *vel = PyList_New(3);
+    PyObject *out = (pos && vel) ? PyTuple_Pack(3, pos, vel, Py_False) : NULL;
+    for (int i = 0; out != NULL && i < 3; i++) {
+        PyList_SET_ITEM(pos, i, Py_NewRef(float_zero));
+        PyList_SET_ITEM(vel, i, Py_NewRef(float_zero));
+    }
+    Py_XDECREF(pos);
+    Py_XDECREF(vel);
+    return out;
 }
 
 /* Eye.retinal_speed; ``eye`` = the eye's pos_list, prev_pos, prev_gaze and rot_flat, in that order. */
@@ -817,14 +855,14 @@ static PyObject *look_sample(const Look *lk, const double *e)
     if (lk->kind == 0)
         return nothing();
     if (lk->kind == 1)
-        return Py_BuildValue("([ddd][ddd]O)", lk->p[0], lk->p[1], lk->p[2], lk->v[0], lk->v[1], lk->v[2], Py_True);
+        return sample_of(lk->p, lk->v, 1);
     const double *s = lk->s, *r = lk->r, *p = lk->p, *v = lk->v;
     double n0 = s[0] * e[0], n1 = s[1] * e[1], n2 = s[2] * e[2], n3 = s[3] * e[3], n4 = s[4] * e[4], n5 = s[5] * e[5];
-    return Py_BuildValue("([ddd][ddd]O)",
-                         p[0] + r[0] * n0 + r[1] * n1 + r[2] * n2, p[1] + r[3] * n0 + r[4] * n1 + r[5] * n2,
-                         p[2] + r[6] * n0 + r[7] * n1 + r[8] * n2, v[0] + r[0] * n3 + r[1] * n4 + r[2] * n5,
-                         v[1] + r[3] * n3 + r[4] * n4 + r[5] * n5, v[2] + r[6] * n3 + r[7] * n4 + r[8] * n5,
-                         Py_True);
+    double pos[3] = {p[0] + r[0] * n0 + r[1] * n1 + r[2] * n2, p[1] + r[3] * n0 + r[4] * n1 + r[5] * n2,
+                     p[2] + r[6] * n0 + r[7] * n1 + r[8] * n2};
+    double vel[3] = {v[0] + r[0] * n3 + r[1] * n4 + r[2] * n5, v[1] + r[3] * n3 + r[4] * n4 + r[5] * n5,
+                     v[2] + r[6] * n3 + r[7] * n4 + r[8] * n5};
+    return sample_of(pos, vel, 1);
 }
 
 /* retina_see_all(targets, data, eye, dt, constants, rng) -> [sample per target]
@@ -1309,7 +1347,11 @@ PyMODINIT_FUNC PyInit__kernels(void)
     np_empty = PyObject_GetAttrString(numpy, "empty");
     np_ndarray = PyObject_GetAttrString(numpy, "ndarray");
     np_float32 = PyObject_GetAttrString(numpy, "float32");
+    np_float64_dtype = PyObject_CallMethod(numpy, "dtype", "s", "float64");
     Py_DECREF(numpy);
+    if (np_float64_dtype == NULL || (s_dtype = PyUnicode_InternFromString("dtype")) == NULL
+        || (float_zero = PyFloat_FromDouble(0.0)) == NULL)
+        return NULL;
     if (np_ndarray == NULL || np_float32 == NULL)
         return NULL;
     if (np_empty == NULL || (int_three = PyLong_FromLong(3)) == NULL)
