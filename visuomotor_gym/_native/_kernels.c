@@ -995,6 +995,10 @@ typedef struct {
 
 static double *buf(Buffers *b, PyObject *obj, int writable, Py_ssize_t min_len)
 {
+    if (b->n >= (int)(sizeof(b->view) / sizeof(b->view[0]))) {
+        PyErr_SetString(PyExc_RuntimeError, "too many buffers");
+        return NULL;
+    }
     if (f64_buffer(obj, &b->view[b->n], writable) < 0)
         return NULL;
     Py_buffer *v = &b->view[b->n++];
