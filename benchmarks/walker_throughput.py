@@ -5,7 +5,8 @@ The walk is a 20 m course with 10 cm bars every ~2 m, stepped over with a 20 cm 
 contact checks near obstacles, the watched substeps of ``WalkerGait.step_physics``, are exercised, and
 nothing trips); episodes restart at the end of the course. Each control step calls ``set_next_footstep``, ``advance`` and ``step_physics``. The
 reference restores each recorded physics state (``mj_setState``) and calls ``mj_step`` with the same
-substeps, as ``benchmarks/env_throughput.py`` does for the envs. Issue 12 wants ObstacleWalk-v0 at
+substeps, as ``benchmarks/env_throughput.py`` does for the envs (which also times the pure-Python path
+when the compiled kernels are built). Issue 12 wants ObstacleWalk-v0 at
 >= 0.5 of raw physics; this is the body's share of that budget. Best of ``--repeats`` interleaved runs.
 
 The same run measures the whole env, ``ObstacleWalk-v0`` (``env.step``: gait, contact checks, eye,
@@ -19,6 +20,7 @@ env's recorded physics states (same model, same 10 substeps).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import shlex
 import sys
 import time
@@ -78,12 +80,10 @@ def raw_run(model: mujoco.MjModel, states: np.ndarray, n_substeps: int) -> float
 def env_record(steps: int):
     """iwao's actions and the physics states before each step, over ``steps`` control steps of
     ObstacleWalk-v0 (episodes restart with the next seed)."""
-    import gymnasium as gym
-
     import visuomotor_gym  # noqa: F401
     from visuomotor_gym.agents import make_agent
 
-    env = gym.make("ObstacleWalk-v0").unwrapped
+    env = make_env()
     agent = make_agent("iwao", "ObstacleWalk-v0", 8)
     spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
     states = np.empty((steps, mujoco.mj_stateSize(env.model, spec)))
@@ -102,6 +102,17 @@ def env_record(steps: int):
             obs, _ = env.reset(seed=seed)
             agent.reset()
     return env, episodes, states
+
+
+def make_env(compiled: bool = True):
+    """ObstacleWalk-v0, unwrapped; ``compiled=False``: on the pure-Python path (visuomotor_gym._native)."""
+    import gymnasium as gym
+
+    import visuomotor_gym  # noqa: F401
+    from visuomotor_gym import _native
+
+    with contextlib.nullcontext() if compiled else _native.disabled():
+        return gym.make("ObstacleWalk-v0").unwrapped
 
 
 def env_replay(env, episodes) -> float:
@@ -130,10 +141,16 @@ def main(argv=None) -> dict:
     raw_rate = args.steps / min(raw_times)
     env_steps = args.env_steps or args.steps
     env, episodes, env_states = env_record(env_steps)
-    env_times, env_raw_times = [], []
+    from visuomotor_gym import _native
+
+    compiled = _native.enabled()
+    pure_env = make_env(compiled=False) if compiled else None
+    env_times, env_raw_times, pure_times = [], [], []
     for _ in range(args.repeats):
         env_times.append(env_replay(env, episodes))
         env_raw_times.append(raw_run(env.model, env_states, env.n_substeps))
+        if compiled:
+            pure_times.append(env_replay(pure_env, episodes))
     env_rate = env_steps / min(env_times)  # resets included, as in an evaluation
     env_raw_rate = env_steps / min(env_raw_times)
     result = {
@@ -151,6 +168,8 @@ def main(argv=None) -> dict:
         "env_control_steps_per_s": round(env_rate, 1),
         "env_raw_mj_step_control_steps_per_s": round(env_raw_rate, 1),
         "ratio_env_over_raw": round(env_rate / env_raw_rate, 3),
+        "compiled_kernels": compiled,
+        "ratio_pure_python_env_over_raw": round(env_steps / min(pure_times) / env_raw_rate, 3) if compiled else None,
         "provenance": provenance(shlex.join(["python", *sys.argv])),
     }
     return report_benchmark(result, args.json)

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from visuomotor_gym import _native
 from visuomotor_gym.geometry import solve3
 
 
@@ -64,7 +65,7 @@ class HandController:
         margin = 1e-3
         self.lower = joint_ranges[:, 0] + margin
         self.upper = joint_ranges[:, 1] - margin
-        self.nominal = np.asarray(nominal, dtype=float)
+        self.nominal = np.ascontiguousarray(nominal, dtype=float)
         weights = np.ones(len(joint_ranges))
         weights[:n_torso] = self.params.torso_weight
         self.weights = weights
@@ -72,6 +73,17 @@ class HandController:
         self._jacp = np.zeros((3, model.nv))
         self._damping2 = self.params.damping**2  # lambda^2 on the diagonal
         self.reference = np.zeros(3)
+        # The compiled element-wise steps (visuomotor_gym._native, _kernels.c: hand_*), when built, and
+        # the arrays they fill; the matrix products stay numpy's.
+        self._native = _native.enabled()
+        n = len(joint_ranges)
+        self._native_indices = np.concatenate(  # the order of _kernels.c's HandConsts
+            [[n], np.arange(model.nv)[dof_ids], np.arange(model.nq)[qpos_ids]]).astype(np.float64).tobytes()
+        self._native_work = (np.empty((3, n)), np.empty((3, n)), np.empty(n), np.empty(n), np.empty(3))
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+        self._native = self._native and _native.enabled()  # unpickled where the extension is missing
 
     def reset(self, hand_pos: np.ndarray) -> None:
         """Start the hand reference where the hand is."""
@@ -79,6 +91,9 @@ class HandController:
 
     def advance_reference(self, target, dt: float) -> np.ndarray:
         """Move the reference toward ``target`` (a 3-vector) by at most ``max_speed * dt``; return it."""
+        if self._native:  # this method, compiled (_kernels.c: hand_advance)
+            self.reference = _native.kernels.hand_advance(self.reference, target, self.params.max_speed_m_s, dt)
+            return self.reference
         tx, ty, tz = target.tolist() if isinstance(target, np.ndarray) else target
         rx, ry, rz = self.reference.tolist()
         dx, dy, dz = tx - rx, ty - ry, tz - rz
@@ -98,6 +113,8 @@ class HandController:
         """
         p = self.params
         mujoco.mj_jacSite(self.model, data, self._jacp, None, self.site_id)
+        if self._native and setpoint.flags.c_contiguous and setpoint.dtype == np.float64:
+            return self._setpoints_native(data, setpoint)
         # A contiguous copy, and ndarray.dot rather than @: on these 3x10 shapes numpy's per-call
         # overhead is most of the cost (this runs every control step). The 3-vector and 3x3 steps are
         # scalar arithmetic, the same operations numpy would do element by element.
@@ -121,3 +138,16 @@ class HandController:
         dq += setpoint
         np.maximum(dq, self.lower, out=dq)
         return np.minimum(dq, self.upper, out=dq)
+
+    def _setpoints_native(self, data: mujoco.MjData, setpoint: np.ndarray) -> np.ndarray:
+        """:meth:`setpoints` after ``mj_jacSite``: the same numpy products (jac.dot, jw.dot(jw.T),
+        y.dot(jw)) on the same values, the element-wise steps around them compiled."""
+        k = _native.kernels
+        p = self.params
+        jac, jw, posture, x, y = self._native_work
+        k.hand_gather(self._native_indices, self._jacp, data.qpos, setpoint, self.nominal, self.weights, p.posture_gain,
+                      jac, jw, posture, x)
+        k.hand_solve(jw.dot(jw.T), jac.dot(x), self.reference, data.site_xpos, self.site_id, self._damping2, y)
+        dq = np.empty(len(posture))
+        k.hand_finish(y.dot(jw), self.weights, posture, setpoint, p.max_joint_step_rad, self.lower, self.upper, dq)
+        return dq

@@ -27,6 +27,7 @@ import gymnasium as gym
 import mujoco
 import numpy as np
 
+from visuomotor_gym import _native
 from visuomotor_gym.assets import asset_path
 from visuomotor_gym.core import args
 from visuomotor_gym.core.eye import EYE_ACTION_STRUCTURE, EYE_BLOCKS, Eye
@@ -147,6 +148,7 @@ class VisuomotorEnv(gym.Env):
         self.action_structure = {**body.action_structure, **EYE_ACTION_STRUCTURE, **HEAD_ACTION_STRUCTURE}
         self._n_body_act = body.n_action
         self.action_space = gym.spaces.Box(-1.0, 1.0, shape=(sum(self.action_structure.values()),), dtype=np.float32)
+        self._n_action = self.action_space.shape[0]
         self.layout = ObservationLayout(
             tuple(task.leading_blocks) + EYE_BLOCKS + HEAD_BLOCKS + tuple(body.observation_blocks)
             + tuple(task.trailing_blocks)
@@ -159,6 +161,7 @@ class VisuomotorEnv(gym.Env):
         self._viewer = None
         self._warned_human = False
         self._needs_reset = True  # step() before the first reset() is an error
+        self._native = _native.enabled()  # compiled action check and observation array (_kernels.c)
         self._warned_after_end = False
         self._reset_parts()
 
@@ -274,6 +277,7 @@ class VisuomotorEnv(gym.Env):
 
     def __setstate__(self, state):
         self.__dict__.update(state)
+        self._native = state.get("_native", False) and _native.enabled()  # unpickled without the extension
         if "_warning_total" in state:
             self._warning_stats = [self.data.warning[i] for i in self._bad_warnings]
 
@@ -285,6 +289,10 @@ class VisuomotorEnv(gym.Env):
 
     def _check_action(self, action) -> tuple[np.ndarray, list]:
         """The action as float64, clipped to [-1, 1], and the same values as a list; errors say why not."""
+        if self._native:  # compiled: a float32/64 array of the right shape, finite, in [-1, 1]; else None
+            checked = _native.kernels.check_action(action, self._n_action)
+            if checked is not None:
+                return checked
         if type(action) is np.ndarray and action.shape == self.action_space.shape and action.dtype.kind == "f":
             a = action.astype(np.float64)  # the common case: a float array of the right shape
         else:
@@ -317,7 +325,7 @@ class VisuomotorEnv(gym.Env):
         t_expected = d.time + self.dt
         task = self.task
         if not task.needs_substep_checks(d):
-            mujoco.mj_step(m, d, nstep=self.n_substeps)
+            mujoco.mj_step(m, d, self.n_substeps)  # nstep (positional: cheaper to pass)
         else:  # the task's event (a catch) may happen within this step: check every substep
             for _ in range(self.n_substeps):
                 mujoco.mj_step(m, d)
@@ -341,6 +349,10 @@ class VisuomotorEnv(gym.Env):
         self.head.observe(values, d)
         self.body.observe(values, d)
         self.task.observe_trailing(values, samples, d)
+        if self._native:  # compiled np.array(values, dtype=np.float32) (floats and ints only, else None)
+            obs = _native.kernels.float32_array(values)
+            if obs is not None:
+                return obs
         return np.array(values, dtype=np.float32)
 
     def _format(self, obs: np.ndarray):
@@ -359,7 +371,7 @@ class VisuomotorEnv(gym.Env):
             "saccade_onset": False,
             "time": float(d.time),
             "gaze_dir": plant.gaze.copy(),
-            "eye_pos": np.array(self.eye.pos_list),
+            "eye_pos": _native.kernels.vector3(self.eye.pos_list) if self._native else np.array(self.eye.pos_list),
         }
         info.update(self.head.info(d))
         info.update(self.body.info(d))

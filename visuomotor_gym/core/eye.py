@@ -17,10 +17,12 @@ import math
 import mujoco
 import numpy as np
 
+from visuomotor_gym import _native
 from visuomotor_gym.body import names
 from visuomotor_gym.core.observation import Block
 from visuomotor_gym.geometry import rotate, rotate_t, unit_from_angles
 from visuomotor_gym.oculomotor.plant import (
+    _ZERO,
     DEG,
     OculomotorParams,
     OculomotorPlant,
@@ -76,7 +78,20 @@ class Eye:
         self._az_range = (params.eye_azimuth_range_deg[0] * DEG, params.eye_azimuth_range_deg[1] * DEG)
         self._el_range = (params.eye_elevation_range_deg[0] * DEG, params.eye_elevation_range_deg[1] * DEG)
         self._log_fix = (math.log(params.fixation_range_m[0]), math.log(params.fixation_range_m[1]))
+        # The compiled command and VOR (visuomotor_gym._native, _kernels.c: eye_command, eye_apply), when built.
+        self._native = _native.enabled() and not record
+        self._native_constants = (self.gaze_action_range, *self._log_fix, params.vergence_max_diopter_s)
+        self._native_ranges = (*self._az_range, *self._el_range)
+        self._native_addresses = (self._qpos_az, self._qpos_el, self._fix_qpos, *dofs)
+        self._views = None  # (data, its xmat, xpos, qpos, qvel): views of the data last applied to
         self.reset_state()
+
+    def __getstate__(self) -> dict:
+        return {**self.__dict__, "_views": None}  # views into an MjData: rebuilt after unpickling
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+        self._native = self._native and _native.enabled()  # unpickled where the extension is missing
 
     # --- episode ------------------------------------------------------------------------------
     def reset_state(self) -> None:
@@ -110,6 +125,14 @@ class Eye:
         """Run the plant for one control step toward the requested gaze change (retinal azimuth and
         elevation of the current eye frame, in action units) and move vergence toward the fixation
         action (log-mapped onto the fixation range, rate-limited in diopters)."""
+        if self._native:  # this method, compiled, unless a saccade starts
+            plant = self.plant
+            stepped = _native.kernels.eye_command(self.rot_flat, plant, plant._native_constants, _ZERO,
+                                                  self._native_constants, g_az, g_el, g_fix, dt, n_substeps,
+                                                  self.fixation)
+            if stepped is not None:
+                saccading, deferred, self.fixation = stepped
+                return PlantStep(False, saccading, deferred)
         u = unit_from_angles(g_az * self.gaze_action_range, g_el * self.gaze_action_range)  # eye frame
         target = rotate(self.rot_flat, *u)  # world, a tuple (the plant takes one as it is)
         plant_step = self.plant.step(target, dt, n_substeps, rng)
@@ -128,6 +151,18 @@ class Eye:
         the rotation's 9 numbers, row-major; ``pos_list``).
         """
         d = data
+        if self._native:  # this method, compiled
+            views = self._views
+            if views is None or views[0] is not d:  # MjData's arrays, read once per data object
+                views = self._views = (d, d.xmat, d.xpos, d.qpos, d.qvel)
+            _, xmat, xpos, qpos, qvel = views
+            flat, self.pos_list, self.in_head, clamped = _native.kernels.eye_apply(
+                xmat, xpos, self.head_body, self.plant.gaze, self._offset_list, self._native_ranges, qpos, qvel,
+                self._native_addresses, self.fixation)
+            self.rot_flat = flat
+            if clamped:
+                self.plant.constrain(np.array(flat[0::3]))
+            return
         h0, h1, h2, h3, h4, h5, h6, h7, h8 = d.xmat[self.head_body].tolist()  # head rotation, row-major
         head = (h0, h1, h2, h3, h4, h5, h6, h7, h8)
         gx, gy, gz = rotate_t(head, *self.plant.gaze.tolist())  # gaze in head coordinates

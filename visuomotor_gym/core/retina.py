@@ -16,6 +16,7 @@ from collections import deque
 import mujoco
 import numpy as np
 
+from visuomotor_gym import _native
 from visuomotor_gym.vision import foveation
 from visuomotor_gym.vision.foveation import VisionParams
 
@@ -99,7 +100,21 @@ class Retina:
         self.dt = float(dt)
         # Slightly wider than the field (1e-9 rad): foveation.perceive makes the exact decision.
         self._cos_fov = math.cos(min(params.field_of_view_deg * foveation.DEG + 1e-9, math.pi))
+        # The compiled _see_all (visuomotor_gym._native, _kernels.c: retina_see_all), when built; its
+        # constants in the order of its VisionConsts struct.
+        self._native = _native.enabled()
+        deg = foveation.DEG
+        self._native_constants = np.array([
+            1.0 if params.foveated else 0.0, self._cos_fov, params.field_of_view_deg * deg, params.noise_scale,
+            params.retinal_position_std_arcmin, foveation.ARCMIN, params.retinal_velocity_weber,
+            params.retinal_velocity_floor_deg_s * deg, params.depth_std_fraction, params.depth_rate_std_fraction,
+            params.fovea_e2_deg * deg, params.position_slip_knee_deg_s * deg,
+        ], dtype=np.float64).tobytes()
         self.reset()
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+        self._native = self._native and _native.enabled()  # unpickled where the extension is missing
 
     def reset(self) -> None:
         self._delay: deque = deque(maxlen=self.delay_steps + 1)
@@ -123,6 +138,9 @@ class Retina:
         """:meth:`_see` of every target (not the oracle, no saccade in flight), with the eye's pose read
         once: the same arithmetic in the same order, without a call and its look-ups per target (a
         walker's course hands the retina a dozen targets every step)."""
+        if self._native:  # this method, compiled
+            return _native.kernels.retina_see_all(targets, data, eye.pos_list + eye.prev_pos + eye.prev_gaze
+                                                  + eye.rot_flat, self.dt, self._native_constants, rng)
         vp = self.params
         foveated = vp.foveated
         cos_fov = self._cos_fov

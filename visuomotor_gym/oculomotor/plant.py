@@ -54,6 +54,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from visuomotor_gym import _native
 from visuomotor_gym.geometry import angle_between, cross, unit_from_angles
 
 DEG = math.pi / 180.0
@@ -227,6 +228,16 @@ class OculomotorPlant:
     def __init__(self, params: OculomotorParams | None = None, record: bool = False):
         self.params = params or OculomotorParams()
         self.record = record
+        # The compiled step (visuomotor_gym._native), when built; not for the recorded trace. Its
+        # constants in the order of _kernels.c's PlantConsts.
+        self._native = _native.enabled() and not record
+        p = self.params
+        self._native_constants = np.array(
+            [p.saccade_threshold_deg * DEG, p.pursuit_latency_s, p.pursuit_accel_max_deg_s2 * DEG,
+             p.pursuit_max_deg_s, DEG, p.saccade_refractory_s, len(p.pursuit_gain_points),
+             *(x for q in p.pursuit_gain_points for x in q)],
+            dtype=np.float64,
+        ).tobytes()
         self.reset(np.array([1.0, 0.0, 0.0]), time=0.0)
 
     def reset(self, gaze: np.ndarray, time: float = 0.0) -> None:
@@ -255,6 +266,10 @@ class OculomotorPlant:
         if self.record:
             self.trace_t.append(self.time)
             self.trace_gaze.append(self.gaze.copy())
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+        self._native = self._native and _native.enabled()  # unpickled where the extension is missing
 
     @property
     def angular_velocity(self) -> np.ndarray:
@@ -312,6 +327,10 @@ class OculomotorPlant:
 
         ``rng`` draws the optional saccade endpoint noise (only used when that noise is > 0).
         """
+        if self._native:  # this method, compiled (_native/_kernels.c: plant_step), unless a saccade starts
+            stepped = _native.kernels.plant_step(self, target, dt, n_substeps, self._native_constants, _ZERO)
+            if stepped is not None:
+                return PlantStep(False, *stepped)
         p = self.params
         t0 = self.time
         tx, ty, tz = target if type(target) is tuple else np.asarray(target, dtype=float).tolist()
