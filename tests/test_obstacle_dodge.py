@@ -277,3 +277,62 @@ def test_fajen_warren_holds_a_dodge_under_way_when_no_change_can_show_in_time():
     agent.command = (-math.radians(18.0), 0.7)
     course, speed = agent._evade((0.0, 0.0, 0.0), (0.9, 0.0))
     assert (course, speed) == (-math.radians(18.0), 0.7)
+
+
+def test_speed_action_spans_the_gaits_steps_with_zero_at_the_nominal_speed():
+    """[-1, 0, 1] -> 0.5, 1.3, 1.9 m/s: footsteps of 0.25 (the gait's shortest), 0.65 and 0.95 m per 0.5 s."""
+    body = ObstacleDodgeEnv().body
+    for a1, step in ((-1.0, 0.25), (0.0, 0.65), (1.0, 0.95), (-0.5, 0.45)):
+        length, lateral, _ = body.footstep_from_locomotion(0.0, a1)
+        assert math.isclose(length, step) and lateral == 0.0
+    for speed in (0.5, 0.9, 1.3, 1.6, 1.9):
+        a = DodgeBody.action_from_locomotion(0.0, speed)
+        assert math.isclose(body.footstep_from_locomotion(*a)[0], speed * 0.5)
+    assert DodgeBody.action_from_locomotion(0.0, 0.2) == [0.0, -1.0]
+
+
+def test_the_walker_slows_to_half_a_metre_per_second():
+    env = ObstacleDodgeEnv(crowd_distribution={"first_onset_s": (30.0, 31.0)})  # nobody appears
+    env.reset(seed=0)
+    act = np.zeros(7, np.float32)
+    act[1] = -1.0
+    xs = []
+    for _ in range(250):
+        _, _, _, _, info = env.step(act)
+        xs.append(info["pelvis_pos"][0])
+    assert abs((xs[-1] - xs[-101]) / 2.0 - 0.5) < 0.05  # the last 2 s (4 steps of 0.25 m)
+
+
+def test_a_veer_lasts_one_second():
+    """Jovancevic et al.: ~1 s. A veering pedestrian turns when it comes within its veer distance and
+    takes up its first velocity again 1 s later."""
+    assert CrowdDistribution().veer_s == 1.0
+    env = ObstacleDodgeEnv(crowd_distribution={"veer_p": 1.0})
+    env.reset(seed=0)
+    task = env.task
+    first = task.crowd.pedestrians[0, 3:5].copy()
+    t_on = t_off = None
+    for _ in range(600):
+        env.step(np.zeros(7, np.float32))
+        moved = not np.allclose(task.vel[0], first)
+        if moved and t_on is None:
+            t_on = env.data.time
+        if t_on is not None and not moved and t_off is None:
+            t_off = env.data.time
+            break
+    assert t_on is not None and t_off is not None and abs(t_off - t_on - 1.0) < 0.03
+
+
+def test_fajen_warren_also_predicts_a_veering_pedestrian_returning_to_its_course():
+    """A pedestrian whose estimated velocity turned 1 s ago gets three more predicted tracks (it takes up
+    its old velocity after 0.3, 0.6 or 1 s); one that kept its velocity gets none."""
+    agent = _agent_with_pedestrian(3.0, 2.0, 0.0, -1.3)
+    agent.poses = [((0.0, 0.0, 0.0), [1.0, 0, 0, 0, 1.0, 0, 0, 0, 1.0], (0.0, 0.0, 0.0), 0.9, 2.0)]
+    f = agent.filters[0]
+    f.history = [(t, 0.0, -1.3) for t in np.arange(0.0, 2.001, 0.02)]
+    tau = np.arange(0.0, 3.0, 0.1)
+    assert agent._predicted_tracks([f], tau).shape == (1, len(tau), 2)
+    f.history = [(t, 1.0, 0.0) if t < 1.5 else (t, 0.0, -1.3) for t in np.arange(0.0, 2.001, 0.02)]
+    tracks = agent._predicted_tracks([f], tau)
+    assert tracks.shape == (4, len(tau), 2)
+    assert np.allclose(tracks[3, -1], (3.0 + 1.0 * (tau[-1] - 1.0), 2.0 - 1.3))  # 1 s at -1.3 m/s, then (1, 0)

@@ -13,9 +13,14 @@ choice: a crab-walking abstraction of turning; steering in Fajen & Warren 2003 i
 locomotion). As with footsteps, the command is read at each mid-stance for the next step of that foot:
 it shows in the pelvis's path ~0.5-1 s later.
 
-Action block ``locomotion`` (2 values in [-1, 1], linear maps, modelling choice): heading (direction of
-travel from the path's +x, + = left) onto [-30, 30] deg; speed onto [0.7, 1.9] m/s (0 = 1.3 m/s, the
-nominal gait). Toe clearance stays at the gait's nominal 5 cm (the floor is flat).
+Action block ``locomotion`` (2 values in [-1, 1], modelling choice): heading (direction of travel from
+the path's +x, + = left), linear onto [-30, 30] deg; speed, piecewise linear onto [0.5, 1.9] m/s with 0 =
+1.3 m/s, the nominal gait ([-1, 0] onto [0.5, 1.3], [0, 1] onto [1.3, 1.9]). 0.5 and 1.9 m/s are what the
+gait's step lengths allow at its fixed 0.5 s per step (``GaitParams.step_range_m`` 0.25-0.95 m): humans
+slow right down when a pedestrian cuts in (Olivier et al. 2012 report speed as well as course
+adaptations), so the body offers the gait's whole range; it cannot stop (the gait's cadence is fixed).
+Until issue 13's second pass the floor was 0.7 m/s (a modelling choice with no source; the sweep is in
+docs/reproductions/dodge.md). Toe clearance stays at the gait's nominal 5 cm (the floor is flat).
 """
 
 from __future__ import annotations
@@ -26,7 +31,9 @@ from visuomotor_gym.body.walker import GaitParams
 from visuomotor_gym.body.walker_body import WalkerBody
 
 HEADING_RANGE_DEG = 30.0
-SPEED_RANGE_M_S = (0.7, 1.9)
+# The gait's speeds at 0.5 s per step: step lengths 0.25-0.95 m (GaitParams.step_range_m).
+SPEED_RANGE_M_S = (0.5, 1.9)
+NOMINAL_SPEED_M_S = 1.3  # the gait's nominal 0.65 m step per 0.5 s: the action's 0
 
 
 class DodgeBody(WalkerBody):
@@ -40,7 +47,7 @@ class DodgeBody(WalkerBody):
         gait clips length and lateral to its ranges)."""
         heading = a0 * HEADING_RANGE_DEG * math.pi / 180.0
         lo, hi = SPEED_RANGE_M_S
-        speed = 0.5 * (lo + hi) + a1 * 0.5 * (hi - lo)
+        speed = NOMINAL_SPEED_M_S + a1 * ((NOMINAL_SPEED_M_S - lo) if a1 < 0.0 else (hi - NOMINAL_SPEED_M_S))
         step = speed * self.p.step_s
         return step * math.cos(heading), step * math.sin(heading), self.p.nominal_clearance_m
 
@@ -49,7 +56,8 @@ class DodgeBody(WalkerBody):
         """The inverse map (for agents), clipped to [-1, 1]."""
         lo, hi = SPEED_RANGE_M_S
         h = heading_rad / (HEADING_RANGE_DEG * math.pi / 180.0)
-        s = (2.0 * speed - lo - hi) / (hi - lo)
+        dv = speed - NOMINAL_SPEED_M_S
+        s = dv / ((NOMINAL_SPEED_M_S - lo) if dv < 0.0 else (hi - NOMINAL_SPEED_M_S))
         return [min(max(h, -1.0), 1.0), min(max(s, -1.0), 1.0)]
 
     def command(self, data, a, al: list, dt: float) -> None:
@@ -57,4 +65,4 @@ class DodgeBody(WalkerBody):
         self.gait.advance(data, dt)
 
 
-__all__ = ["HEADING_RANGE_DEG", "SPEED_RANGE_M_S", "DodgeBody", "GaitParams"]
+__all__ = ["HEADING_RANGE_DEG", "NOMINAL_SPEED_M_S", "SPEED_RANGE_M_S", "DodgeBody", "GaitParams"]

@@ -69,7 +69,7 @@ class ObstacleDodgeEnv(VisuomotorEnv):
     | index | block | meaning |
     |---|---|---|
     | 0 | locomotion | heading (direction of travel from the path, + = left), linear onto [-30, 30] deg; saturates near 18 deg at 1.3 m/s (feet never cross: at most 0.36 m sideways per stride) |
-    | 1 | locomotion | speed, linear onto [0.7, 1.9] m/s (0: the nominal 1.3 m/s) |
+    | 1 | locomotion | speed, piecewise linear onto [0.5, 1.9] m/s (-1: 0.5, 0: the nominal 1.3, 1: 1.9 m/s; the gait's 0.25-0.95 m steps at 0.5 s per step) |
     | 2-3 | gaze | requested gaze change in retinal coordinates (azimuth, elevation) of the current eye frame, times ``gaze_action_range_deg`` (60 deg); 0 holds gaze fixed in the world |
     | 4 | fixation | fixation (vergence) distance, log-mapped onto [0.1, 20] m; does not change the noise in v0 |
     | 5-6 | head | head target: neck yaw in [-80, 80] deg and pitch in [-50, 40] deg (negative = down), reached at <= 300 deg/s |

@@ -14,8 +14,9 @@ of the crossers would hit a walker that neither looks nor steers; modelling choi
 **veers** with probability 0.1 (Jovancevic, Sullivan & Hayhoe: 10 % of the pedestrians veered onto a
 collision course; REFERENCES.md): it starts on a course that misses (|timing| 1.0-1.5 s), and when it
 comes within 3-5 m of the walker it turns onto a collision course (toward the point where it would meet
-the walker if both kept their velocities) for ``veer_s`` = 1.5 s (the veer in Jovancevic et al. lasted
-~1 s before contact; 1.5 s: modelling choice), then resumes its course.
+the walker if both kept their velocities) for ``veer_s`` = 1.0 s (the veer in Jovancevic et al. lasted
+~1 s; REFERENCES.md "(10 %, ~1 s)"), then resumes its course. (Until issue 13's second pass ``veer_s`` was
+1.5 s, a modelling choice; docs/reproductions/dodge.md has both.)
 
 **What the eye sees of a pedestrian**: one point on its axis at 1.5 m (upper chest, a modelling choice
 near the eyes' height so a level gaze sees it) with its velocity (:class:`PedestrianTarget`), sampled by
@@ -66,7 +67,7 @@ class CrowdDistribution:
     veer_p: float = 0.1  # Jovancevic, Sullivan & Hayhoe: 10 % veered onto a collision course
     veer_timing_s: tuple[float, float] = (1.0, 1.5)  # |timing| of a veering pedestrian's first course
     veer_distance_m: tuple[float, float] = (3.0, 5.0)  # the veer starts within this distance of the walker
-    veer_s: float = 1.5
+    veer_s: float = 1.0  # Jovancevic, Sullivan & Hayhoe: the veer lasted ~1 s
     min_crossing_m: float = 3.0  # crossing points between this far from the start ...
     goal_clear_m: float = 1.0  # ... and this far before the goal
 
