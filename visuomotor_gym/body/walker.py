@@ -118,7 +118,8 @@ class GaitParams:
     # ObstacleWalk and ObstacleDodge never turns). Walkers at their preferred speed turn by 30 and 60 deg
     # within a step when told a step ahead (Patla, Prentice, Robinson & Neufeld 1991, J Exp Psychol Hum
     # Percept Perform 17(3):603-634: its abstract confirms cued direction changes planned in the previous
-    # step; the 30/60 deg values are recalled, not checked in its text); 45 deg is a modelling choice between the two, above ALLSTEPS'
+    # step; the 30/60 deg values are recalled, not checked in its text); 45 deg is a modelling choice
+    # between the two, above ALLSTEPS'
     # +-30 deg path changes (Xie et al. 2020) plus the ~10 deg the alternating feet add.
     max_turn_deg: float = 45.0
 
