@@ -664,7 +664,7 @@ def render_html(lb: Leaderboard) -> str:
         "</tbody></table>",
     ]
     parts += [
-        "<h2>Catch rate along the observability ladder</h2>",
+        "<h2>Success rate along the observability ladder</h2>",
         svg_catch_rate(rows, ladder),
         f'<ul class="ladder">{ladder_items}</ul>',
         "<h2>Gaze realism components</h2>",
