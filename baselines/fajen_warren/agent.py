@@ -104,7 +104,8 @@ class FajenWarrenParams:
     latency_at_command: bool = True
     velocity_window_s: float = 0.5
     speed_cost: float = 0.15
-    speed_margin_m: float = 2.5  # closest distances beyond this are all equally safe (sweep: dodge.md)
+    # closest distances beyond this are all equally safe (modelling choice; sweep: docs/reproductions/dodge.md)
+    speed_margin_m: float = 2.5
     evade_courses_deg: tuple = (-18.0, -9.0, 0.0, 9.0, 18.0)  # candidate courses off the path (gait's limit ~18 deg)
     course_cost: float = 0.3  # m of predicted distance per rad away from the steering dynamics' phi
     lateral_speed_m_s: float = 0.36  # the gait's widest sideways progress (tests/test_obstacle_dodge.py)
@@ -119,7 +120,8 @@ class FajenWarrenParams:
     # Perception and gaze (modelling choices, see the module docstring).
     accel_std: float = 1.0  # m/s^2, white acceleration noise of the constant-velocity model
     min_dwell_s: float = 0.1
-    vel_std_weight: float = 3.0  # s of staleness per m/s of the velocity estimate's std (modelling choice; sweep: dodge.md)
+    # s of staleness per m/s of the velocity estimate's std (modelling choice; sweep: docs/reproductions/dodge.md)
+    vel_std_weight: float = 3.0
     search_azimuth_deg: float = 45.0
     search_distance_m: float = 6.0
     search_weight: float = 0.25  # a side's search urgency per second since it was last scanned
