@@ -819,3 +819,29 @@ def test_check_never_unpickles(monkeypatch):
         "ppo-intercept-v3__EyeCatch-v0", "ppo-intercept-v3__EyeCatchOracle-v0"}, pages=False)
     assert report.ok, "\n".join(messages(report))
     assert report.rescored_episodes == 4
+
+
+@pytest.mark.parametrize("env_id", ["EyeCatch-v0", "SteppingStones-v0", "ObstacleDodge-v0"])
+def test_belief_mpc_params_round_trip_every_family(env_id):
+    """The belief-mpc-params file of each family's belief_mpc agent loads back to the same agent class
+    and parameters (tuples such as the dodge agent's candidate speeds come back as tuples)."""
+    from visuomotor_gym.agents import make_agent
+    from visuomotor_gym.leaderboard.policies import BELIEF_MPC_FORMAT, policy_format
+
+    fmt = policy_format(BELIEF_MPC_FORMAT)
+    agent = fmt.load(fmt.export("belief_mpc", env_id), env_id)
+    import gymnasium as gym
+
+    reference = make_agent("belief_mpc", env_id, gym.make(env_id).action_space.shape[0])
+    assert type(agent) is type(reference) and agent.params == reference.params
+
+
+def test_belief_mpc_params_reject_a_malformed_tuple():
+    from visuomotor_gym.leaderboard.policies import BELIEF_MPC_FORMAT, policy_format
+
+    fmt = policy_format(BELIEF_MPC_FORMAT)
+    obj = json.loads(fmt.export("belief_mpc", "ObstacleDodge-v0"))
+    for bad in (["fast", 1.3], [True, 1.3], 1.3):
+        obj["params"]["speeds"] = bad
+        with pytest.raises(ValueError, match="params.speeds"):
+            fmt.load(json.dumps(obj).encode(), "ObstacleDodge-v0")

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -75,7 +76,8 @@ def format_for_agent(agent_name: str) -> PolicyFormat | None:
 
 def _typed_params(params, cls, what: str) -> dict:
     """``params`` checked against the dataclass ``cls``: exactly its fields, each value of its default's
-    JSON type (bool, int, float (an int is accepted), str). Raises ValueError naming the field."""
+    JSON type (bool, int, float (an int is accepted), str; a tuple of numbers from a JSON list of numbers,
+    returned as a tuple). Raises ValueError naming the field."""
     from dataclasses import MISSING, fields
 
     known = {f.name: f for f in fields(cls)}
@@ -94,6 +96,12 @@ def _typed_params(params, cls, what: str) -> dict:
             ok = isinstance(value, (int, float)) and not isinstance(value, bool)
         elif isinstance(default, str):
             ok = isinstance(value, str)
+        elif isinstance(default, tuple):
+            ok = isinstance(value, list) and all(
+                isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in value
+            )
+            if ok:
+                params = {**params, name: tuple(value)}
         else:
             ok = value is None or isinstance(value, (bool, int, float, str))
         if not ok:
@@ -169,28 +177,42 @@ register_policy_format(PolicyFormat(EYECATCH_FORMAT, "eyecatch", ".json", _eyeca
 BELIEF_MPC_FORMAT = "belief-mpc-params"
 
 
+def _belief_mpc_classes(env_id: str) -> tuple[type, type, str | None]:
+    """(agent class, params class, how its note names the env's VisionParams, None when the agent takes
+    none) of the belief_mpc agent on ``env_id``'s family: the catch agent, or the stones and dodge agents
+    of issue 13. (The stones note keeps the name committed entries were exported with, ``stones_vision``,
+    an alias of ``registration.env_vision_params``: the check compares re-exported bytes.)"""
+    import visuomotor_gym  # noqa: F401  (registers the ids for gym.spec)
+    from visuomotor_gym.registration import family_of
+
+    family = family_of(env_id)
+    if family == "stones":
+        from visuomotor_gym.baselines.belief_mpc.stones import StonesBeliefMPCAgent, StonesBeliefMPCParams
+
+        return StonesBeliefMPCAgent, StonesBeliefMPCParams, "stones_vision"
+    if family == "dodge":
+        from visuomotor_gym.baselines.belief_mpc.dodge import DodgeBeliefMPCAgent, DodgeBeliefMPCParams
+
+        return DodgeBeliefMPCAgent, DodgeBeliefMPCParams, "env_vision_params"
+    from visuomotor_gym.baselines.belief_mpc import BeliefMPCAgent
+    from visuomotor_gym.baselines.belief_mpc.agent import BeliefMPCParams
+
+    return BeliefMPCAgent, BeliefMPCParams, None
+
+
 def _belief_mpc_export(spec: str, env_id: str) -> bytes:
     from dataclasses import asdict
 
     from visuomotor_gym.agents import parse_agent_spec
-    from visuomotor_gym.baselines.belief_mpc import BeliefMPCAgent
 
     name, overrides = parse_agent_spec(spec)
     if name != "belief_mpc":
         raise ValueError(f"the {BELIEF_MPC_FORMAT} format serves the belief_mpc agent, not {name!r}")
-    import visuomotor_gym  # noqa: F401  (registers the ids for gym.spec)
-    from visuomotor_gym.registration import family_of
-
-    if family_of(env_id) == "stones":  # the stones agent (baselines/belief_mpc/stones.py, issue 13)
-        from visuomotor_gym.baselines.belief_mpc.stones import StonesBeliefMPCAgent
-
-        params = asdict(StonesBeliefMPCAgent.for_env(env_id, **overrides).params)
-        note = ("Every StonesBeliefMPCParams field as StonesBeliefMPCAgent.for_env(env_id, **overrides) resolves "
-                "it; the policy is StonesBeliefMPCAgent(StonesBeliefMPCParams(**params), vision=stones_vision(env_id)).")
-    else:
-        params = asdict(BeliefMPCAgent.for_env(env_id, **overrides).params)
-        note = ("Every BeliefMPCParams field as BeliefMPCAgent.for_env(env_id, **overrides) resolves it; "
-                "the policy is BeliefMPCAgent(BeliefMPCParams(**params)).")
+    agent_cls, params_cls, vision = _belief_mpc_classes(env_id)
+    params = asdict(agent_cls.for_env(env_id, **overrides).params)
+    a, p = agent_cls.__name__, params_cls.__name__
+    note = f"Every {p} field as {a}.for_env(env_id, **overrides) resolves it; the policy is {a}({p}(**params)"
+    note += f", vision={vision}(env_id))." if vision else ")."
     obj = {
         "format": BELIEF_MPC_FORMAT,
         "format_version": 1,
@@ -203,19 +225,12 @@ def _belief_mpc_export(spec: str, env_id: str) -> bytes:
 
 
 def _belief_mpc_load(data: bytes, env_id: str) -> Policy:
-    from visuomotor_gym.baselines.belief_mpc import BeliefMPCAgent
-    from visuomotor_gym.baselines.belief_mpc.agent import BeliefMPCParams
-    from visuomotor_gym.registration import family_of
+    from visuomotor_gym.registration import env_vision_params
 
     obj = _read_json_policy(data, BELIEF_MPC_FORMAT, env_id)
-    if family_of(env_id) == "stones":
-        from visuomotor_gym.baselines.belief_mpc.stones import StonesBeliefMPCAgent, StonesBeliefMPCParams
-        from visuomotor_gym.registration import env_vision_params
-
-        params = _typed_params(obj["params"], StonesBeliefMPCParams, "StonesBeliefMPCParams")
-        return StonesBeliefMPCAgent(StonesBeliefMPCParams(**params), vision=env_vision_params(env_id))
-    params = _typed_params(obj["params"], BeliefMPCParams, "BeliefMPCParams")
-    return BeliefMPCAgent(BeliefMPCParams(**params))
+    agent_cls, params_cls, vision = _belief_mpc_classes(env_id)
+    params = params_cls(**_typed_params(obj["params"], params_cls, params_cls.__name__))
+    return agent_cls(params, vision=env_vision_params(env_id)) if vision else agent_cls(params)
 
 
 register_policy_format(
