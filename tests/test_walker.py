@@ -35,12 +35,13 @@ def model():
     return mujoco.MjModel.from_xml_path(str(assets.asset_path(wn.WALKER_SCENE)))
 
 
-def walk(model, duration_s, command=None, setup=None, x=0.0, y=0.0, yaw=0.0, record=None, params=None):
-    """Reset a fresh walker, optionally place obstacles (``setup(gait, data)``), and walk
-    ``duration_s`` seconds; ``command(gait)`` returns the footstep to set each control step."""
+def walk(model, duration_s, command=None, setup=None, x=0.0, y=0.0, yaw=0.0, record=None, params=None,
+         gait_cls=WalkerGait):
+    """Reset a fresh walker (a ``gait_cls``), optionally place obstacles (``setup(gait, data)``), and
+    walk ``duration_s`` seconds; ``command(gait)`` returns the footstep to set each control step."""
     model = model if params is None else mujoco.MjModel.from_xml_path(str(assets.asset_path(wn.WALKER_SCENE)))
     data = mujoco.MjData(model)
-    gait = WalkerGait(model, params)
+    gait = gait_cls(model, params)
     gait.pool.park_all(model, data)
     if setup is not None:
         setup(gait, data)
@@ -473,17 +474,7 @@ def test_targets_are_bit_identical_to_the_plain_formulas(model):
 
 
 def _turning_walk(model, duration_s, command, record=None, x=0.0, y=0.0, yaw=0.0):
-    data = mujoco.MjData(model)
-    gait = TurningGait(model)
-    gait.pool.park_all(model, data)
-    gait.reset(model, data, x, y, yaw)
-    for _ in range(round(duration_s / DT)):
-        gait.set_next_footstep(*command(gait))
-        gait.advance(data, DT)
-        gait.step_physics(model, data, NSUB)
-        if record is not None:
-            record(gait, data)
-    return gait, data
+    return walk(model, duration_s, command, x=x, y=y, yaw=yaw, record=record, gait_cls=TurningGait)
 
 
 def test_turning_gait_follows_its_footholds_headings(model):

@@ -37,7 +37,7 @@ import time
 from dataclasses import dataclass, fields, replace
 
 import numpy as np
-from visuomotor_gym.baselines.fajen_warren.agent import FajenWarrenAgent, FajenWarrenParams
+from visuomotor_gym.baselines.fajen_warren.agent import FajenWarrenAgent, FajenWarrenParams, look_action
 
 from visuomotor_gym.registration import env_vision, env_vision_params
 from visuomotor_gym.vision.foveation import DEG, VisionParams
@@ -187,18 +187,7 @@ class DodgeBeliefMPCAgent(FajenWarrenAgent):
         c, s = math.cos(odo[2]), math.sin(odo[2])
         ex, ey = odo[0] + c * eye_pos[0] - s * eye_pos[1], odo[1] + s * eye_pos[0] + c * eye_pos[1]
         ez = pelvis_z + eye_pos[2]
-        dx, dy, dz = tx - ex, ty - ey, tz - ez
-        wx, wy = c * dx + s * dy, -s * dx + c * dy  # pelvis frame
-        n = math.sqrt(wx * wx + wy * wy + dz * dz) or 1.0
-        wx, wy, wz = wx / n, wy / n, dz / n
-        (a00, a01, a02), (a10, a11, a12), (a20, a21, a22) = rot[0:3], rot[3:6], rot[6:9]
-        e0 = a00 * wx + a10 * wy + a20 * wz  # R^T w: in the eye frame
-        e1 = a01 * wx + a11 * wy + a21 * wz
-        e2 = a02 * wx + a12 * wy + a22 * wz
-        r = self.gaze_range
-        head_yaw = p.look_head_share * math.atan2(wy, wx)
-        return [min(max(math.atan2(e1, e0) / r, -1.0), 1.0), min(max(math.atan2(e2, math.hypot(e0, e1)) / r, -1.0), 1.0),
-                0.0, min(max(head_yaw / (80.0 * DEG), -1.0), 1.0), 0.0]
+        return look_action((ex, ey, ez), (tx, ty, tz), odo[2], rot, self.gaze_range, p.look_head_share)
 
     def _plan(self, eye, gaze, pos0, vel, sig0, current: int) -> int:
         p = self.params

@@ -173,6 +173,30 @@ class PedestrianFilter:
         self.t_seen = t
 
 
+
+def look_action(eye, point, yaw: float, rot, gaze_range: float, head_share: float) -> list:
+    """Gaze, fixation and head actions that turn the eye from the ``eye`` position (path frame) to
+    ``point``: the direction in the pelvis frame (heading ``yaw``), then in the eye frame (``rot``: the
+    eye_rot block, row-major), as a gaze change in units of ``gaze_range``; the head yaws
+    ``head_share`` of the direction's azimuth (neck yaw range +-80 deg)."""
+    ex, ey, ez = eye
+    tx, ty, tz = point
+    c, s = math.cos(yaw), math.sin(yaw)
+    dx, dy, dz = tx - ex, ty - ey, tz - ez
+    wx, wy = c * dx + s * dy, -s * dx + c * dy  # pelvis frame
+    n = math.sqrt(wx * wx + wy * wy + dz * dz) or 1.0
+    wx, wy, wz = wx / n, wy / n, dz / n
+    (a00, a01, a02), (a10, a11, a12), (a20, a21, a22) = rot[0:3], rot[3:6], rot[6:9]
+    e0 = a00 * wx + a10 * wy + a20 * wz  # R^T w: in the eye frame
+    e1 = a01 * wx + a11 * wy + a21 * wz
+    e2 = a02 * wx + a12 * wy + a22 * wz
+    d_az = math.atan2(e1, e0)
+    d_el = math.atan2(e2, math.hypot(e0, e1))
+    r = gaze_range
+    head_yaw = head_share * math.atan2(wy, wx)
+    return [min(max(d_az / r, -1.0), 1.0), min(max(d_el / r, -1.0), 1.0), 0.0,
+            min(max(head_yaw / (80.0 * DEG), -1.0), 1.0), 0.0]
+
 class FajenWarrenAgent:
     """See the module docstring. ``predict(obs) -> (action, state)`` on flat ObstacleDodge observations."""
 
@@ -448,18 +472,4 @@ class FajenWarrenAgent:
             az = side * p.search_azimuth_deg * DEG
             tx, ty, tz = ex + p.search_distance_m * math.cos(az), ey + p.search_distance_m * math.sin(az), ez
         self.log.append((t, target, self.phi))
-        c, s = math.cos(odo[2]), math.sin(odo[2])
-        dx, dy, dz = tx - ex, ty - ey, tz - ez
-        wx, wy = c * dx + s * dy, -s * dx + c * dy  # pelvis frame
-        n = math.sqrt(wx * wx + wy * wy + dz * dz) or 1.0
-        wx, wy, wz = wx / n, wy / n, dz / n
-        (a00, a01, a02), (a10, a11, a12), (a20, a21, a22) = rot[0:3], rot[3:6], rot[6:9]
-        e0 = a00 * wx + a10 * wy + a20 * wz  # R^T w: in the eye frame
-        e1 = a01 * wx + a11 * wy + a21 * wz
-        e2 = a02 * wx + a12 * wy + a22 * wz
-        d_az = math.atan2(e1, e0)
-        d_el = math.atan2(e2, math.hypot(e0, e1))
-        r = self.gaze_range
-        head_yaw = p.head_share * math.atan2(wy, wx)
-        return [min(max(d_az / r, -1.0), 1.0), min(max(d_el / r, -1.0), 1.0), 0.0,
-                min(max(head_yaw / (80.0 * DEG), -1.0), 1.0), 0.0]
+        return look_action((ex, ey, ez), (tx, ty, tz), odo[2], rot, self.gaze_range, p.head_share)
