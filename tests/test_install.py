@@ -94,6 +94,13 @@ def test_wheel_contains_assets_and_baselines(wheel):
             assert rel in names, f"{rel} is missing from the wheel"
     for path in (REPO / "baselines").glob("*.py"):
         assert f"visuomotor_gym/baselines/{path.name}" in names
+    # what the documented commands need (README "From a wheel"): the committed policies and the
+    # rl_zoo3 hyperparameters; the typing marker and the licence
+    for path in (REPO / "baselines" / "ppo" / "policies").glob("*.npz"):
+        assert f"visuomotor_gym/baselines/ppo/policies/{path.name}" in names
+    assert "visuomotor_gym/baselines/ppo/rl_zoo3.yml" in names
+    assert "visuomotor_gym/py.typed" in names
+    assert any(n.endswith(".dist-info/licenses/LICENSE") for n in names), "LICENSE is not in the wheel"
     # the repository-level folders are installed inside the package, not as top-level packages
     assert not any(n.startswith(("envs_assets/", "baselines/", "tests/")) for n in names)
 
@@ -153,6 +160,23 @@ def test_installed_console_scripts_resolve(site, tmp_path):
     assert result.returncode == 0, result.stderr[-4000:]
     scripts = json.loads(result.stdout.strip().splitlines()[-1])
     assert scripts and all(scripts.values()), scripts
+
+
+def test_installed_wheel_finds_the_committed_policy(site, tmp_path):
+    """The README's way to the committed policies from a wheel, and the policy file is the clone's."""
+    result = _run_installed(site, """
+        import hashlib, json, pathlib
+        import visuomotor_gym.baselines.ppo as p
+        path = pathlib.Path(p.__file__).parent / "policies" / "ppo-gated__EyeCatch-v0.npz"
+        print(json.dumps({"path": str(path), "sha": hashlib.sha256(path.read_bytes()).hexdigest()}))
+    """, tmp_path)
+    assert result.returncode == 0, result.stderr[-4000:]
+    report = json.loads(result.stdout.strip().splitlines()[-1])
+    assert Path(report["path"]).resolve().is_relative_to(site.resolve())
+    import hashlib
+
+    committed = REPO / "baselines" / "ppo" / "policies" / "ppo-gated__EyeCatch-v0.npz"
+    assert report["sha"] == hashlib.sha256(committed.read_bytes()).hexdigest()
 
 
 def test_installed_vmgym_envs_lists_the_registry(site, tmp_path):

@@ -1,0 +1,273 @@
+"""Write one documentation page per environment family (``docs/families/<family>.md``).
+
+Everything on a page comes from the code and the data, never typed by hand:
+
+* the registered ids of the family (``visuomotor_gym.registration.ENV_SPECS``): rung, arguments,
+  episode limit, and the action and observation shapes of an env built from each id;
+* the action blocks of the family's foveated id (``action_structure``);
+* the env class's docstring (description, action and observation index tables -- the observation
+  table is itself generated from the layout --, rewards, starting state, episode end, arguments,
+  version history);
+* the current leaderboard entries on the family's ids (``leaderboard/``), with gaze gains;
+* a picture, where one exists under ``docs/``.
+
+    python docs/gen_family_pages.py           # write the pages
+    python docs/gen_family_pages.py --check   # exit 1 if a committed page differs (tests/test_docs.py)
+
+``make docs`` runs it before ``mkdocs build --strict``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import inspect
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+DOCS = ROOT / "docs"
+OUT = DOCS / "families"
+LEADERBOARD = ROOT / "leaderboard"
+
+# family -> (page title, foveated id, reproduction pages (title, path relative to docs/), pictures:
+# candidate images relative to docs/, the first that exists is shown, with its caption)
+FAMILIES = {
+    "catch": (
+        "Catch: EyeCatch",
+        "EyeCatch-v0",
+        [("Eyecatch (Yeo et al. 2012)", "reproductions/eyecatch.md"),
+         ("Eom et al. 2019: belief MPC, two balls", "reproductions/eom.md"),
+         ("The default vision: moving-target localisation", "reproductions/gaze_default.md"),
+         ("PPO baselines", "baselines/ppo.md")],
+        [("images/eyecatch_record_frame.png",
+          "The Eyecatch agent catching: scene camera (the green line is its line of sight) beside its eye camera")],
+    ),
+    "reach": (
+        "Reach: ShelfReach",
+        "ShelfReach-v0",
+        [("Faraway et al. 2007: reaches as Bézier curves", "reproductions/faraway.md")],
+        [("images/shelfreach_record_frame.png", "The faraway agent reaching to a shelf target"),
+         ("reproductions/images/faraway_reach_paths.png", "Hand paths of the faraway agent to the shelf targets")],
+    ),
+    "walk": (
+        "Walk: ObstacleWalk",
+        "ObstacleWalk-v0",
+        [("Iwao et al.: gaze while walking over obstacles", "reproductions/iwao.md"),
+         ("PPO baselines (the walk recipe)", "baselines/ppo.md")],
+        [("images/obstaclewalk_iwao_seed0_frame.png",
+          "The iwao agent on ObstacleWalk-v0: side view with the line of sight, and its eye camera")],
+    ),
+    "stones": (
+        "Stones: SteppingStones",
+        "SteppingStones-v0",
+        [("Stepping stones (Eom et al. 2019, section 7; Patla & Vickers 2003)", "reproductions/stones.md")],
+        [("images/steppingstones_record_frame.png", "The lookahead agent on SteppingStones-v0"),
+         ("reproductions/images/stones_turning.png", "The lookahead agent turning through a 60 deg course")],
+    ),
+    "dodge": (
+        "Dodge: ObstacleDodge",
+        "ObstacleDodge-v0",
+        [("Dodging pedestrians (Fajen & Warren 2003; Eom et al. 2019, section 7)", "reproductions/dodge.md")],
+        [("images/obstacledodge_record_frame.png", "The fajen_warren agent among the pedestrians")],
+    ),
+}
+
+
+def _env_class(entry_point: str):
+    module, name = entry_point.split(":")
+    return getattr(importlib.import_module(module), name)
+
+
+def _cell(text: str) -> str:
+    return str(text).replace("|", "\\|").replace("\n", " ")
+
+
+def _kwargs(kwargs: dict) -> str:
+    if not kwargs:
+        return "–"
+    return ", ".join(f"`{k}={v!r}`" for k, v in kwargs.items())
+
+
+def _ids_table(specs) -> list[str]:
+    import gymnasium as gym
+
+    rows = ["| id | what the eye gives | arguments | max steps | action | observation |",
+            "|---|---|---|---|---|---|"]
+    for spec in specs:
+        env = gym.make(spec.id)
+        try:
+            act, obs = env.action_space.shape, env.observation_space.shape
+        finally:
+            env.close()
+        rows.append(f"| `{spec.id}` | {_cell(spec.description)} | {_cell(_kwargs(spec.kwargs))} | "
+                    f"{spec.max_episode_steps} | `{act}` | `{obs}` |")
+    return rows
+
+
+def _action_blocks(env_id: str) -> list[str]:
+    import gymnasium as gym
+
+    env = gym.make(env_id)
+    try:
+        actions = dict(env.unwrapped.action_structure)
+    finally:
+        env.close()
+    lines = ["| action block | indices | size |", "|---|---|---|"]
+    start = 0
+    for name, size in actions.items():
+        index = f"{start}" if size == 1 else f"{start}-{start + size - 1}"
+        lines.append(f"| `{name}` | {index} | {size} |")
+        start += size
+    return lines
+
+
+def _leaderboard_rows(env_ids) -> list[str]:
+    """Current (not superseded) entries on ``env_ids``, ladder order, best first; gaze gain = success
+    minus that of a current entry of the agent's gaze-blind twin on the same id."""
+    if not (LEADERBOARD / "protocol.json").is_file():
+        return []
+    from visuomotor_gym.leaderboard.entries import load_leaderboard
+
+    lb = load_leaderboard(LEADERBOARD)
+    entries = [e for e in lb.valid_entries if e.superseded is None and e.env_id in env_ids]
+    if not entries:
+        return []
+
+    def rate(e):
+        r = e.results
+        return float(r.get("success_rate", r["catch_rate"]))
+
+    by_agent = {(e.env_id, e.results["agent"]): e for e in entries}
+    order = list(env_ids)
+    entries.sort(key=lambda e: (order.index(e.env_id), -rate(e), e.name))
+    rows = ["| agent (spec) | env id | success [95 % CI] | gaze gain | gaze realism | latency p95 | episodes |",
+            "|---|---|---|---|---|---|---|"]
+    for e in entries:
+        r = e.results
+        ci = r.get("success_rate_ci95", r.get("catch_rate_ci95"))
+        twins = [f"gaze_blind:{r['agent']}"] + (["fixed_gaze"] if r["agent"] == "eyecatch" else [])
+        twin = next((by_agent[(e.env_id, t)] for t in twins if (e.env_id, t) in by_agent), None)
+        gain = f"{100 * (rate(e) - rate(twin)):+.1f} pts" if twin is not None else "–"
+        realism = r["gaze_realism"]["score"]
+        rows.append(
+            f"| `{e.name}` (`{_cell(r['agent'])}`) | `{e.env_id}` | {100 * rate(e):.1f} % "
+            f"[{100 * ci[0]:.1f}, {100 * ci[1]:.1f}] | {gain} | "
+            f"{'–' if realism is None else f'{realism:.3f}'} | {r['latency_ms']['p95']:.2f} ms | {r['episodes']} |"
+        )
+    return rows
+
+
+def _dedent(doc: str) -> str:
+    """The docstring without its indentation, taken from its section headings (``    ## Rewards``):
+    tables substituted into a docstring may not be indented (inspect.cleandoc would keep it all)."""
+    lines = doc.expandtabs().splitlines()
+    heads = [len(line) - len(line.lstrip()) for line in lines if line.lstrip().startswith("## ")]
+    indent = min(heads) if heads else 0
+    out = [line[min(indent, len(line) - len(line.lstrip())):] for line in lines]
+    return inspect.cleandoc("\n".join(out))
+
+
+def family_page(family: str) -> str:
+    """The Markdown of one family's page."""
+    import visuomotor_gym  # noqa: F401  (registers the ids)
+    from visuomotor_gym.registration import ENV_SPECS
+
+    title, main_id, pages, pictures = FAMILIES[family]
+    specs = [s for s in ENV_SPECS if s.family == family]
+    cls = _env_class(specs[0].entry_point)
+    doc = _dedent(cls.__doc__ or "")
+    lines = [
+        "<!-- Generated by docs/gen_family_pages.py from the env class's docstring, the registry and "
+        "leaderboard/: do not edit. `make docs-pages` rewrites it; tests/test_docs.py fails when it is stale. -->",
+        "",
+        f"# {title}",
+        "",
+        f"`{cls.__module__}.{cls.__name__}` · foveated id `{main_id}` · "
+        + " · ".join(f"[{t}](../{p})" for t, p in pages),
+        "",
+    ]
+    for path, caption in pictures:
+        if (DOCS / path).is_file():
+            lines += [f"![{caption}](../{path})", "", f"*{caption}.*", ""]
+            break
+    lines += [
+        "```python",
+        "import gymnasium as gym",
+        "import visuomotor_gym  # registers the ids",
+        "",
+        f'env = gym.make("{main_id}")  # "visuomotor_gym:{main_id}" in subprocess workers',
+        "obs, info = env.reset(seed=0)",
+        "obs, reward, terminated, truncated, info = env.step(env.action_space.sample())",
+        "```",
+        "",
+        "## Registered ids",
+        "",
+        "Every rung has the same physics and scenario sampler: a seed gives the same scenario on each. "
+        "Shapes are those of an env built from the id (flat observations, the default).",
+        "",
+        *_ids_table(specs),
+        "",
+        f"## Action blocks of `{main_id}`",
+        "",
+        "From `env.unwrapped.action_structure` (what each index means: Action Space below). The "
+        "observation's index table (Observation Space below) is generated from the layout the env "
+        'declares, as `env.unwrapped.observation_structure` gives it; with `obs_mode="dict"` the '
+        "observation is a `Dict` of the same blocks.",
+        "",
+        *_action_blocks(main_id),
+        "",
+        f"## Reference (`{cls.__name__}` docstring)",
+        "",
+    ]
+    # The docstring's sections become subsections of the reference.
+    for line in doc.splitlines():
+        lines.append("#" + line if line.startswith("## ") else line)
+    lines.append("")
+    board = _leaderboard_rows([s.id for s in specs])
+    lines += ["## Baselines on the leaderboard", ""]
+    if board:
+        lines += [
+            "Current entries of the [leaderboard](../evaluation.md#the-leaderboard) on this family's ids "
+            "(pinned seeds, `vmgym bench`'s evaluator). *Gaze gain*: success minus that of the agent's "
+            "gaze-blind twin (`gaze_blind:<agent>`) on the same seeds.",
+            "",
+            *board,
+            "",
+        ]
+    else:
+        lines += ["No leaderboard entry on this family's ids yet.", ""]
+    return "\n".join(lines).rstrip() + "\n"
+
+
+def pages() -> dict[Path, str]:
+    return {OUT / f"{family}.md": family_page(family) for family in FAMILIES}
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--check", action="store_true", help="exit 1 if a committed page is stale; write nothing")
+    args = parser.parse_args(argv)
+    from visuomotor_gym.registration import FAMILIES as REGISTERED
+
+    missing = sorted(set(REGISTERED) - set(FAMILIES))
+    if missing:
+        print(f"families without a page entry in docs/gen_family_pages.py: {missing}", file=sys.stderr)
+        return 1
+    stale = []
+    for path, text in pages().items():
+        current = path.read_text(encoding="utf-8") if path.is_file() else None
+        if current != text:
+            stale.append(path.relative_to(ROOT).as_posix() if path.is_relative_to(ROOT) else str(path))
+            if not args.check:
+                path.parent.mkdir(parents=True, exist_ok=True)
+                path.write_text(text, encoding="utf-8")
+    if args.check and stale:
+        print("stale family pages (run `make docs-pages`): " + ", ".join(stale), file=sys.stderr)
+        return 1
+    print(("stale: " if args.check else "written: ") + (", ".join(stale) or "none"))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
