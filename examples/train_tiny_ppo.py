@@ -1,6 +1,8 @@
 """Train a tiny stable-baselines3 PPO on EyeCatch-v0 for a few thousand steps, then evaluate it.
 
-A smoke run of plain SB3 on the raw observation (it learns nothing useful in 4k steps; the project's
+The saved model gets a ``<name>.meta.json`` beside it (what ``ppo:<path>`` needs besides the zip:
+the algorithm, and that it saw the raw observation), so the common evaluator (``vmgym bench --agent
+ppo:<path>``) plays it too. A smoke run of plain SB3 on the raw observation (it learns nothing useful in 4k steps; the project's
 recipe with belief features is `vmgym train ppo --env EyeCatch-v0`, docs: baselines/ppo.md).
 Needs the rl extra (install CPU PyTorch first, README "Installation").
 
@@ -10,6 +12,7 @@ Needs the rl extra (install CPU PyTorch first, README "Installation").
 from __future__ import annotations
 
 import argparse
+import json
 import os
 from pathlib import Path
 
@@ -20,7 +23,7 @@ def main(argv=None) -> Path:
     parser.add_argument("--timesteps", type=int, default=4096, help="environment transitions to train on")
     parser.add_argument("--n-envs", type=int, default=2)
     parser.add_argument("--subproc", action="store_true", help="one process per env (SubprocVecEnv)")
-    parser.add_argument("--eval-episodes", type=int, default=5)
+    parser.add_argument("--eval-episodes", type=int, default=3)
     parser.add_argument("--out", default="outputs/examples", help="folder for the saved model")
     args = parser.parse_args(argv)
     os.environ.setdefault("MUJOCO_GL", "egl")
@@ -43,15 +46,25 @@ def main(argv=None) -> Path:
 
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    path = model.save(out / f"ppo_tiny_{args.env}.zip") or out / f"ppo_tiny_{args.env}.zip"
+    path = out / f"ppo_tiny_{args.env}.zip"
+    model.save(path)
+    # The meta `ppo:<path>` reads (baselines/ppo/agent.py): plain SB3 on the raw observation, no
+    # belief features, the env's own hand action, no observation normalisation.
+    meta = {"algo": "PPO", "env_id": args.env, "belief": False, "hand_action": "absolute"}
+    path.with_suffix(".meta.json").write_text(json.dumps(meta, indent=2) + "\n")
 
     eval_env = make_vec_env(env_id, n_envs=1, seed=1000)
     mean, std = evaluate_policy(model, eval_env, n_eval_episodes=args.eval_episodes, deterministic=True)
     eval_env.close()
-    print(f"trained {model.num_timesteps} steps on {args.env}; return over {args.eval_episodes} episodes: "
-          f"{mean:.3f} +- {std:.3f}; saved {path}")
-    print(f"evaluate it with the common evaluator: vmgym bench --agent ppo:{path} --env {args.env} --episodes 20")
-    return Path(path)
+    print(f"trained {model.num_timesteps} steps on {args.env}; SB3 evaluate_policy return over "
+          f"{args.eval_episodes} episodes: {mean:.3f} +- {std:.3f}; saved {path}")
+
+    from visuomotor_gym.bench.evaluate import evaluate
+
+    result = evaluate(f"ppo:{path}", args.env, episodes=args.eval_episodes, seed=0)
+    print(f"common evaluator (seeds 0-{args.eval_episodes - 1}): success {100 * result.summary['success_rate']:.1f} %;"
+          f" the same as: vmgym bench --agent ppo:{path} --env {args.env} --episodes {args.eval_episodes} --seed 0")
+    return path
 
 
 if __name__ == "__main__":

@@ -63,4 +63,6 @@ def test_train_tiny_ppo(tmp_path):
     pytest.importorskip("stable_baselines3")
     out = _run("train_tiny_ppo.py", "--timesteps", "1024", "--eval-episodes", "1", "--out", str(tmp_path)).stdout
     assert "trained 1024 steps on EyeCatch-v0" in out
+    assert "common evaluator (seeds 0-0): success" in out  # the saved model plays as ppo:<path>
     assert (tmp_path / "ppo_tiny_EyeCatch-v0.zip").is_file()
+    assert json.loads((tmp_path / "ppo_tiny_EyeCatch-v0.meta.json").read_text())["algo"] == "PPO"
