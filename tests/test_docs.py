@@ -146,3 +146,32 @@ def test_changelog_license_and_py_typed():
     pyproject = (REPO / "pyproject.toml").read_text()
     assert '"visuomotor_gym" = ["py.typed"]' in pyproject
     assert 'license = "MIT"' in pyproject
+
+
+def test_install_instructions_cannot_pull_cuda_by_accident():
+    import tomllib
+
+    project = tomllib.loads((REPO / "pyproject.toml").read_text())["project"]
+    assert not any(d.lower().startswith("torch") for d in project["dependencies"]), "torch in core dependencies"
+    assert any(d.startswith("torch") for d in project["optional-dependencies"]["rl"])
+    readme = (REPO / "README.md").read_text(encoding="utf-8")
+    section = readme.split("## Installation", 1)[1].split("\n## ", 1)[0]
+    cpu = "pip install torch==2.13.0 --index-url https://download.pytorch.org/whl/cpu"
+    assert cpu in section and section.index(cpu) < section.index('pip install ".[rl,viz]"')
+    makefile = (REPO / "Makefile").read_text()
+    assert "TORCH_INDEX ?= https://download.pytorch.org/whl/cpu" in makefile
+    # the venv is given CPU torch before the extras that depend on it
+    setup = makefile.split("$(STAMP): pyproject.toml Makefile", 1)[1].split("\n\n", 1)[0]
+    assert setup.index("$(TORCH_SPEC)") < setup.index('".[rl,viz,dev]"')
+    assert "download.pytorch.org/whl/cpu" in (DOCS / "getting-started.md").read_text(encoding="utf-8")
+
+
+@pytest.mark.parametrize("doc", ["README.md", "examples/README.md", "leaderboard/README.md"])
+def test_relative_links_of_repository_pages_resolve(doc):
+    """The pages GitHub shows outside the site (the site's own links: mkdocs build --strict)."""
+    path = REPO / doc
+    links = re.findall(r"\]\(([^)\s]+)\)", path.read_text(encoding="utf-8"))
+    relative = [link.split("#")[0] for link in links if not re.match(r"^[a-z]+:", link) and not link.startswith("#")]
+    assert relative, f"{doc}: no relative link found (the pattern is broken)"
+    missing = sorted({link for link in relative if not (path.parent / link).exists()})
+    assert not missing, f"{doc}: links to missing files {missing}"
