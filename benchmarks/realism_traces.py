@@ -4,6 +4,9 @@ For one env id and one agent spec, plays pinned seeds ``0..N-1`` and saves the t
 :func:`visuomotor_gym.bench.trace.save_traces`. The agent is an ordinary spec (``iwao``,
 ``gaze_blind:iwao``, ``static_gaze:iwao`` where registered) or ``random_gaze:<spec>``: that agent's
 body actions with uniform random gaze and head actions (seeded), the "random gaze" of the table.
+``static_gaze:az=..,el=..[,neck_yaw=..,neck_pitch=..]:<spec>`` is that agent's static twin held at that
+posture, built from ``visuomotor_gym.static_gaze`` (or, before it is merged, from the module file named
+by the environment variable ``STATIC_GAZE_MODULE``).
 
     python benchmarks/realism_traces.py ObstacleWalk-v0 iwao 20 out/walk_iwao.npz
     python benchmarks/realism_traces.py ObstacleWalk-v0 random_gaze:iwao 20 out/walk_random.npz
@@ -48,6 +51,34 @@ class RandomGaze:
         return action, state
 
 
+def _static_gaze_module():
+    import importlib
+    import importlib.util
+    import os
+
+    try:
+        return importlib.import_module("visuomotor_gym.static_gaze")
+    except ImportError:
+        path = os.environ.get("STATIC_GAZE_MODULE")
+        if not path:
+            raise
+        spec = importlib.util.spec_from_file_location("static_gaze_module", path)
+        module = importlib.util.module_from_spec(spec)
+        sys.modules["static_gaze_module"] = module  # dataclasses look their module up there
+        spec.loader.exec_module(module)
+        return module
+
+
+def static_gaze(spec: str, env_id: str, dim: int, seed: int):
+    """``static_gaze:az=..,el=..:<agent spec>`` -> the static twin (posture given explicitly)."""
+    from visuomotor_gym.agents import make_agent
+
+    options, _, base = spec.removeprefix("static_gaze:").partition(":")
+    sg = _static_gaze_module()
+    posture = sg.Posture(**{k: float(v) for k, v in (kv.split("=") for kv in options.split(","))})
+    return sg.StaticGaze(make_agent(base, env_id, dim, seed=seed), posture, sg.env_geometry(env_id))
+
+
 def record(env_id: str, agent: str, episodes: int, path: str) -> None:
     from visuomotor_gym.agents import env_action_structure, make_agent
     from visuomotor_gym.bench.evaluate import make_env
@@ -61,6 +92,8 @@ def record(env_id: str, agent: str, episodes: int, path: str) -> None:
         if agent.startswith("random_gaze:"):
             policy = RandomGaze(make_agent(agent.removeprefix("random_gaze:"), env_id, dim, seed=seed),
                                 env_action_structure(env_id), seed=seed)
+        elif agent.startswith("static_gaze:") and "=" in agent.split(":")[1]:
+            policy = static_gaze(agent, env_id, dim, seed)
         else:
             policy = make_agent(agent, env_id, dim, seed=seed)
         traces.append(run_episode(env, policy, seed=seed, env_id=env_id, agent=agent))

@@ -51,7 +51,7 @@ DODGE_REFERENCE: dict[str, dict] = {
         "notes": "Share over the pedestrians that appeared >= 1 s before the episode ended.",
     },
     "fixation_latency_s": {
-        "value": 0.74, "low": 0.548, "high": 0.74, "tolerance": 0.3, "unit": "s", "group": "where",
+        "value": 0.74, "low": 0.548, "high": 0.74, "tolerance": 0.3, "unit": "s", "group": "where", "given": "pedestrian_fixated_share",
         "source": "Jovancevic, Sullivan & Hayhoe (REFERENCES.md [V]): first fixation 740 ms after a pedestrian "
                   "appeared, 548 ms for one veering onto a collision course",
         "notes": "Per episode the median over the fixated pedestrians, from appearance to the start of the first "

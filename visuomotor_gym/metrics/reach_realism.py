@@ -71,7 +71,7 @@ REACH_REFERENCE: dict[str, dict] = {
         "notes": "Median over reaches of the relative time of the peak speed within the reach.",
     },
     "gaze_hand_lead_s": {
-        "value": 0.56, "low": 0.3, "high": 0.8, "tolerance": 0.2, "unit": "s", "group": "where",
+        "value": 0.56, "low": 0.3, "high": 0.8, "tolerance": 0.2, "unit": "s", "group": "where", "given": "object_fixation_share",
         "source": "Land, Mennie & Rusted 1999 (REFERENCES.md, Reaching): gaze reaches an object ~0.56 s before "
                   "the hand acts on it; Johansson et al. 2001: gaze leads the hand. Range: our choice.",
         "notes": "Median over reached episodes of (hand arrival) - (first time gaze is within 5 deg of the object).",

@@ -16,6 +16,12 @@ How a set of episodes is scored (:func:`score_components`, used by every family)
   an eye that never lands on a stone has no human look-ahead. (Before issue 21 undefined components were
   dropped from the mean, so a still eye was never penalised for not moving.) Coverage stops a handful of
   stray episodes from scoring for the rest;
+* a component measured only on the rows or episodes where the eye was on a target (the look-ahead of the
+  rows whose gaze is on a stone, the latency of the pedestrians that were fixated) names that target's
+  share as its ``given``, and its score is capped by the score of the share: a look-ahead measured on the
+  few fixations that landed on a stone by chance says nothing about an eye that rarely looks at stones (a
+  random eye's chance hits land ~2 steps ahead as often as not, because any line of sight 30-50 deg down
+  lands there);
 * components are grouped: ``"moves"`` (when the eye moves: saccade rate, fixation durations, saccade
   latencies and timing locked to the task), ``"where"`` (where it lands: share of fixation time on the task's
   targets, look-ahead, foveation of the ball or the object) and, for the reach family, ``"hand"`` (the
@@ -116,7 +122,8 @@ def score_components(per_episode: Sequence[Mapping[str, float]], reference: Mapp
     combine (``"mean"`` or ``"median"``). Returns ``{"score", "components": {name: {"value", "score",
     "episodes"}}}``: ``value`` the reduced value (NaN when no episode defines it), ``score``
     :func:`score_component` times the coverage (defined episodes / scored episodes; 0 when undefined),
-    ``episodes`` the defining episodes; ``score`` the smallest group mean (NaN without episodes).
+    ``episodes`` the defining episodes, capped by the score of the component an entry names as ``given``;
+    ``score`` the smallest group mean (NaN without episodes).
     """
     if reduce not in ("mean", "median"):
         raise ValueError(f"reduce must be 'mean' or 'median', got {reduce!r}")
@@ -136,7 +143,16 @@ def score_components(per_episode: Sequence[Mapping[str, float]], reference: Mapp
         else:
             value, score = float("nan"), 0.0
         components[name] = {"value": value, "score": score if n else float("nan"), "episodes": int(ok.size)}
-        groups.setdefault(group, []).append(score)
+    for name, entry in reference.items():  # capped by the share it is measured on (module docstring)
+        given = entry.get("given")
+        if given is not None:
+            if given not in components or reference[given].get("given") is not None:
+                raise ValueError(f"reference entry {name!r}: 'given' must name an unconditional component of the "
+                                 f"table, got {given!r}")
+            if n:
+                components[name]["score"] = min(components[name]["score"], components[given]["score"])
+    for name, entry in reference.items():
+        groups.setdefault(entry["group"], []).append(components[name]["score"])
     total = min(float(np.mean(v)) for v in groups.values()) if n and groups else float("nan")
     return {"score": total, "components": components}
 

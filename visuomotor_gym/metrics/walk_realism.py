@@ -68,7 +68,7 @@ WALK_REFERENCE: dict[str, dict] = {
     },
     "fixation_while_crossing": {
         "value": 0.0, "low": 0.0, "high": 0.05, "tolerance": 0.1, "unit": "fraction of the crossing",
-        "group": "where",
+        "group": "where", "given": "obstacle_fixation_share",
         "source": "Patla & Vickers 1997: obstacles were not fixated while being stepped over, the planning was "
                   "done in the steps before (REFERENCES.md [V]); the 5 % allowance is our modelling choice",
         "notes": "Pelvis within one step of the obstacle; over the obstacles fixated during their approach "
@@ -86,7 +86,7 @@ WALK_REFERENCE: dict[str, dict] = {
                  "ahead of the eye.",
     },
     "travel_fixation_distance_m": {
-        "value": 1.5, "low": 1.0, "high": 2.0, "tolerance": 0.5, "unit": "m", "group": "where",
+        "value": 1.5, "low": 1.0, "high": 2.0, "tolerance": 0.5, "unit": "m", "group": "where", "given": "path_fixation_share",
         "source": "Patla & Vickers 1997: travel fixations 1-2 m ahead of the feet (REFERENCES.md [V])",
         "notes": "The look-ahead: median horizontal eye-to-gaze-point distance while gaze is on the floor and "
                  "on no obstacle.",
