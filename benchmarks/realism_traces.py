@@ -102,8 +102,25 @@ def record(env_id: str, agent: str, episodes: int, path: str) -> None:
     print(f"{env_id} {agent}: {ok}/{episodes} succeeded, {time.time() - start:.0f} s -> {path}", flush=True)
 
 
+def family_reference(env_id: str) -> dict:
+    """The realism table of an env id's family."""
+    from visuomotor_gym.registration import family_of
+
+    family = family_of(env_id)
+    if family == "catch":
+        from visuomotor_gym.metrics.realism import load_reference
+
+        return load_reference()
+    module, name = {"reach": ("reach_realism", "REACH_REFERENCE"), "walk": ("walk_realism", "WALK_REFERENCE"),
+                    "stones": ("stones_realism", "STONES_REFERENCE"), "dodge": ("dodge_realism", "DODGE_REFERENCE")}[family]
+    import importlib
+
+    return getattr(importlib.import_module(f"visuomotor_gym.metrics.{module}"), name)
+
+
 def score(paths: list[str]) -> None:
     from visuomotor_gym.bench.trace import load_traces
+    from visuomotor_gym.metrics.realism import group_scores
     from visuomotor_gym.metrics.summary import summarize
 
     for path in paths:
@@ -113,7 +130,9 @@ def score(paths: list[str]) -> None:
         comps = {k: (None if v["value"] is None else round(v["value"], 3), None if v["score"] is None else
                      round(v["score"], 2), v["episodes"]) for k, v in real["components"].items()}
         sc = real["score"]
-        print(f"{path}: success {s['success_rate']:.2f} realism {sc if sc is None else round(sc, 3)}")
+        groups = group_scores(real, family_reference(traces[0].env_id))
+        print(f"{path}: success {s['success_rate']:.2f} realism {sc if sc is None else round(sc, 3)} groups "
+              + " ".join(f"{g} {v:.2f}" for g, v in groups.items()))
         print("   ", json.dumps(comps))
 
 

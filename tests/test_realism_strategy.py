@@ -65,7 +65,7 @@ def make(env_id, t, gaze, eye, onsets, head=None, success=True, **task) -> Episo
                         truncated=False, task=task)
 
 
-def piecewise(t, onsets, targets):
+def piecewise(t, onsets):
     """Per row, the index of the fixation in progress: 0 before the first onset, i after onset i."""
     rows = [int(round(s / DT)) + 1 for s in onsets]
     return np.searchsorted(np.asarray(rows), np.arange(len(t)), side="right")
@@ -83,7 +83,7 @@ def random_onsets(rng, duration, start=0.02):
 
 def random_gaze(rng, t, onsets, el=(-60.0, 20.0)):
     """A line of sight that jumps to a uniformly random direction at every onset (az within +-60 deg)."""
-    k = piecewise(t, onsets, None)
+    k = piecewise(t, onsets)
     dirs = direction(rng.uniform(-60.0, 60.0, len(onsets) + 1), rng.uniform(*el, len(onsets) + 1))
     return dirs[k]
 
@@ -162,7 +162,7 @@ def walk_trace(kind, seed=0):
     travel = unit(np.tile([1.5, 0.0, -1.6], (len(t), 1)))  # the floor 1.5 m ahead, carried with the body
     if kind == "human":  # a saccade every 0.3 s; every fifth fixation during an approach goes to the obstacle
         onsets = list(np.round(np.arange(0.3, t[-1], 0.3), 10))
-        fix = piecewise(t, onsets, None)
+        fix = piecewise(t, onsets)
         gaze = travel.copy()
         for ob in OBSTACLES:
             near = ob[0] - 0.5 * ob[2]
@@ -424,6 +424,5 @@ def test_lookahead_scores_high_and_its_held_twin_low_on_real_episodes():
     full, blind = stones_gaze_realism(looking), stones_gaze_realism(held)
     assert full["score"] >= 0.85, full
     assert blind["score"] <= 0.5, blind
-    assert blind["components"]["fixation_duration_s"] == {"value": float("nan"), "score": 0.0, "episodes": 0} or (
-        blind["components"]["fixation_duration_s"]["episodes"] == 0 and blind["components"]["fixation_duration_s"][
-            "score"] == 0.0)
+    held = blind["components"]["fixation_duration_s"]  # the held eye never saccades: undefined, scored 0
+    assert held["episodes"] == 0 and held["score"] == 0.0
