@@ -21,7 +21,13 @@ from visuomotor_gym.metrics import gaze as G
 from visuomotor_gym.metrics import strategy
 from visuomotor_gym.metrics.dodge_realism import DODGE_REFERENCE, dodge_gaze_realism
 from visuomotor_gym.metrics.reach_realism import REACH_REFERENCE, reach_measures, reach_realism
-from visuomotor_gym.metrics.realism import GROUPS, gaze_realism, load_reference, score_component, score_components
+from visuomotor_gym.metrics.realism import (
+    GROUPS,
+    gaze_realism,
+    load_reference,
+    score_component,
+    score_components,
+)
 from visuomotor_gym.metrics.stones_realism import STONES_REFERENCE, stone_fixation_share, stones_gaze_realism
 from visuomotor_gym.metrics.walk_realism import WALK_REFERENCE, path_fixation_share, walk_gaze_realism
 
@@ -48,7 +54,7 @@ def saccade_rows(t, onsets, rows=2):
     flying = np.zeros(len(t), dtype=bool)
     ks = []
     for s in onsets:
-        k = int(round(s / DT)) + 1
+        k = round(s / DT) + 1
         if k < len(t):
             onset[k] = True
             flying[k:k + rows] = True
@@ -67,7 +73,7 @@ def make(env_id, t, gaze, eye, onsets, head=None, success=True, **task) -> Episo
 
 def piecewise(t, onsets):
     """Per row, the index of the fixation in progress: 0 before the first onset, i after onset i."""
-    rows = [int(round(s / DT)) + 1 for s in onsets]
+    rows = [round(s / DT) + 1 for s in onsets]
     return np.searchsorted(np.asarray(rows), np.arange(len(t)), side="right")
 
 

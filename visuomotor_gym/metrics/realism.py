@@ -30,8 +30,10 @@ How a set of episodes is scored (:func:`score_components`, used by every family)
   a human eye and looks where humans look. The two cheap ways to imitate one group fail the other: a
   still or body-locked eye (held twin, best static posture) can sit where humans look most of the time
   (a pitch of 40 deg down lands 1.9 m ahead, on the travel path) but makes no saccades, so its
-  ``moves`` group is ~0; a random eye saccades at a human-like rate but its fixations fall on the task's
-  targets only by chance, so its ``where`` group is low. A mean over all components (the score before
+  ``moves`` group is ~0 (where a body-locked eye does saccade at a human rate, re-centring as a walker's
+  pelvis turns on the stepping stones, its fixations sweep past the targets and its ``where`` group
+  fails); a random eye saccades at a human-like rate but its fixations fall on the task's targets only
+  by chance, so its ``where`` group is low. A mean over all components (the score before
   issue 21) let either of them bank the other group's points: a still eye scored 0.97-1.0 on three
   families. The minimum, not a product or a geometric mean, because a product punishes a human-like
   agent twice for one weak group and a geometric mean of two groups still gives sqrt(0.25) = 0.5 to an
