@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import json
 import math
-import tomllib
 from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
 import pytest
+import tomllib
 
 import visuomotor_gym  # noqa: F401
 from visuomotor_gym.agents import GazeBlind, is_deterministic, make_agent, match_vision, parse_agent_spec

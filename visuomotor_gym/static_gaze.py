@@ -76,7 +76,7 @@ class EyeGeometry:
         return self.eye_el_deg[0] + self.neck_pitch_deg[0], self.eye_el_deg[1] + self.neck_pitch_deg[1]
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def env_geometry(env_id: str) -> EyeGeometry:
     """The :class:`EyeGeometry` of a registered id (its env built once per process)."""
     import gymnasium as gym
@@ -193,7 +193,7 @@ def posture_from_overrides(overrides: dict) -> Posture:
                          "az=<deg>,el=<deg>[,neck_yaw=<deg>,neck_pitch=<deg>,fix=<m>]")
     for key, value in overrides.items():
         if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise ValueError(f"static_gaze posture: {key} must be a number, got {value!r}")
+            raise ValueError(f"static_gaze posture: {key} must be a number, got {value!r}")  # noqa: TRY004 (a spec's text)
     return Posture(**{k: float(v) for k, v in overrides.items()})
 
 
@@ -353,9 +353,27 @@ def _los_posture(az: float, el: float, geometry: EyeGeometry) -> Posture | None:
         return None
 
 
+RACE_MIN_EPISODES = 4  # modelling choice: no posture is dropped on fewer episodes
+RACE_Z = 1.96  # the Wilson interval's 95 % upper bound (two-sided z)
+
+
+def wilson_upper(successes: int, n: int, z: float = RACE_Z) -> float:
+    """The Wilson score interval's upper bound of a success rate (Wilson 1927)."""
+    if n == 0:
+        return 1.0
+    p = successes / n
+    centre = p + z * z / (2 * n)
+    spread = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n))
+    return (centre + spread) / (1 + z * z / n)
+
+
 class _Scorer:
     """Plays postures on the design seeds with the common evaluator's chunk layout and remembers
-    every result (seed by seed, so a posture played on 16 seeds extends to 40 without replaying)."""
+    every result seed by seed (a posture played on 16 seeds extends to 40 without replaying).
+
+    A posture stops early once it can no longer reach ``bar`` successes even if every remaining
+    episode succeeds (``bar``: the k-th best complete score so far, so the pruning never changes which
+    postures make the top k; ties continue, as the tie rule might favour the newcomer)."""
 
     def __init__(self, env_id: str, agent: str, design_seed: int, log=None):
         from visuomotor_gym.bench.evaluate import make_env
@@ -365,32 +383,56 @@ class _Scorer:
         self.results: dict[Posture, list[bool]] = {}
         self.stage_of: dict[Posture, str] = {}
         self.log = log or (lambda *_: None)
+        self.episodes_played = 0
 
-    def play(self, posture: Posture, episodes: int, stage: str) -> int:
-        """Successes of ``posture`` on the first ``episodes`` design seeds."""
+    def play(self, posture: Posture, episodes: int, stage: str, bar: int = 0, race: float = 0.0) -> bool:
+        """Play ``posture`` on the first ``episodes`` design seeds unless it cannot reach ``bar``
+        successes, or (after :data:`RACE_MIN_EPISODES`) the Wilson upper bound of its success rate
+        is below ``race``; returns whether it played them all."""
         from visuomotor_gym.bench.evaluate import episode_chunks, episode_seeds, run_chunk
 
         have = self.results.setdefault(posture, [])
         self.stage_of.setdefault(posture, stage)
-        if len(have) < episodes:
-            spec = static_gaze_spec(posture, self.agent)
-            seeds = episode_seeds(self.design_seed, episodes)
-            # evaluate()'s chunks for this many episodes; only the seeds not played yet are run
-            for chunk in episode_chunks(episodes):
-                chunk_seeds = [seeds[i] for i in chunk]
-                if chunk_seeds[-1] < self.design_seed + len(have):
-                    continue
-                if chunk_seeds[0] < self.design_seed + len(have):  # a chunk layout that changed: replay it
-                    del have[chunk_seeds[0] - self.design_seed:]
-                have.extend(tr.success for tr in run_chunk(spec, self.env_id, chunk_seeds, env=self.env))
-            self.log(f"{stage:>8} {posture.as_spec():<55} {sum(have[:episodes]):>3}/{episodes}")
-        return sum(have[:episodes])
+        before = len(have)
+        spec = static_gaze_spec(posture, self.agent)
+        seeds = episode_seeds(self.design_seed, episodes)
+        for chunk in episode_chunks(episodes):  # evaluate()'s chunks for this many episodes
+            chunk_seeds = [seeds[i] for i in chunk]
+            if chunk_seeds[-1] < self.design_seed + len(have):
+                continue  # played already
+            if chunk_seeds[0] < self.design_seed + len(have):  # a chunk layout that changed: replay it
+                del have[chunk_seeds[0] - self.design_seed:]
+            if sum(have) + episodes - len(have) < bar:
+                break
+            if len(have) >= RACE_MIN_EPISODES and wilson_upper(sum(have), len(have)) < race:
+                break
+            have.extend(tr.success for tr in run_chunk(spec, self.env_id, chunk_seeds, env=self.env))
+            self.episodes_played += len(chunk_seeds)
+        complete = len(have) >= episodes
+        if len(have) > before or not complete:
+            self.log(f"{stage:>9} {posture.as_spec():<55} {sum(have[:episodes]):>3}/{min(len(have), episodes):<3}"
+                     + ("" if complete else f" stopped (bar {bar}/{episodes}, race {race:.3f})"))
+        return complete
+
+    def complete(self, postures, episodes: int) -> list[Posture]:
+        return [p for p in postures if len(self.results.get(p, ())) >= episodes]
 
     def rank(self, postures, episodes: int) -> list[Posture]:
-        """Best first: more successes on ``episodes`` seeds, then nearer straight ahead, then the
-        neck nearer straight ahead (the tie rule)."""
-        return sorted(postures, key=lambda p: (-sum(self.results[p][:episodes]), p.distance_from_ahead_deg(),
-                                               abs(p.neck_yaw) + abs(p.neck_pitch), p.az, p.el))
+        """The postures played on ``episodes`` seeds, best first: more successes, then the line of
+        sight nearer straight ahead, then the neck nearer straight ahead (the tie rule)."""
+        return sorted(self.complete(postures, episodes),
+                      key=lambda p: (-sum(self.results[p][:episodes]), p.distance_from_ahead_deg(),
+                                     abs(p.neck_yaw) + abs(p.neck_pitch), p.az, p.el))
+
+    def best_rate(self, episodes: int) -> float:
+        """The best complete success rate on ``episodes`` seeds (0 while none is complete)."""
+        ranked = self.rank(list(self.results), episodes)
+        return sum(self.results[ranked[0]][:episodes]) / episodes if ranked else 0.0
+
+    def bar(self, episodes: int, k: int) -> int:
+        """The k-th best complete score on ``episodes`` seeds (0 while fewer than k are complete)."""
+        ranked = self.rank(list(self.results), episodes)
+        return sum(self.results[ranked[k - 1]][:episodes]) if len(ranked) >= k else 0
 
     def close(self):
         self.env.close()
@@ -402,27 +444,33 @@ def search(env_id: str, agent: str, *, design_seed: int = DESIGN_SEED, coarse_ep
            command: str | None = None, log=None) -> dict:
     """Search the best static posture of ``agent`` on ``env_id``; returns the results record.
 
-    Stages (every posture is played with :func:`visuomotor_gym.bench.evaluate.run_chunk` in
-    ``evaluate()``'s chunk layout, episode ``i`` on seed ``design_seed + i``):
+    Every posture is played with :func:`visuomotor_gym.bench.evaluate.run_chunk` in ``evaluate()``'s
+    chunk layout, episode ``i`` on seed ``design_seed + i`` (so ``evaluate(spec, env_id, n,
+    design_seed)`` replays it). Stages:
 
     1. ``coarse``: the line of sight on a ``coarse_step`` grid over the eye+neck range (straight up or
-       down once), the neck along it (within its range), on ``coarse_episodes`` seeds;
+       down once), the neck along it (within its range), on ``coarse_episodes`` seeds, nearest
+       straight ahead first;
     2. ``refine<step>`` for each of ``refine_steps``: the 8 neighbours at +-step around the
        ``refine_top`` best so far, neck along, on ``coarse_episodes`` seeds;
     3. ``final``: the ``finalists`` best so far extended to ``final_episodes`` seeds;
     4. ``neck``: at the best final line of sight, the neck at +-``neck_step`` (yaw, pitch, both) around
        the along-the-line-of-sight neck (the postures the eye can hold; none when ``neck_step`` is 0),
-       on ``coarse_episodes`` seeds; its ``refine_top`` best extended to ``final_episodes`` seeds.
+       on ``final_episodes`` seeds.
 
-    The chosen posture is the best on ``final_episodes`` seeds; ties go to the higher success, then
-    the line of sight nearer straight ahead, then the neck nearer straight ahead. ``postures``: an
-    explicit list instead of the grid (every one on ``final_episodes`` seeds; for tests).
+    A posture stops early once it cannot reach the score that selection needs (stages 1-2: the
+    ``max(refine_top, finalists)``-th best on ``coarse_episodes`` seeds; 3-4: the best on
+    ``final_episodes`` seeds), which never changes the selection (see :class:`_Scorer`), or, in
+    stages 1, 2 and 4, once the Wilson 95 % upper bound of its rate (after 4 episodes) is below the
+    best complete rate so far (racing: a posture clearly worse than the best is not played out). The chosen
+    posture is the best on ``final_episodes`` seeds; ties go to the line of sight nearer straight
+    ahead, then the neck nearer straight ahead. ``postures``: an explicit list instead of the grid
+    (each on ``final_episodes`` seeds, no early stop; for tests).
     """
     from visuomotor_gym.bench.evaluate import check_env_id
     from visuomotor_gym.bench.provenance import provenance
 
     env_id = check_env_id(env_id)
-    parse_agent_spec(agent)
     if parse_agent_spec(agent)[0] in ("static_gaze", "gaze_blind", "fixed_gaze"):
         raise ValueError(f"search takes an agent with its own gaze, got {agent!r}")
     if not 1 <= coarse_episodes <= final_episodes:
@@ -431,20 +479,25 @@ def search(env_id: str, agent: str, *, design_seed: int = DESIGN_SEED, coarse_ep
     started = time.perf_counter()
     scorer = _Scorer(env_id, agent, design_seed, log=log)
     stages = []
+    keep = max(refine_top, finalists)
     try:
         if postures is not None:
-            explicit = [check_posture(p, geometry) for p in postures]
-            for p in explicit:
+            final = [check_posture(p, geometry) for p in postures]
+            for p in final:
                 scorer.play(p, final_episodes, "explicit")
-            stages.append({"name": "explicit", "episodes": final_episodes, "postures": len(explicit)})
-            final = explicit
+            stages.append({"name": "explicit", "episodes": final_episodes, "postures": len(final)})
         else:
             coarse = [p for el in _grid(*geometry.los_el_deg, coarse_step) for az in _grid(*geometry.los_az_deg, coarse_step)
                       if (abs(el) < 90.0 or az == 0.0) and (p := _los_posture(az, el, geometry)) is not None]
+            coarse.sort(key=lambda p: (p.distance_from_ahead_deg(), p.az, p.el))
             for p in coarse:
-                scorer.play(p, coarse_episodes, "coarse")
+                scorer.play(p, coarse_episodes, "coarse", bar=scorer.bar(coarse_episodes, keep),
+                            race=scorer.best_rate(coarse_episodes))
             stages.append({"name": "coarse", "step_deg": coarse_step, "episodes": coarse_episodes,
-                           "neck": "along the line of sight, within its range", "postures": len(coarse)})
+                           "neck": "along the line of sight, within its range", "postures": len(coarse),
+                           "az_deg": [min(p.az for p in coarse), max(p.az for p in coarse)],
+                           "el_deg": [min(p.el for p in coarse), max(p.el for p in coarse)],
+                           "early_stop_rank": keep})
             for step in refine_steps:
                 centres = scorer.rank(list(scorer.results), coarse_episodes)[:refine_top]
                 new = []
@@ -455,17 +508,20 @@ def search(env_id: str, agent: str, *, design_seed: int = DESIGN_SEED, coarse_ep
                             if p is not None and p not in scorer.results and p not in new:
                                 new.append(p)
                 for p in new:
-                    scorer.play(p, coarse_episodes, f"refine{step:g}")
+                    scorer.play(p, coarse_episodes, f"refine{step:g}", bar=scorer.bar(coarse_episodes, keep),
+                                race=scorer.best_rate(coarse_episodes))
                 stages.append({"name": f"refine{step:g}", "step_deg": step, "episodes": coarse_episodes,
-                               "around": [c.as_spec() for c in centres], "postures": len(new)})
-            final = scorer.rank(list(scorer.results), coarse_episodes)[:finalists]
-            for p in final:
-                scorer.play(p, final_episodes, "final")
-            stages.append({"name": "final", "episodes": final_episodes, "postures": len(final)})
-            best = scorer.rank(final, final_episodes)[0]
+                               "around": [c.as_spec() for c in centres], "postures": len(new),
+                               "early_stop_rank": keep})
+            best_coarse = scorer.rank(list(scorer.results), coarse_episodes)[:finalists]
+            for p in best_coarse:
+                scorer.play(p, final_episodes, "final", bar=scorer.bar(final_episodes, 1))
+            stages.append({"name": "final", "episodes": final_episodes,
+                           "postures": [p.as_spec() for p in best_coarse], "early_stop_rank": 1})
+            best = scorer.rank(best_coarse, final_episodes)[0]
             ny0, np0 = neck_along(best.az, best.el, geometry)
-            necks = []
             offsets = (-neck_step, 0.0, neck_step) if neck_step > 0 else (0.0,)
+            necks = []
             for ny in sorted({ny0 + k for k in offsets}):
                 for npitch in sorted({np0 + k for k in offsets}):
                     p = Posture(best.az, best.el, float(ny), float(npitch))
@@ -473,17 +529,15 @@ def search(env_id: str, agent: str, *, design_seed: int = DESIGN_SEED, coarse_ep
                         check_posture(p, geometry)
                     except ValueError:
                         continue
-                    if p not in final:
+                    if p not in scorer.results:
                         necks.append(p)
             for p in necks:
-                scorer.play(p, coarse_episodes, "neck")
-            top_necks = scorer.rank(necks, coarse_episodes)[:refine_top]
-            for p in top_necks:
-                scorer.play(p, final_episodes, "neck")
-            stages.append({"name": "neck", "step_deg": neck_step, "episodes": coarse_episodes,
-                           "final_episodes_for_best": refine_top,
-                           "line_of_sight": {"az": best.az, "el": best.el}, "postures": len(necks)})
-            final = final + top_necks
+                scorer.play(p, final_episodes, "neck", bar=scorer.bar(final_episodes, 1),
+                            race=scorer.best_rate(final_episodes))
+            stages.append({"name": "neck", "step_deg": neck_step, "episodes": final_episodes,
+                           "line_of_sight": {"az": best.az, "el": best.el}, "postures": len(necks),
+                           "early_stop_rank": 1})
+            final = best_coarse + necks
         chosen = scorer.rank(final, final_episodes)[0]
     finally:
         scorer.close()
@@ -502,10 +556,16 @@ def search(env_id: str, agent: str, *, design_seed: int = DESIGN_SEED, coarse_ep
         "rules": {"dead_band_deg": DEAD_BAND_DEG, "fixation_m": DEFAULT_FIXATION_M,
                   "ties": "higher success, then the line of sight nearer straight ahead, then the neck nearer "
                           "straight ahead",
+                  "early_stop": "a posture stops once successes + remaining episodes < the score of the "
+                                "stage's early_stop_rank-th best complete posture (it can no longer be selected), "
+                                f"or (coarse, refine and neck stages, after {RACE_MIN_EPISODES} episodes) once the "
+                                "Wilson 95 % upper bound of its success rate is below the best complete rate of "
+                                "the stage's episode count (racing; stopped postures are not ranked)",
                   "evaluator": "visuomotor_gym.bench.evaluate.run_chunk in evaluate()'s chunk layout: the same "
                                "per-seed outcomes as evaluate(spec, env_id, episodes, design_seed)"},
         "postures": [{**asdict(p), "stage": scorer.stage_of[p], "successes": sum(r), "episodes": len(r)}
                      for p, r in scorer.results.items()],
+        "episodes_played": scorer.episodes_played,
         "wall_time_s": round(wall, 1),
         "provenance": provenance(command),
     }
@@ -542,6 +602,22 @@ def update_postures(record: dict, path: Path | None = None, source: str | None =
     path.write_text(json.dumps(data, indent=2) + "\n")
 
 
+def summary_table(folder: Path) -> str:
+    """A markdown table of every search results JSON in ``folder`` (env, agent, posture, rates)."""
+    rows = ["| env id | agent | posture (deg; fixation m) | design seeds | pinned seeds 0-199 | search wall time |",
+            "|---|---|---|---|---|---|"]
+    for path in sorted(Path(folder).glob("*__*.json")):
+        r = json.loads(path.read_text())
+        c = r["chosen"]
+        pinned = r.get("pinned")
+        pinned_text = (f"{pinned['successes']}/{pinned['episodes']} ({100 * pinned['success']:.1f} %)"
+                       if pinned else "not run")
+        rows.append(f"| {r['env_id']} | `{r['agent']}` | `{Posture(**{k: c[k] for k in POSTURE_KEYS}).as_spec()}` | "
+                    f"{c['successes']}/{c['episodes']} ({100 * c['success']:.1f} %) | {pinned_text} | "
+                    f"{r['wall_time_s'] / 60:.0f} min |")
+    return "\n".join(rows) + "\n"
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="python -m visuomotor_gym.static_gaze",
                                      description="Search an agent's best static gaze-and-head posture.")
@@ -571,7 +647,17 @@ def main(argv=None) -> int:
     p.add_argument("--episodes", type=int, default=200)
     p.add_argument("--workers", type=int, default=1)
     p.add_argument("--update-postures", action="store_true")
+    t = sub.add_parser("summary", help="write a markdown table of the results JSONs in a folder")
+    t.add_argument("folder")
+    t.add_argument("--out", default=None, help="markdown file (default: print)")
     args = parser.parse_args(argv)
+    if args.command == "summary":
+        table = summary_table(Path(args.folder))
+        if args.out:
+            Path(args.out).write_text(table)
+        else:
+            print(table, end="")
+        return 0
     command = "python -m visuomotor_gym.static_gaze " + " ".join(sys.argv[1:] if argv is None else argv)
     if args.command == "pinned":
         path = Path(args.results)
