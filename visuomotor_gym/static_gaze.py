@@ -604,7 +604,15 @@ def update_postures(record: dict, path: Path | None = None, source: str | None =
 
 def summary_table(folder: Path) -> str:
     """A markdown table of every search results JSON in ``folder`` (env, agent, posture, rates)."""
-    rows = ["| env id | agent | posture (deg; fixation m) | design seeds | pinned seeds 0-199 | search wall time |",
+    rows = ["# Best static twins (`static_gaze:<agent>`)", "",
+            "Each agent with its gaze, fixation and head held at one body-frame posture (line of sight "
+            "`az`/`el`, neck `neck_yaw`/`neck_pitch`, degrees, positive = left/up; fixation `fix`, m), the "
+            "posture searched on the design seeds (100000-100039) by `python -m visuomotor_gym.static_gaze "
+            "search` (its command, grid, stages and every posture's score are in the JSON next to this file), "
+            "then played on the 200 pinned seeds (0-199) with the common evaluator. Regenerate this table "
+            "with `python -m visuomotor_gym.static_gaze summary docs/reproductions/data/static_gaze --out "
+            "docs/reproductions/data/static_gaze/summary.md`.", "",
+            "| env id | agent | posture (deg; fixation m) | design seeds | pinned seeds 0-199 | search wall time |",
             "|---|---|---|---|---|---|"]
     for path in sorted(Path(folder).glob("*__*.json")):
         r = json.loads(path.read_text())
