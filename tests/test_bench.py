@@ -407,7 +407,8 @@ def test_bench_command_bad_arguments(tmp_path, capsys):
 
 
 def test_bench_gaze_gain_plays_the_twin_on_the_same_seeds(tmp_path):
-    """`vmgym bench --gaze-gain`: the twin (gaze_blind:<agent>) on the same seeds; gain = success - twin's."""
+    """`vmgym bench --gaze-gain`: both twins (gaze_blind:<agent>, and static_gaze:<agent> at its searched
+    posture, written out) on the same seeds; gain = success - the better twin's."""
     import json
     import subprocess
     import sys
@@ -424,8 +425,18 @@ def test_bench_gaze_gain_plays_the_twin_on_the_same_seeds(tmp_path):
     assert gain["twin_agent"] == "gaze_blind:eyecatch"
     twin = evaluate("gaze_blind:eyecatch", "EyeCatch-v0", 6, 0)
     assert gain["twin_success_rate"] == twin.summary["success_rate"]
-    assert gain["gain"] == pytest.approx(results["success_rate"] - gain["twin_success_rate"])
-    assert "gaze gain" in proc.stdout and "--gaze-gain" in results["provenance"]["command"]
+    from visuomotor_gym.bench.evaluate import static_twin_spec
+
+    static = static_twin_spec("eyecatch", "EyeCatch-v0")
+    assert gain["static_twin_agent"] == static and static.startswith("static_gaze:az=")
+    static_run = evaluate(static, "EyeCatch-v0", 6, 0)
+    assert gain["static_twin_success_rate"] == static_run.summary["success_rate"]
+    best = max(gain["twin_success_rate"], gain["static_twin_success_rate"])
+    assert gain["gain"] == pytest.approx(results["success_rate"] - best)
+    assert gain["held_difference"] == pytest.approx(results["success_rate"] - gain["twin_success_rate"])
+    assert gain["definition"] == "best_twin"
+    assert "gaze gain" in proc.stdout and "best static twin" in proc.stdout
+    assert "--gaze-gain" in results["provenance"]["command"]
     # a forged gain is refused by the results validator
     from visuomotor_gym.bench.results import ResultsError, validate_results
 
@@ -517,6 +528,13 @@ def test_the_twin_of_a_twin_is_refused():
     for spec in ("fixed_gaze", "gaze_blind:eyecatch"):
         with pytest.raises(ValueError, match="already a gaze-blind agent"):
             twin_spec(spec)
+    from visuomotor_gym.bench.evaluate import static_twin_spec
+
+    for spec in ("fixed_gaze", "gaze_blind:eyecatch", "static_gaze:eyecatch"):
+        with pytest.raises(ValueError, match="already a twin"):
+            static_twin_spec(spec, "EyeCatch-v0")
+    with pytest.raises(ValueError):  # no posture was searched for this agent on this id
+        static_twin_spec("random", "EyeCatch-v0")
 
 
 def test_summary_rows_speak_each_familys_terms():

@@ -210,7 +210,7 @@ BACKENDS = ("local", "ray")
 def twin_spec(agent: str) -> str:
     """The gaze-blind twin of an agent spec: the same agent with its gaze and head held
     (``gaze_blind:<spec>``; ``fixed_gaze`` is already the twin of ``eyecatch``)."""
-    if agent == "fixed_gaze" or agent.startswith("gaze_blind:"):
+    if agent == "fixed_gaze" or agent.startswith(("gaze_blind:", "static_gaze:")):
         raise ValueError(f"{agent!r} is already a gaze-blind agent: it has no twin")
     return f"gaze_blind:{agent}"
 
