@@ -407,7 +407,8 @@ def test_bench_command_bad_arguments(tmp_path, capsys):
 
 
 def test_bench_gaze_gain_plays_the_twin_on_the_same_seeds(tmp_path):
-    """`vmgym bench --gaze-gain`: the twin (gaze_blind:<agent>) on the same seeds; gain = success - twin's."""
+    """`vmgym bench --gaze-gain`: both twins (gaze_blind:<agent>, and static_gaze:<agent> at its searched
+    posture, written out) on the same seeds; gain = success - the better twin's."""
     import json
     import subprocess
     import sys
@@ -424,14 +425,100 @@ def test_bench_gaze_gain_plays_the_twin_on_the_same_seeds(tmp_path):
     assert gain["twin_agent"] == "gaze_blind:eyecatch"
     twin = evaluate("gaze_blind:eyecatch", "EyeCatch-v0", 6, 0)
     assert gain["twin_success_rate"] == twin.summary["success_rate"]
-    assert gain["gain"] == pytest.approx(results["success_rate"] - gain["twin_success_rate"])
-    assert "gaze gain" in proc.stdout and "--gaze-gain" in results["provenance"]["command"]
+    from visuomotor_gym.bench.evaluate import static_twin_spec
+
+    static = static_twin_spec("eyecatch", "EyeCatch-v0")
+    assert gain["static_twin_agent"] == static and static.startswith("static_gaze:az=")
+    static_run = evaluate(static, "EyeCatch-v0", 6, 0)
+    assert gain["static_twin_success_rate"] == static_run.summary["success_rate"]
+    best = max(gain["twin_success_rate"], gain["static_twin_success_rate"])
+    assert gain["gain"] == pytest.approx(results["success_rate"] - best)
+    assert gain["held_difference"] == pytest.approx(results["success_rate"] - gain["twin_success_rate"])
+    assert gain["definition"] == "best_twin"
+    assert "gaze gain" in proc.stdout and "best static twin" in proc.stdout
+    assert "--gaze-gain" in results["provenance"]["command"]
     # a forged gain is refused by the results validator
     from visuomotor_gym.bench.results import ResultsError, validate_results
 
     results["gaze_gain"]["gain"] = 0.9
     with pytest.raises(ResultsError, match="gain"):
         validate_results(results)
+
+
+def _gain_results(k_agent=180, k_held=40, k_static=150, n=200):
+    """A valid results object of a committed run with a hand-written two-twin gaze_gain block."""
+    import json
+    from pathlib import Path
+
+    from visuomotor_gym.metrics import wilson_interval
+
+    root = Path(__file__).resolve().parents[1]
+    obj = json.loads((root / "docs/reproductions/data/dodge_fajen_warren_200.json").read_text())
+    assert obj["episodes"] == n
+    ci = lambda k: [float(x) for x in wilson_interval(k, n)]  # noqa: E731
+    obj.update(caught=k_agent, catch_rate=k_agent / n, catch_rate_ci95=ci(k_agent), success_rate=k_agent / n,
+               success_rate_ci95=ci(k_agent))
+    obj["gaze_gain"] = {
+        "twin_agent": "gaze_blind:fajen_warren", "twin_successes": k_held, "twin_success_rate": k_held / n,
+        "twin_success_rate_ci95": ci(k_held),
+        "static_twin_agent": "static_gaze:az=30,el=-5,neck_yaw=0,neck_pitch=0,fix=3:fajen_warren",
+        "static_twin_successes": k_static, "static_twin_success_rate": k_static / n,
+        "static_twin_success_rate_ci95": ci(k_static), "definition": "best_twin",
+        "held_difference": (k_agent - k_held) / n, "gain": (k_agent - max(k_held, k_static)) / n,
+    }
+    return obj
+
+
+def test_gaze_gain_is_success_minus_the_better_twin_and_a_forged_claim_is_refused():
+    """The gain is success - max(held twin, best static twin); the held-twin difference keeps its own
+    name; the validator recomputes both from the twins' counts and refuses any other claim."""
+    from visuomotor_gym.bench.results import ResultsError, validate_results
+
+    ok = _gain_results()
+    validate_results(ok)
+    assert ok["gaze_gain"]["gain"] == pytest.approx(0.15) and ok["gaze_gain"]["held_difference"] == pytest.approx(0.70)
+    forged = [
+        ("gain", 0.70, "gain"),  # the held-twin difference claimed as the gain
+        ("held_difference", 0.5, "held_difference"),
+        ("static_twin_success_rate", 0.5, "static_twin_success_rate"),  # not 150/200
+        ("definition", "held", "definition"),
+    ]
+    for key, value, match in forged:
+        bad = _gain_results()
+        bad["gaze_gain"][key] = value
+        with pytest.raises(ResultsError, match=match):
+            validate_results(bad)
+    # the static twin is the better twin only when it is: with a held twin above it, the gain uses the held one
+    flip = _gain_results(k_held=160, k_static=100)
+    validate_results(flip)
+    assert flip["gaze_gain"]["gain"] == pytest.approx(0.10)
+    # a static twin's fields come together
+    partial = _gain_results()
+    del partial["gaze_gain"]["static_twin_successes"]
+    with pytest.raises(ResultsError):
+        validate_results(partial)
+
+
+def test_legacy_held_only_gaze_gain_still_validates():
+    """Results written before the static twin existed (committed files) keep validating as 'held'."""
+    from visuomotor_gym.bench.results import validate_results
+
+    legacy = _gain_results()
+    g = legacy["gaze_gain"]
+    for key in ("static_twin_agent", "static_twin_successes", "static_twin_success_rate",
+                "static_twin_success_rate_ci95", "held_difference", "definition"):
+        del g[key]
+    g["gain"] = legacy["success_rate"] - g["twin_success_rate"]
+    validate_results(legacy)
+
+
+def test_static_twin_base_reads_both_spellings():
+    from visuomotor_gym.bench.evaluate import static_twin_base
+
+    assert static_twin_base("static_gaze:iwao") == "iwao"
+    assert static_twin_base("static_gaze:az=0,el=-20:iwao") == "iwao"
+    assert static_twin_base("static_gaze:az=0,el=-20:eyecatch:alpha=1") == "eyecatch:alpha=1"
+    assert static_twin_base("gaze_blind:iwao") is None and static_twin_base("iwao") is None
 
 
 def test_the_twin_of_a_twin_is_refused():
@@ -441,6 +528,13 @@ def test_the_twin_of_a_twin_is_refused():
     for spec in ("fixed_gaze", "gaze_blind:eyecatch"):
         with pytest.raises(ValueError, match="already a gaze-blind agent"):
             twin_spec(spec)
+    from visuomotor_gym.bench.evaluate import static_twin_spec
+
+    for spec in ("fixed_gaze", "gaze_blind:eyecatch", "static_gaze:eyecatch"):
+        with pytest.raises(ValueError, match="already a twin"):
+            static_twin_spec(spec, "EyeCatch-v0")
+    with pytest.raises(ValueError):  # no posture was searched for this agent on this id
+        static_twin_spec("random", "EyeCatch-v0")
 
 
 def test_summary_rows_speak_each_familys_terms():

@@ -30,7 +30,6 @@ COMPONENTS = (
     "ball_foveation",
     "head_contribution",
     "saccade_hand_synchrony",
-    "hand_peak_speed_m_s",
 )
 
 
@@ -139,12 +138,14 @@ def make_trace(
 
 # --- saccade timing --------------------------------------------------------------------------------
 def test_saccade_onsets_give_known_latency_and_intervals():
-    tr = make_trace(saccades=(0.10, 0.30, 0.54, 0.90))
+    tr = make_trace(saccades=(0.10, 0.30, 0.54, 0.90), gaze="ball")
     np.testing.assert_allclose(M.saccade_onset_times(tr), [0.10, 0.30, 0.54, 0.90], atol=1e-9)
     assert M.first_saccade_latency(tr) == pytest.approx(0.10)
     np.testing.assert_allclose(M.saccade_intervals(tr), [0.20, 0.24, 0.36], atol=1e-9)
     # Catch-up: intervals that start at or before the apex (0.44 s): 0.20 (from 0.10) and 0.24 (from 0.30).
     assert M.catchup_saccade_interval(tr) == pytest.approx(0.22)
+    # the same onsets with the eye left on the thrower: no saccade lands on the ball, no catch-up interval
+    assert math.isnan(M.catchup_saccade_interval(make_trace(saccades=(0.10, 0.30, 0.54, 0.90))))
 
 
 def test_ball_apex_time_is_the_highest_sample():
@@ -367,7 +368,7 @@ def test_reference_table_has_every_component_with_a_source():
 def test_reference_numbers_from_the_papers():
     ref = M.load_reference()
     assert ref["catchup_saccade_interval_s"]["value"] == 0.2  # Eyecatch 4.1, Fig. 4; Eom 4.1
-    assert ref["hand_peak_speed_m_s"]["high"] == 2.0  # Eyecatch 4.3
+    assert "hand_peak_speed_m_s" not in ref  # the hand controller caps it at 2 m/s (Eyecatch 4.3): not scored
     assert "Young and Stark 1963" in ref["catchup_saccade_interval_s"]["source"]
     assert "Eq. 17" in ref["head_contribution"]["source"]
     assert "Fig. 4" in ref["saccade_hand_synchrony"]["source"]
@@ -396,24 +397,27 @@ def test_score_component_rejects_unknown_names():
         M.score_component("blink_rate", 1.0)
 
 
-def test_gaze_realism_averages_available_components():
+def test_gaze_realism_scores_undefined_components_zero_and_takes_the_weaker_group():
     t = np.round(np.arange(0.0, FLIGHT + 1e-9, DT), 10)
     tr = make_trace(gaze="ball", saccades=(0.2,), hand=hand_from_submovements(t, SUBMOVEMENTS))
     ref = M.load_reference()
     out = M.gaze_realism([tr, tr], ref)
     assert set(out["components"]) == set(COMPONENTS)
     comps = out["components"]
-    # one saccade only: no interval, the component is excluded (NaN) and does not enter the mean
+    # one saccade only: no interval; the component is undefined and scores 0 (it is not left out)
     assert math.isnan(comps["catchup_saccade_interval_s"]["value"])
     assert comps["catchup_saccade_interval_s"]["episodes"] == 0
+    assert comps["catchup_saccade_interval_s"]["score"] == 0.0
     assert comps["first_saccade_latency_s"]["value"] == pytest.approx(0.2)
     assert comps["first_saccade_latency_s"]["score"] == 1.0
     # head fixed while the gaze follows the ball down to the hand (39 deg below straight ahead): 0
     assert comps["head_contribution"]["value"] == pytest.approx(0.0)
     assert comps["pursuit_share_after_apex"]["value"] == pytest.approx(1.0)
-    scores = [c["score"] for c in comps.values() if not math.isnan(c["score"])]
-    assert len(scores) == len(COMPONENTS) - 1
-    assert out["score"] == pytest.approx(np.mean(scores))
+    groups = {}
+    for name, c in comps.items():
+        groups.setdefault(ref[name]["group"], []).append(c["score"])
+    assert set(groups) == {"moves", "where"}
+    assert out["score"] == pytest.approx(min(np.mean(v) for v in groups.values()))
     assert 0.0 <= out["score"] <= 1.0
     for name, c in comps.items():
         if not math.isnan(c["value"]):
@@ -426,6 +430,8 @@ def test_gaze_realism_value_is_the_mean_over_episodes():
     out = M.gaze_realism([a, b, make_trace()])  # the third never saccades: excluded from the latency mean
     assert out["components"]["first_saccade_latency_s"]["value"] == pytest.approx(0.25)
     assert out["components"]["first_saccade_latency_s"]["episodes"] == 2
+    # its score is scaled by the share of episodes that define it (2 of 3)
+    assert out["components"]["first_saccade_latency_s"]["score"] == pytest.approx(math.exp(-0.5) * 2 / 3)
 
 
 # --- summary -----------------------------------------------------------------------------------------

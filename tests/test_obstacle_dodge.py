@@ -217,8 +217,11 @@ def _trace(gaze_on, onset=0.2):
         gaze[gaze_on:] = np.array([5.0, 2.0, 0.0]) / math.hypot(5.0, 2.0)
     crowd = np.zeros((N_PEDESTRIANS, 9))
     crowd[:, 0] = (onset, 50.0, 50.0, 50.0)  # the other three appear after the end: not counted
+    onset = np.zeros(n, bool)
+    if gaze_on is not None:
+        onset[gaze_on] = True
     return SimpleNamespace(t=t, dt=0.02, eye_pos=eye, gaze_dir=gaze, pedestrian_pos=ped, pedestrians=crowd,
-                           diverged=False)
+                           diverged=False, saccade_onset=onset, in_saccade=onset.copy())
 
 
 def test_dodge_realism_measures_on_synthetic_traces():

@@ -3,6 +3,7 @@ true state, every rung from the registry, the iwao baseline against its gaze-bli
 
 from __future__ import annotations
 
+import math
 from types import SimpleNamespace
 
 import gymnasium as gym
@@ -253,13 +254,22 @@ def test_walk_realism_measures_on_a_synthetic_trace():
     # Gaze on the obstacle's top during the first 20 % of its approach, then on the floor 1.5 m ahead.
     target = np.where((pelvis[:, 0] < 0.4)[:, None], [5.0, 0.0, 0.2], eye * [1, 1, 0] + [1.5, 0.0, 0.0])
     gaze = (target - eye) / np.linalg.norm(target - eye, axis=1, keepdims=True)
-    trace = SimpleNamespace(eye_pos=eye, gaze_dir=gaze, pelvis_pos=pelvis, obstacles=obstacle, diverged=False)
+    onset = np.zeros(len(t), bool)
+    onset[np.argmax(pelvis[:, 0] >= 0.4)] = True  # the saccade from the obstacle to the floor
+    trace = SimpleNamespace(eye_pos=eye, gaze_dir=gaze, pelvis_pos=pelvis, obstacles=obstacle, diverged=False, t=t,
+                            dt=0.02, saccade_onset=onset, in_saccade=onset.copy())
     m = episode_measures(trace)
-    # Approach: pelvis x in [0, 4.375). On the obstacle: x < 0.4 (fixated), and while the travel gaze (1.5 m
-    # ahead on the floor, so 1.31 m ahead at the top's height) sweeps over its 0.05 + 2 x 0.10 m: 0.25 m more.
-    assert m["obstacle_fixation_share"] == pytest.approx((0.4 + 0.25) / 4.375, abs=0.01)
+    # Approach: pelvis x in [0, 4.375). Fixated (gaze point held): x < 0.4. The travel gaze (1.5 m ahead on the
+    # floor) also sweeps over it for 0.25 m, but that is a travel fixation (the gaze point moves at 1.3 m/s).
+    assert m["obstacle_fixation_share"] == pytest.approx(0.4 / 4.375, abs=0.01)
     assert m["fixation_while_crossing"] == 0.0
     assert m["travel_fixation_distance_m"] == pytest.approx(1.5, abs=0.01)
     assert 45.0 < m["gaze_below_horizon_deg"] < 50.0  # arctan(1.6 / 1.5) = 46.8 deg
+    assert m["path_fixation_share"] == 1.0 and m["saccade_rate_hz"] == pytest.approx(1 / t[-1])
+    assert math.isnan(m["fixation_duration_s"])  # one saccade: no fixation between two
     score = walk_gaze_realism([trace])
-    assert 0.0 < score["score"] <= 1.0 and score["components"]["fixation_while_crossing"]["score"] == 1.0
+    comps = score["components"]
+    # looked away while crossing (in range), capped by the score of the obstacle share it is measured on
+    assert comps["fixation_while_crossing"]["score"] == comps["obstacle_fixation_share"]["score"] > 0.9
+    # where it looked is human-like, but one saccade in 6 s is not: the moves group decides the score
+    assert score["components"]["fixation_duration_s"]["score"] == 0.0 and score["score"] < 0.1

@@ -367,6 +367,7 @@ class _Trace:
         self.gaze_dir = to / np.linalg.norm(to, axis=1, keepdims=True)
         self.saccade_onset = np.zeros(n, bool)
         self.saccade_onset[5] = True
+        self.in_saccade = self.saccade_onset.copy()
         self.env_id = "ShelfReach-v0"
 
 

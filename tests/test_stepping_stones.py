@@ -254,18 +254,24 @@ def test_stones_realism_measures_on_a_synthetic_trace():
     eye = np.stack([1.3 * t, 0 * t, 1.6 + 0 * t], axis=1)
     target = np.concatenate([stones[np.minimum(n + 1, 7)], np.full((len(t), 1), STONE_TOP_Z)], axis=1)
     gaze = (target - eye) / np.linalg.norm(target - eye, axis=1, keepdims=True)
+    onset = np.r_[False, np.diff(n) > 0]  # a saccade when the gaze switches to the next stone
     trace = SimpleNamespace(eye_pos=eye, gaze_dir=gaze, stones=stones, stone_radius=0.25, next_stone=n, t=t, dt=dt,
-                            diverged=False)
+                            diverged=False, saccade_onset=onset, in_saccade=onset.copy())
     m = episode_measures(trace)
     assert m["fixation_steps_ahead"] == 2.0
     assert m["fixation_lead_s"] == pytest.approx(0.9, abs=0.03)  # onset 0.9 s before each landing
+    assert m["stone_fixation_share"] > 0.9
+    assert m["fixation_duration_s"] == pytest.approx(0.48)  # 25 rows between switches, 1 of them in flight
     score = stones_gaze_realism([trace])
-    assert score["score"] == pytest.approx(1.0)
+    for name in ("stone_fixation_share", "fixation_steps_ahead", "fixation_lead_s", "fixation_duration_s"):
+        assert score["components"][name]["score"] > 0.7, name
+    assert score["score"] > 0.6  # 8 saccades in 6 s (1.3/s): a little below the human rate
     late = SimpleNamespace(**{**trace.__dict__, "gaze_dir": (np.concatenate(
         [stones[np.minimum(n, 7)], np.full((len(t), 1), STONE_TOP_Z)], axis=1) - eye)})
     late.gaze_dir = late.gaze_dir / np.linalg.norm(late.gaze_dir, axis=1, keepdims=True)
     m2 = episode_measures(late)  # gaze one step later: on the stone the swinging foot lands on
-    assert m2["fixation_steps_ahead"] == 1.0 and stones_gaze_realism([late])["score"] < 0.9
+    assert m2["fixation_steps_ahead"] == 1.0
+    assert stones_gaze_realism([late])["components"]["fixation_steps_ahead"]["score"] < 0.9
 
 
 def test_summary_routes_stones_traces_to_the_stones_realism():
@@ -275,5 +281,6 @@ def test_summary_routes_stones_traces_to_the_stones_realism():
     env = gym.make("SteppingStones-v0")
     trace = run_episode(env, make_agent("lookahead", "SteppingStones-v0", 9), 2, "SteppingStones-v0", "lookahead")
     out = summarize([trace])
-    assert set(out["gaze_realism"]["components"]) == {"fixation_steps_ahead", "fixation_lead_s"}
+    assert set(out["gaze_realism"]["components"]) == {"saccade_rate_hz", "fixation_duration_s", "stone_fixation_share",
+                                                      "fixation_steps_ahead", "fixation_lead_s"}
     assert out["episodes"] == 1 and out["success_rate"] in (0.0, 1.0)

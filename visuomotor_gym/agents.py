@@ -20,6 +20,9 @@ Agent names (``make_agent``):
   action is 0 (gaze held fixed in the world, where reset put it: on the thrower) and the head action
   0 (the reset pose, straight ahead); everything else is the base agent's. The *gaze-blind twin* of
   DESIGN section 4: the agent's success minus its twin's on the same seeds is the gaze gain.
+* ``static_gaze:[<posture>:]<agent spec>``: any agent with its gaze, fixation and head held at one
+  constant posture in the body frame (:mod:`visuomotor_gym.static_gaze`): its best static twin when
+  the posture is the searched one (``static_gaze:<agent>``).
 * ``fixed_gaze``: ``gaze_blind:eyecatch`` (the Eyecatch filter and hand, gaze and head held);
   ``fixed_gaze:param=value`` passes overrides to the Eyecatch agent.
 
@@ -108,10 +111,14 @@ def parse_agent_spec(spec: str) -> tuple[str, dict[str, Any]]:
     if name not in _REGISTRY:
         raise ValueError(f"unknown agent {name!r}; known agents: {agent_names()}")
     if name in _WRAPPERS:  # "gaze_blind:eyecatch:alpha=1": the rest is the base agent's whole spec
+        own: dict[str, Any] = {}
+        head, _, tail = rest.partition(":")
+        if "=" in head:  # "static_gaze:az=-9,el=35:eyecatch": the wrapper's own key=value options first
+            own, rest = _parse_overrides(head, spec), tail  # (agent names never contain '=')
         if not rest:
             raise ValueError(f"{name!r} wraps another agent: write {name}:<agent spec>, e.g. {name}:eyecatch")
         parse_agent_spec(rest)  # an unknown base agent fails here, naming the known ones
-        return name, {"base": rest}
+        return name, {**own, "base": rest}
     overrides: dict[str, Any] = {}
     if name in PATH_AGENTS:
         if colon and not rest.strip():
@@ -120,12 +127,18 @@ def parse_agent_spec(spec: str) -> tuple[str, dict[str, Any]]:
     if rest and "=" not in rest:  # "name:<path>": one positional argument
         return name, {"path": rest}
     if rest:
-        for item in rest.split(","):
-            key, eq, value = item.partition("=")
-            if not eq or not key:
-                raise ValueError(f"agent override {item!r} in {spec!r} is not key=value")
-            overrides[key.strip()] = _parse_value(value.strip())
+        overrides = _parse_overrides(rest, spec)
     return name, overrides
+
+
+def _parse_overrides(text: str, spec: str) -> dict[str, Any]:
+    overrides: dict[str, Any] = {}
+    for item in text.split(","):
+        key, eq, value = item.partition("=")
+        if not eq or not key:
+            raise ValueError(f"agent override {item!r} in {spec!r} is not key=value")
+        overrides[key.strip()] = _parse_value(value.strip())
+    return overrides
 
 
 def _parse_value(text: str) -> Any:
@@ -360,6 +373,18 @@ register_agent("gaze_blind", _gaze_blind,
                "gaze_blind:<agent>: that agent with its gaze and head held (its gaze-blind twin)", wraps=True)
 register_agent("fixed_gaze", _fixed_gaze,
                "gaze_blind:eyecatch: the Eyecatch filter and hand with gaze and head held (gaze-blind reference)")
+
+
+def _static_gaze(env_id, action_dim, seed, base=None, **posture):
+    from visuomotor_gym.static_gaze import make_static_gaze
+
+    return make_static_gaze(env_id, action_dim, seed, base=base, **posture)
+
+
+register_agent("static_gaze", _static_gaze,
+               "static_gaze:[az=..,el=..,neck_yaw=..,neck_pitch=..,fix=..:]<agent>: that agent with gaze and head "
+               "held at one body-frame posture (the searched best one when none is given): its best static twin",
+               wraps=True)
 
 
 def _iwao(env_id, action_dim, seed, **kw):

@@ -30,8 +30,13 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--out", required=True, help="results JSON file to write")
     p.add_argument("--workers", type=int, default=1, help="worker processes (default 1: in-process)")
     p.add_argument("--gaze-gain", action="store_true",
-                   help="also play the agent's gaze-blind twin (gaze_blind:<agent>) on the same seeds and record "
-                        "the gaze gain (success minus the twin's)")
+                   help="also play the agent's two twins on the same seeds, the held twin (gaze_blind:<agent>: "
+                        "gaze and head held where reset put them) and the best static twin (static_gaze:<agent>: "
+                        "one posture of eye and neck searched on design seeds), and record the gaze gain: "
+                        "success minus the better twin's (and the held-twin difference)")
+    p.add_argument("--static-twin", default=None, metavar="SPEC",
+                   help="with --gaze-gain: the static twin to play instead of the searched posture, e.g. "
+                        "static_gaze:az=0,el=-20,neck_yaw=0,neck_pitch=0,fix=2:iwao")
     p.add_argument("--backend", choices=("local", "ray"), default="local",
                    help="local: this process or a process pool of --workers (default); ray: Ray tasks on a "
                         "cluster (pip install 'visuomotor_gym[distributed]'), same per-seed outcomes")
@@ -53,6 +58,8 @@ def canonical_command(args: argparse.Namespace) -> str:
         parts[-2:-2] = ["--backend", args.backend]
     if getattr(args, "gaze_gain", False):
         parts[-2:-2] = ["--gaze-gain"]
+        if getattr(args, "static_twin", None):
+            parts[-2:-2] = ["--static-twin", args.static_twin]
     if args.traces:
         parts += ["--traces", Path(args.traces).name]
     return shlex.join(parts)
@@ -111,11 +118,19 @@ def summary_rows(results: dict) -> list[tuple[str, str]]:
     gain = results.get("gaze_gain")
     if gain:
         tlo, thi = gain["twin_success_rate_ci95"]
-        rows += [
-            ("gaze-blind twin", f"{gain['twin_success_rate']:.3f}  95% CI [{tlo:.3f}, {thi:.3f}]  "
-                                f"({gain['twin_agent']})"),
-            ("gaze gain", f"{gain['gain']:+.3f}  (success minus the twin's, same seeds)"),
-        ]
+        rows.append(("held twin", f"{gain['twin_success_rate']:.3f}  95% CI [{tlo:.3f}, {thi:.3f}]  "
+                                  f"({gain['twin_agent']})"))
+        if "static_twin_agent" in gain:
+            slo, shi = gain["static_twin_success_rate_ci95"]
+            rows += [
+                ("best static twin", f"{gain['static_twin_success_rate']:.3f}  95% CI [{slo:.3f}, {shi:.3f}]  "
+                                     f"({gain['static_twin_agent']})"),
+                ("gaze gain", f"{gain['gain']:+.3f}  (success minus the better twin's, same seeds)"),
+                ("held-twin difference", f"{gain['held_difference']:+.3f}  (success minus the held twin's)"),
+            ]
+        else:
+            rows.append(("held-twin difference", f"{gain['gain']:+.3f}  (success minus the held twin's; "
+                                                 f"no static twin in these results)"))
     for name, comp in gaze["components"].items():
         rows.append((f"  {name}", f"score {_fmt(comp.get('score'))}  (value {_fmt(comp.get('value'))})"))
     hand_path = results.get("hand_path")
@@ -225,10 +240,21 @@ def main_bench(args: argparse.Namespace) -> int:
         validate_inputs(args.agent, args.env, args.episodes, args.seed, args.workers)
         if args.address is not None and args.backend != "ray":
             raise ValueError("--address is only used with --backend ray")
+        static = None
+        if args.static_twin is not None and not args.gaze_gain:
+            raise ValueError("--static-twin is only used with --gaze-gain")
         if args.gaze_gain:
-            from visuomotor_gym.bench.evaluate import twin_spec
+            from visuomotor_gym.bench.evaluate import static_twin_base, static_twin_spec, twin_spec
 
             validate_inputs(twin_spec(args.agent), args.env, args.episodes, args.seed, args.workers)
+            if args.static_twin is None:
+                static = static_twin_spec(args.agent, args.env)
+            else:
+                if static_twin_base(args.static_twin) != args.agent:
+                    raise ValueError(f"--static-twin {args.static_twin!r} is not a static twin of --agent "
+                                     f"{args.agent!r}: write static_gaze:<posture>:{args.agent}")
+                static = args.static_twin
+            validate_inputs(static, args.env, args.episodes, args.seed, args.workers)
         if args.backend == "ray":
             import importlib.util
 
@@ -240,15 +266,16 @@ def main_bench(args: argparse.Namespace) -> int:
     result = evaluate(args.agent, args.env, args.episodes, args.seed, workers=args.workers,
                       keep_traces=traces_path is not None, progress=not args.no_progress,
                       backend=args.backend, address=args.address)
-    twin = None
+    twin = static_twin = None
     if args.gaze_gain:
         from visuomotor_gym.bench.evaluate import twin_spec
 
-        twin = evaluate(twin_spec(args.agent), args.env, args.episodes, args.seed, workers=args.workers,
-                        keep_traces=False, progress=not args.no_progress, backend=args.backend,
-                        address=args.address)
+        twin, static_twin = (
+            evaluate(spec, args.env, args.episodes, args.seed, workers=args.workers, keep_traces=False,
+                     progress=not args.no_progress, backend=args.backend, address=args.address)
+            for spec in (twin_spec(args.agent), static))
     try:
-        results = build_results(result, canonical_command(args), twin_result=twin)
+        results = build_results(result, canonical_command(args), twin_result=twin, static_result=static_twin)
         print_summary(results)
         write_results(out, results, force=args.force)
     except (ResultsError, OSError) as exc:  # FileExistsError, or the disk failing after the run

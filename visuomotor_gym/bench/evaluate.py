@@ -210,9 +210,33 @@ BACKENDS = ("local", "ray")
 def twin_spec(agent: str) -> str:
     """The gaze-blind twin of an agent spec: the same agent with its gaze and head held
     (``gaze_blind:<spec>``; ``fixed_gaze`` is already the twin of ``eyecatch``)."""
-    if agent == "fixed_gaze" or agent.startswith("gaze_blind:"):
+    if agent == "fixed_gaze" or agent.startswith(("gaze_blind:", "static_gaze:")):
         raise ValueError(f"{agent!r} is already a gaze-blind agent: it has no twin")
     return f"gaze_blind:{agent}"
+
+
+TWIN_WRAPPERS = ("gaze_blind", "static_gaze")
+
+
+def static_twin_spec(agent: str, env_id: str) -> str:
+    """The best static twin of an agent spec on ``env_id``: the same agent with its gaze, vergence and head
+    replaced by the constant posture searched for it (``static_gaze:<posture>:<spec>``, the posture written
+    out so the spec replays the same whatever the postures file says later; :mod:`visuomotor_gym.static_gaze`).
+    Raises ValueError when ``agent`` is already a twin or no posture was searched for it on ``env_id``."""
+    if agent == "fixed_gaze" or agent.partition(":")[0] in TWIN_WRAPPERS:
+        raise ValueError(f"{agent!r} is already a twin (held or static gaze): it has no twin")
+    from visuomotor_gym.static_gaze import resolve_spec
+
+    return resolve_spec(f"static_gaze:{agent}", env_id)
+
+
+def static_twin_base(spec: str) -> str | None:
+    """The agent whose static twin ``spec`` is (``static_gaze:[posture:]<agent>`` -> ``<agent>``), else None."""
+    name, _, rest = spec.partition(":")
+    if name != "static_gaze" or not rest:
+        return None
+    head, colon, tail = rest.partition(":")
+    return tail if colon and "=" in head else rest
 
 
 def _run_on_ray(agent, env_id, chunks, seeds, address, progress) -> list[list[EpisodeTrace]]:

@@ -46,11 +46,12 @@ def load_schema() -> dict:
     return json.loads(text)
 
 
-def build_results(eval_result, command: str | None, twin_result=None) -> dict:
+def build_results(eval_result, command: str | None, twin_result=None, static_result=None) -> dict:
     """The results object of an :class:`~visuomotor_gym.bench.evaluate.EvalResult` (validated).
 
     ``command`` is the command line recorded in the provenance (no personal paths, please).
-    ``twin_result``: the agent's gaze-blind twin on the same seeds (adds ``gaze_gain``).
+    ``twin_result``: the agent's held (gaze-blind) twin on the same seeds, ``static_result`` its best
+    static twin (adds ``gaze_gain``; see :func:`gaze_gain_block`).
     """
     from visuomotor_gym.bench.provenance import provenance
 
@@ -91,26 +92,40 @@ def build_results(eval_result, command: str | None, twin_result=None) -> dict:
     if "hand_path" in s:  # single-ball catch ids: hand paths against Faraway's model (metrics.catch_handpath)
         obj["hand_path"] = s["hand_path"]
     if twin_result is not None:
-        obj["gaze_gain"] = gaze_gain_block(eval_result, twin_result)
+        obj["gaze_gain"] = gaze_gain_block(eval_result, twin_result, static_result)
     # Round-trip through JSON so the object holds plain JSON types only (no numpy scalars).
     obj = json.loads(json.dumps(obj, default=_json_default))
     validate_results(obj)
     return obj
 
 
-def gaze_gain_block(eval_result, twin_result) -> dict:
-    """``gaze_gain`` of the results: the twin's success on the same pinned seeds, and the gain."""
-    if (twin_result.env_id, twin_result.episodes, twin_result.seed) != (
-            eval_result.env_id, eval_result.episodes, eval_result.seed):
-        raise ValueError("the gaze-blind twin must play the same env id and pinned seeds as the agent")
-    t = twin_result.summary
-    return {
-        "twin_agent": twin_result.agent,
-        "twin_successes": int(round(t["success_rate"] * twin_result.episodes)),
-        "twin_success_rate": float(t["success_rate"]),
-        "twin_success_rate_ci95": [float(x) for x in t["success_rate_ci95"]],
-        "gain": float(eval_result.summary["success_rate"]) - float(t["success_rate"]),
-    }
+def _twin_rate(result, reference) -> tuple[int, float, list[float]]:
+    if (result.env_id, result.episodes, result.seed) != (reference.env_id, reference.episodes, reference.seed):
+        raise ValueError(f"the twin {result.agent!r} must play the same env id and pinned seeds as the agent")
+    rate = float(result.summary["success_rate"])
+    return int(round(rate * result.episodes)), rate, [float(x) for x in result.summary["success_rate_ci95"]]
+
+
+def gaze_gain_block(eval_result, twin_result, static_result=None) -> dict:
+    """``gaze_gain`` of the results: both twins' success on the same pinned seeds, and the gain.
+
+    The **gaze gain** is the success rate minus the better of the two twins': the held twin
+    (``gaze_blind:<agent>``, gaze and head held where reset put them) and the best static twin
+    (``static_gaze:<agent>``, one constant posture of eye and neck searched on design seeds). A small gain
+    means a fixed posture does as well as the agent's eye movements: the env does not test *moving* the
+    eye. ``held_difference`` keeps the held twin's difference under its own name. Without
+    ``static_result`` the block is the legacy ``definition = "held"`` one (gain = held difference).
+    """
+    success = float(eval_result.summary["success_rate"])
+    k, rate, ci = _twin_rate(twin_result, eval_result)
+    block = {"twin_agent": twin_result.agent, "twin_successes": k, "twin_success_rate": rate,
+             "twin_success_rate_ci95": ci}
+    if static_result is None:
+        return {**block, "definition": "held", "gain": success - rate}
+    ks, rate_s, ci_s = _twin_rate(static_result, eval_result)
+    return {**block, "static_twin_agent": static_result.agent, "static_twin_successes": ks,
+            "static_twin_success_rate": rate_s, "static_twin_success_rate_ci95": ci_s,
+            "definition": "best_twin", "held_difference": success - rate, "gain": success - max(rate, rate_s)}
 
 
 def is_real_time(p95_ms: float | None, control_period_ms: float) -> bool:
@@ -263,27 +278,54 @@ def _success_problems(obj: dict, episodes: int | None, catch_rate, env_id) -> li
     return out
 
 
-def _gaze_gain_problems(obj: dict, episodes: int | None) -> list[tuple[str, str]]:
-    """``gaze_gain`` (optional): the twin's rate is its successes / episodes with their Wilson interval,
-    and the gain is success_rate minus the twin's."""
-    gain = obj.get("gaze_gain")
-    if not isinstance(gain, dict) or episodes is None:
-        return []
+def _twin_rate_problems(gain: dict, prefix: str, episodes: int) -> list[tuple[str, str]]:
+    """One twin's rate is its successes / episodes, with their Wilson interval."""
     out = []
-    k, rate, ci, g = (gain.get(n) for n in ("twin_successes", "twin_success_rate", "twin_success_rate_ci95", "gain"))
+    k, rate, ci = (gain.get(f"{prefix}{n}") for n in ("successes", "success_rate", "success_rate_ci95"))
     if _is_int(k) and _is_num(rate):
         if k > episodes or abs(rate - k / episodes) > TOLERANCE:
-            out.append(("$.gaze_gain.twin_success_rate", f"twin_success_rate = {rate} is not twin_successes / "
-                                                          f"episodes = {k}/{episodes}"))
+            out.append((f"$.gaze_gain.{prefix}success_rate", f"{prefix}success_rate = {rate} is not "
+                                                               f"{prefix}successes / episodes = {k}/{episodes}"))
         elif isinstance(ci, list) and len(ci) == 2 and all(_is_num(x) for x in ci):
             expected = _wilson(k, episodes)
             if expected is not None and any(abs(a - b) > TOLERANCE for a, b in zip(ci, expected)):
-                out.append(("$.gaze_gain.twin_success_rate_ci95", f"interval {ci} is not the Wilson interval "
-                                                                   f"of {k}/{episodes}"))
-    success = obj.get("success_rate")
-    if _is_num(g) and _is_num(rate) and _is_num(success) and abs(g - (success - rate)) > TOLERANCE:
-        out.append(("$.gaze_gain.gain", f"gain = {g} differs from success_rate - twin_success_rate = "
-                                         f"{success} - {rate}"))
+                out.append((f"$.gaze_gain.{prefix}success_rate_ci95", f"interval {ci} is not the Wilson interval "
+                                                                       f"of {k}/{episodes}"))
+    return out
+
+
+def _gaze_gain_problems(obj: dict, episodes: int | None) -> list[tuple[str, str]]:
+    """``gaze_gain`` (optional): each twin's rate is its successes / episodes with their Wilson interval;
+    the gain is success_rate minus the better twin's (``definition = "best_twin"``) or, in results
+    written before the static twin existed, minus the held twin's (``"held"``); ``held_difference`` is
+    success_rate minus the held twin's. A claim that does not follow from the twins' counts is refused."""
+    gain = obj.get("gaze_gain")
+    if not isinstance(gain, dict) or episodes is None:
+        return []
+    out = _twin_rate_problems(gain, "twin_", episodes)
+    static = "static_twin_agent" in gain
+    if static:
+        out += _twin_rate_problems(gain, "static_twin_", episodes)
+    definition = gain.get("definition", "held")
+    if definition == "best_twin" and not static:
+        out.append(("$.gaze_gain.definition", "definition 'best_twin' needs the static twin (static_twin_* fields)"))
+    elif definition == "held" and static:
+        out.append(("$.gaze_gain.definition", "results with a static twin define the gain as 'best_twin' "
+                                              "(success minus the better twin), not 'held'"))
+    success, rate, rate_s, g = (obj.get("success_rate"), gain.get("twin_success_rate"),
+                                gain.get("static_twin_success_rate"), gain.get("gain"))
+    if not (_is_num(success) and _is_num(rate)):
+        return out
+    if static and _is_num(rate_s):
+        expected, text = success - max(rate, rate_s), f"success_rate - max(twin, static twin) = {success} - max({rate}, {rate_s})"
+        held = gain.get("held_difference")
+        if _is_num(held) and abs(held - (success - rate)) > TOLERANCE:
+            out.append(("$.gaze_gain.held_difference", f"held_difference = {held} differs from success_rate - "
+                                                        f"twin_success_rate = {success} - {rate}"))
+    else:
+        expected, text = success - rate, f"success_rate - twin_success_rate = {success} - {rate}"
+    if _is_num(g) and abs(g - expected) > TOLERANCE:
+        out.append(("$.gaze_gain.gain", f"gain = {g} differs from {text}"))
     return out
 
 

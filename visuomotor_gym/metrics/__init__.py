@@ -6,7 +6,10 @@ with the same attributes works), so the evaluator, plots and tests share one def
 * :func:`summarize` -- every benchmark number for a set of episodes, JSON-ready;
 * :func:`wilson_interval` -- the catch rate's confidence interval;
 * :func:`gaze_realism`, :func:`score_component`, :func:`load_reference` -- the realism score against the
-  human reference table ``human_reference.json`` (value, range, unit and source per component);
+  human reference table ``human_reference.json`` (value, range, unit, source and group per component);
+  :func:`score_components` -- the rule every family's realism follows (an undefined component scores 0,
+  the score is the weakest group's mean); :mod:`~visuomotor_gym.metrics.strategy` -- the moving-eye
+  measures (saccade rate, fixation durations, share of fixation time on targets);
 * per-episode measures (NaN when undefined): :func:`first_saccade_latency`, :func:`saccade_intervals`,
   :func:`catchup_saccade_interval`, :func:`ball_apex_time`, :func:`pursuit_share_after_apex`,
   :func:`ball_foveation`, :func:`head_contribution`, :func:`hand_submovement_onsets`,
@@ -40,6 +43,7 @@ from visuomotor_gym.metrics.realism import (
     gaze_realism,
     load_reference,
     score_component,
+    score_components,
 )
 from visuomotor_gym.metrics.stats import wilson_interval
 from visuomotor_gym.metrics.summary import latency_summary, summarize, to_json_safe
@@ -68,6 +72,7 @@ __all__ = [
     "saccade_intervals",
     "saccade_onset_times",
     "score_component",
+    "score_components",
     "summarize",
     "time_to_catch",
     "to_json_safe",

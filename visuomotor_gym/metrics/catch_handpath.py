@@ -29,7 +29,8 @@ detour and return, adds to it. A catcher who predicted the interception point at
 human-like reach to it would score like a human reach; a catcher who chased its estimate would not. This
 is the point of the measure, and also its limit: seed 002 measured reaches, not catches, so applying its
 numbers to catching is our **modelling choice** (no human hand-path data for catching are in
-``REFERENCES.md``; only the hand's peak speed, Eyecatch sec. 4.3, is a catching number).
+``REFERENCES.md``; only the hand's peak speed, Eyecatch sec. 4.3, is a catching number, and it is reported
+unscored because the hand controller caps the hand at 2 m/s, so every agent met it).
 
 Per episode (:func:`catch_hand_path_measures`, NaN where undefined): the distance to Faraway's path
 (max at equal relative arc length, scaled to the paper's 56.7 cm median reach), the curvature index (0 =
@@ -64,7 +65,7 @@ import numpy as np
 from visuomotor_gym import handpath
 from visuomotor_gym.geometry import angles_deg
 from visuomotor_gym.metrics.reach_realism import REACH_REFERENCE
-from visuomotor_gym.metrics.realism import load_reference, score_component
+from visuomotor_gym.metrics.realism import score_component
 
 HAND_ONSET_SPEED_M_S = 0.1  # as metrics.hand.HAND_ONSET_SPEED_M_S and the reach family
 MIN_REACH_M = 0.05  # shorter transports are not reaches (modelling choice, as metrics.reach_realism)
@@ -91,7 +92,6 @@ _APPLIED = (" Applied to the transport of a catch: modelling choice (seed 002 me
 
 
 def _reference() -> dict[str, dict]:
-    catch_speed = load_reference()["hand_peak_speed_m_s"]
     ref = {
         name: {**REACH_REFERENCE[name], "source": REACH_REFERENCE[name]["source"] + _APPLIED}
         for name in ("faraway_distance_cm", "curvature_index", "peak_speed_time")
@@ -102,9 +102,13 @@ def _reference() -> dict[str, dict]:
         "56.7 cm reach. A straight transport also scores ~6 cm: read it with curvature_index.")
     ref["curvature_index"]["notes"] = "Median over catches of handpath.HandPathRealism.curvature_index of the transport."
     ref["peak_speed_time"]["notes"] = "Median over catches of the relative time of the peak speed within the transport."
-    ref["hand_peak_speed_m_s"] = {**catch_speed,
-                                  "notes": "Median over catches of the peak catch-site speed within the transport "
-                                           "(20 ms differences); the catch family's own human number."}
+    ref["hand_peak_speed_m_s"] = {
+        "value": None, "low": None, "high": None, "tolerance": None, "unit": "m/s", "scored": False,
+        "source": "Eyecatch sec. 4.3: humans keep the hand below ~2 m/s. Not scored: the hand controller caps its "
+                  "reference at 2 m/s (control.hand.HandParams.max_speed_m_s), so every agent met the bound "
+                  "(issue 21).",
+        "notes": "Median over catches of the peak catch-site speed within the transport (20 ms differences).",
+    }
     ref["gaze_hand_lead_s"] = {
         "value": None, "low": None, "high": None, "tolerance": None, "unit": "s", "scored": False,
         "source": "None for catching: not scored. (Land, Mennie & Rusted 1999 measured ~0.56 s for reaching to "

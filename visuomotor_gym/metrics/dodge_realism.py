@@ -1,16 +1,24 @@
-"""Pedestrian-avoidance gaze realism (ObstacleDodge family): per-episode measures of where the eye looked,
-scored against human data with :func:`visuomotor_gym.metrics.realism.score_component` (1 inside the
-human range, a Gaussian fall-off outside; the score is the mean of the components).
+"""Pedestrian-avoidance gaze realism (ObstacleDodge family): per-episode measures of when the eye moved
+and where it looked, scored against human data with :func:`visuomotor_gym.metrics.realism.score_components`
+(each component 1 inside the human range with a Gaussian fall-off outside, times the share of episodes
+that define it, 0 when none does; the score is the smaller of the ``moves`` and ``where`` group means:
+see :mod:`visuomotor_gym.metrics.realism`).
 
 Measures (from an :class:`~visuomotor_gym.bench.trace.EpisodeTrace` of an ObstacleDodge env: ``eye_pos``,
-``gaze_dir``, ``pedestrian_pos`` per step (parked before the onset); the crowd ``pedestrians`` per episode):
+``gaze_dir``, ``in_saccade``, ``saccade_onset``, ``pedestrian_pos`` per step (parked before the onset);
+the crowd ``pedestrians`` per episode):
+
+``moves`` (:mod:`visuomotor_gym.metrics.strategy`): ``saccade_rate_hz`` (onsets per second) and
+``fixation_duration_s`` (median saccade-free run between two saccades);
+
+``where``:
 
 * ``pedestrian_fixated_share``: the share of the pedestrians that were fixated at least once while they
   were ahead of the eye (a *fixation*: the line of sight within ``FIXATION_DEG`` of the pedestrian's seen
   point for at least ``FIXATION_MIN_S``), over the pedestrians that appeared at least ``MIN_PRESENT_S``
   before the episode ended;
-* ``fixation_latency_s``: the median time from a pedestrian's appearance to the start of its first
-  fixation, over the fixated pedestrians.
+* ``fixation_latency_s``: the time from a pedestrian's appearance to the start of its first fixation,
+  the median over the episode's fixated pedestrians (undefined, scoring 0, when none was fixated).
 
 Thresholds are modelling choices (stated with each constant).
 """
@@ -22,8 +30,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from visuomotor_gym.metrics.realism import score_component
-from visuomotor_gym.metrics.stats import nan_mean
+from visuomotor_gym.metrics import strategy
+from visuomotor_gym.metrics.realism import score_components
 
 # Modelling choice: a pedestrian's upper body (~0.5 m wide) subtends ~6-10 deg at 3-5 m; gaze within
 # 4 deg of its axis point is on it (eye-tracker accuracy in the VR studies ~1 deg).
@@ -32,18 +40,22 @@ FIXATION_MIN_S = 0.1  # modelling choice: the shortest fixation counted (~100 ms
 MIN_PRESENT_S = 1.0  # modelling choice: pedestrians that appeared this long before the end are counted
 
 DODGE_REFERENCE: dict[str, dict] = {
+    "saccade_rate_hz": strategy.SACCADE_RATE_REFERENCE,
+    "fixation_duration_s": strategy.FIXATION_DURATION_REFERENCE,
     "pedestrian_fixated_share": {
         "value": 0.73, "low": 0.59, "high": 0.85, "tolerance": 0.15, "unit": "fraction of the pedestrians",
+        "group": "where",
         "source": "Jovancevic, Sullivan & Hayhoe (J Vis 4(8), abstract; REFERENCES.md [V]): pedestrians not on a "
                   "collision course were fixated 73 % of the time, veering ones 59 % (unfixated 41 %); the range "
                   "spans the two, its upper end is our modelling choice",
         "notes": "Share over the pedestrians that appeared >= 1 s before the episode ended.",
     },
     "fixation_latency_s": {
-        "value": 0.74, "low": 0.548, "high": 0.74, "tolerance": 0.3, "unit": "s",
+        "value": 0.74, "low": 0.548, "high": 0.74, "tolerance": 0.3, "unit": "s", "group": "where", "given": "pedestrian_fixated_share",
         "source": "Jovancevic, Sullivan & Hayhoe (REFERENCES.md [V]): first fixation 740 ms after a pedestrian "
                   "appeared, 548 ms for one veering onto a collision course",
-        "notes": "Median over the fixated pedestrians, from appearance to the start of the first fixation.",
+        "notes": "Per episode the median over the fixated pedestrians, from appearance to the start of the first "
+                 "fixation; mean over the episodes that fixated one.",
     },
 }
 
@@ -80,25 +92,18 @@ def pedestrian_fixations(trace) -> tuple[float, list[float]]:
     return (fixated / counted if counted else float("nan")), latencies
 
 
+def episode_measures(trace) -> dict[str, float]:
+    share, latencies = pedestrian_fixations(trace)
+    return {"saccade_rate_hz": strategy.saccade_rate(trace), "fixation_duration_s": strategy.fixation_duration(trace),
+            "pedestrian_fixated_share": share,
+            "fixation_latency_s": float(np.median(latencies)) if latencies else float("nan")}
+
+
 def dodge_gaze_realism(traces: Sequence, reference: dict | None = None) -> dict:
     """``{"score", "components": {name: {"value", "score", "episodes"}}}`` for dodge episodes."""
     reference = DODGE_REFERENCE if reference is None else reference
-    shares, latencies, n_lat = [], [], 0
-    for tr in traces:
-        if getattr(tr, "diverged", False):
-            continue
-        share, lat = pedestrian_fixations(tr)
-        shares.append(share)
-        latencies += lat
-        n_lat += bool(lat)
-    values = {"pedestrian_fixated_share": (nan_mean(shares), int(np.isfinite(shares).sum()) if shares else 0),
-              "fixation_latency_s": (float(np.median(latencies)) if latencies else float("nan"), n_lat)}
-    components = {}
-    for name in reference:
-        value, episodes = values[name]
-        components[name] = {"value": value, "score": score_component(name, value, reference), "episodes": episodes}
-    score = nan_mean([c["score"] for c in components.values()])
-    return {"score": score if math.isfinite(score) else float("nan"), "components": components}
+    rows = [episode_measures(tr) for tr in traces if not getattr(tr, "diverged", False)]
+    return score_components(rows, reference)
 
 
 def distance_left(tr) -> float:

@@ -1,32 +1,41 @@
-"""Stepping-stone gaze realism (SteppingStones family): per-episode measures of which stone the eye
-looked at and when, scored against human data with :func:`visuomotor_gym.metrics.realism.score_component`
-(1 inside the human range, a Gaussian fall-off outside; the score is the mean of the components).
+"""Stepping-stone gaze realism (SteppingStones family): per-episode measures of when the eye moved, which
+stone it looked at and when, scored against human data with
+:func:`visuomotor_gym.metrics.realism.score_components` (each component 1 inside the human range with a
+Gaussian fall-off outside, times the share of episodes that define it, 0 when none does; the score is the
+smaller of the ``moves`` and ``where`` group means: see :mod:`visuomotor_gym.metrics.realism`).
 
 Measures (from an :class:`~visuomotor_gym.bench.trace.EpisodeTrace` of a SteppingStones env: ``eye_pos``,
-``gaze_dir``, ``next_stone`` per step; the course ``stones`` and ``stone_radius`` per episode):
+``gaze_dir``, ``in_saccade``, ``saccade_onset``, ``next_stone`` per step; the course ``stones`` and
+``stone_radius`` per episode):
+
+``moves`` (:mod:`visuomotor_gym.metrics.strategy`): ``saccade_rate_hz`` (onsets per second) and
+``fixation_duration_s`` (median saccade-free run between two saccades);
+
+``where``:
 
 * a step's *fixated stone* is the stone whose top the line of sight meets within ``stone_radius +
   ON_STONE_M`` of its centre (none otherwise);
-* ``fixation_steps_ahead``: the median, over the steps with gaze on a stone after the first stone was
-  landed on, of the fixated stone's index minus the index of the stone under the last landed foot
-  (``next_stone - 1``): how many steps ahead of the stance foot the eye is;
-* ``fixation_lead_s``: for each stone landed on, the time from the onset of its last fixation (a run
-  of at least ``MIN_FIXATION_S``) before the landing to the landing (the heel strike: ``LANDING_LAG_S``
-  before ``next_stone`` moves on), the median over the episode's stones (robust to the first stones,
-  which a walker starting on the slab may look at for longer).
+* ``stone_fixation_share``: the share of the resting rows (no saccade in flight) with gaze on a stone
+  not yet stepped on (index >= ``next_stone``): the footholds to come are the task's targets;
+* ``fixation_steps_ahead`` (the look-ahead in steps): the median, over the steps with gaze on a stone
+  after the first stone was landed on, of the fixated stone's index minus the index of the stone under
+  the last landed foot (``next_stone - 1``): how many steps ahead of the stance foot the eye is;
+* ``fixation_lead_s`` (the look-ahead in time): for each stone landed on, the time from the onset of
+  its last fixation (a run of at least ``MIN_FIXATION_S``) before the landing to the landing (the heel
+  strike: ``LANDING_LAG_S`` before ``next_stone`` moves on), the median over the episode's stones
+  (robust to the first stones, which a walker starting on the slab may look at for longer).
 
-Window sizes and the tolerance are modelling choices (stated with each constant).
+Window sizes and tolerances are modelling choices (stated with each constant).
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 
 import numpy as np
 
-from visuomotor_gym.metrics.realism import score_component
-from visuomotor_gym.metrics.stats import nan_mean
+from visuomotor_gym.metrics import strategy
+from visuomotor_gym.metrics.realism import score_components
 
 ON_STONE_M = 0.05  # modelling choice: ~1-2 deg at 1.5-3 m, the accuracy of mobile eye trackers (~1 deg)
 MIN_FIXATION_S = 0.1  # modelling choice: the usual minimum fixation duration of mobile eye-tracking analyses
@@ -36,14 +45,28 @@ LANDING_LAG_S = 0.1
 STONE_PLANE_Z = -0.005  # tasks.stepping_stones.STONE_TOP_Z (the stones' tops)
 
 STONES_REFERENCE: dict[str, dict] = {
+    "saccade_rate_hz": strategy.SACCADE_RATE_REFERENCE,
+    "fixation_duration_s": strategy.FIXATION_DURATION_REFERENCE,
+    "stone_fixation_share": {
+        "value": 0.7, "low": 0.4, "high": 1.0, "tolerance": 0.1, "unit": "fraction of the fixation time",
+        "group": "where",
+        "source": "Patla & Vickers 2003, Exp Brain Res 148:133: walkers stepping on footprints spent > 50 % of the "
+                  "time in travel fixations and fixated the targets the rest of it; Bonnen et al. 2021, Exp "
+                  "Brain Res: more fixations go to footholds as the terrain gets harder (REFERENCES.md [V]); "
+                  "stepping stones with gaps between them are harder than footprints on a floor. No paper gives "
+                  "the share for stepping stones: value, range and tolerance are our modelling choice (the 0.1 "
+                  "tolerance makes a share of 0.2, what a line of sight held 40 deg down collects as the stones "
+                  "pass under it, score exp(-2) = 0.14)",
+        "notes": "Resting rows (no saccade in flight) with gaze on a stone not yet stepped on.",
+    },
     "fixation_steps_ahead": {
-        "value": 2.0, "low": 1.5, "high": 2.5, "tolerance": 0.5, "unit": "steps",
+        "value": 2.0, "low": 1.5, "high": 2.5, "tolerance": 0.5, "unit": "steps", "group": "where", "given": "stone_fixation_share",
         "source": "Patla & Vickers 2003, Exp Brain Res 148:133: stepping targets were fixated ~2 steps ahead "
                   "(REFERENCES.md [V]); the 1.5-2.5 range around it is our modelling choice",
         "notes": "Median over the steps with gaze on a stone, after the first stone was landed on.",
     },
     "fixation_lead_s": {
-        "value": 0.9, "low": 0.8, "high": 1.0, "tolerance": 0.2, "unit": "s",
+        "value": 0.9, "low": 0.8, "high": 1.0, "tolerance": 0.2, "unit": "s", "group": "where", "given": "stone_fixation_share",
         "source": "Patla & Vickers 2003: stepping targets fixated 0.8-1.0 s before the foot lands on them "
                   "(REFERENCES.md [V])",
         "notes": "Onset of the last fixation (>= 0.1 s) of a stone before its landing, to the heel strike; "
@@ -112,22 +135,24 @@ def fixation_lead(trace) -> float:
     return float(np.median(leads)) if leads else float("nan")
 
 
+def stone_fixation_share(trace) -> float:
+    """Share of the resting rows whose gaze is on a stone not yet stepped on (index >= ``next_stone``)."""
+    fix = fixated_stones(trace)
+    upcoming = (fix >= 0) & (fix >= np.asarray(trace.next_stone, dtype=float))
+    return strategy.fixation_share(trace, upcoming)
+
+
 def episode_measures(trace) -> dict[str, float]:
-    return {"fixation_steps_ahead": steps_ahead(trace), "fixation_lead_s": fixation_lead(trace)}
+    return {"saccade_rate_hz": strategy.saccade_rate(trace), "fixation_duration_s": strategy.fixation_duration(trace),
+            "stone_fixation_share": stone_fixation_share(trace),
+            "fixation_steps_ahead": steps_ahead(trace), "fixation_lead_s": fixation_lead(trace)}
 
 
 def stones_gaze_realism(traces: Sequence, reference: dict | None = None) -> dict:
     """``{"score", "components": {name: {"value", "score", "episodes"}}}`` for stepping-stone episodes."""
     reference = STONES_REFERENCE if reference is None else reference
     rows = [episode_measures(tr) for tr in traces if not getattr(tr, "diverged", False)]
-    components = {}
-    for name in reference:
-        values = np.array([r[name] for r in rows], dtype=float)
-        value = nan_mean(values)
-        components[name] = {"value": value, "score": score_component(name, value, reference),
-                            "episodes": int(np.isfinite(values).sum())}
-    score = nan_mean([c["score"] for c in components.values()])
-    return {"score": score if math.isfinite(score) else float("nan"), "components": components}
+    return score_components(rows, reference)
 
 
 def distance_left(tr) -> float:
