@@ -1,19 +1,33 @@
-"""Record one episode as an MP4: the scene camera (with the line of sight drawn in green) beside the
-eye camera, one video frame per control step.
+"""Record one episode as an MP4: the scene view (with the line of sight drawn in green, ending in a
+green dot where it meets the floor) beside the eye camera.
 
-Timing: the env runs at 50 control steps per second and every step (plus the state after reset)
-gives one frame, so ``fps=50`` plays in real time; the default ``fps=25`` plays at **half speed**
-(a 1 s throw lasts 2 s on screen, slow enough to see the saccades), as ``vmgym demo`` does.
+**Timing**: the env runs at 50 control steps per second; a frame is rendered after ``reset`` and after
+every ``stride``-th step (the last step always), so ``fps = 50 / stride`` plays in real time. The
+defaults, ``stride=1`` and ``fps=25``, play at **half speed** (a 1 s throw lasts 2 s on screen, slow
+enough to see the saccades), as ``vmgym demo`` does.
+
+**Scene views** (:data:`SCENE_VIEWS`): the catch and reach families use their scene's fixed camera
+(``scene_camera`` in the MJCF); the walker families (walk, stones, dodge) a camera defined here, not
+in the MJCF (so the compiled models and their golden digests do not change): a free
+:class:`mujoco.MjvCamera` whose look-at point follows the pelvis each frame, at a distance and angle
+chosen per family so that what the task is about stays in view: the next obstacles (walk), the next
+stones (stones), the pedestrians 4-6 m to either side (dodge).
+
+**Speed** (software OpenGL, Mesa llvmpipe, on a headless machine): shadows and 4x multisampling cost
+~8x the rest of a frame, so they are off unless ``quality="high"``; one :class:`mujoco.Renderer` (one
+GL context) renders both views of every frame. A walker episode of ~800 steps went from ~4 minutes
+to under a minute (issue 26; the numbers and command are in the viz branch's report).
 
 The episode is played by :func:`visuomotor_gym.bench.trace.run_episode` itself (the policy sees
-observations only); a thin wrapper renders a frame after ``reset`` and after every ``step`` and
-streams it to the encoder, so the returned trace is exactly the evaluator's.
+observations only); a thin wrapper renders a frame after ``reset`` and after every ``stride``-th
+``step`` and streams it to the encoder, so the returned trace is exactly the evaluator's.
 """
 
 from __future__ import annotations
 
 import os
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -21,6 +35,35 @@ import numpy as np
 from visuomotor_gym.bench.trace import EpisodeTrace, run_episode
 
 VIDEO_SUFFIXES = (".mp4", ".mkv", ".mov")
+QUALITIES = ("fast", "high")
+CONTROL_HZ = 50  # the envs' control rate (dt = 20 ms): fps = CONTROL_HZ / stride is real time
+
+
+@dataclass(frozen=True)
+class FollowView:
+    """A free camera that looks at the pelvis plus ``offset`` (world frame, m) from ``distance`` m away,
+    ``azimuth`` deg about z (0: looking along +x, the path's direction; 90: along +y) and ``elevation``
+    deg (negative: from above), with a vertical field of view of ``fovy`` deg. Values are modelling
+    choices, checked by eye on a frame of each family."""
+
+    distance: float
+    azimuth: float
+    elevation: float
+    offset: tuple[float, float, float]
+    fovy: float = 45.0
+
+
+# The scene view of each family: an MJCF camera name (catch, reach) or a FollowView (walker families).
+SCENE_VIEWS: dict[str, str | FollowView] = {
+    "catch": "scene_camera",
+    "reach": "scene_camera",
+    # From behind and to the right, above: the legs and the next 3-4 m of walkway with its obstacles.
+    "walk": FollowView(distance=5.0, azimuth=55.0, elevation=-28.0, offset=(1.6, 0.0, -0.6)),
+    # From behind, higher: the next stones ahead (the path turns by up to 60 deg, still in view).
+    "stones": FollowView(distance=5.5, azimuth=20.0, elevation=-45.0, offset=(1.5, 0.0, -0.8)),
+    # From behind and high: 6 m ahead and the pedestrians starting 4-6 m to either side.
+    "dodge": FollowView(distance=11.5, azimuth=0.0, elevation=-50.0, offset=(3.5, 0.0, -0.9), fovy=50.0),
+}
 
 
 def _default_headless_gl() -> None:
@@ -92,29 +135,128 @@ class _Labeller:
         return np.asarray(img)
 
 
-def _recording_wrapper(env, sink, labeller):
+def _draw_line_of_sight(scene, eye_pos, gaze_dir, radius: float, max_range_m: float = 30.0) -> None:
+    """A green capsule from the eye along the line of sight to where it meets the floor (a green dot
+    there), or ``max_range_m / 4`` long when it does not meet the floor within ``max_range_m``."""
+    import mujoco
+
+    eye = np.asarray(eye_pos, dtype=float)
+    g = np.asarray(gaze_dir, dtype=float)
+    g = g / max(float(np.linalg.norm(g)), 1e-12)
+    s = -eye[2] / g[2] if g[2] < -1e-9 else np.inf
+    hit = s <= max_range_m
+    end = eye + (s if hit else max_range_m / 4.0) * g
+    color = np.array([0.1, 0.9, 0.2, 0.7], dtype=np.float32)
+    if scene.ngeom < scene.maxgeom:
+        geom = scene.geoms[scene.ngeom]
+        mujoco.mjv_initGeom(geom, mujoco.mjtGeom.mjGEOM_CAPSULE, np.zeros(3), np.zeros(3), np.eye(3).ravel(), color)
+        mujoco.mjv_connector(geom, mujoco.mjtGeom.mjGEOM_CAPSULE, radius, eye, end)
+        scene.ngeom += 1
+    if hit and scene.ngeom < scene.maxgeom:
+        geom = scene.geoms[scene.ngeom]
+        mujoco.mjv_initGeom(geom, mujoco.mjtGeom.mjGEOM_SPHERE, np.full(3, 3.0 * radius), end, np.eye(3).ravel(),
+                            np.array([0.1, 0.9, 0.2, 1.0], dtype=np.float32))
+        scene.ngeom += 1
+
+
+class FrameRenderer:
+    """Renders the views of one frame with a single :class:`mujoco.Renderer` (one GL context, made once).
+
+    ``views``: each an MJCF camera name or a :class:`FollowView`; ``line_of_sight``: draw the gaze into
+    every view but the eye camera (the env's own line, eye to fixation point, for catch and reach; a
+    line to the floor with a dot for the walker families, thick enough to see from a follow view).
+    ``quality="fast"`` (default) renders without shadows, reflections and multisampling (``"high"``:
+    the MJCF's settings, ~8x slower in software OpenGL).
+    """
+
+    def __init__(self, env, views, width: int, height: int, quality: str = "fast", line_of_sight: bool = True):
+        import copy
+
+        import mujoco
+
+        self._mujoco = mujoco
+        u = env.unwrapped
+        self.env = u
+        model = copy.copy(u.model)  # visual settings only: the env's own model is never touched
+        model.vis.global_.offwidth = max(int(model.vis.global_.offwidth), width)
+        model.vis.global_.offheight = max(int(model.vis.global_.offheight), height)
+        self.fast = quality == "fast"
+        if self.fast:
+            model.vis.quality.offsamples = 0
+        self.renderer = mujoco.Renderer(model, height, width)
+        self.views = tuple(views)
+        self.line_of_sight = line_of_sight
+        self.eye_camera = getattr(u, "eye_camera", "")
+        self._cameras = {}
+        self._pelvis = None
+        for view in self.views:
+            if isinstance(view, FollowView):
+                cam = mujoco.MjvCamera()
+                cam.type = mujoco.mjtCamera.mjCAMERA_FREE
+                cam.distance, cam.azimuth, cam.elevation = view.distance, view.azimuth, view.elevation
+                self._cameras[view] = cam
+                if self._pelvis is None:
+                    from visuomotor_gym.body import walker_names as wn
+
+                    self._pelvis = mujoco.mj_name2id(u.model, mujoco.mjtObj.mjOBJ_BODY, wn.WALKER_PELVIS)
+                    if self._pelvis < 0:
+                        raise ValueError(f"a follow view needs a walker body named {wn.WALKER_PELVIS!r}")
+            elif mujoco.mj_name2id(u.model, mujoco.mjtObj.mjOBJ_CAMERA, view) < 0:
+                raise ValueError(f"the model of {u.spec.id if u.spec else type(u).__name__} has no camera {view!r}")
+
+    def render(self, info: dict) -> np.ndarray:
+        mujoco = self._mujoco
+        r, d = self.renderer, self.env.data
+        images = []
+        for view in self.views:
+            if isinstance(view, FollowView):
+                cam = self._cameras[view]
+                cam.lookat[:] = d.xpos[self._pelvis] + np.asarray(view.offset)
+                r.model.vis.global_.fovy = view.fovy
+                r.update_scene(d, camera=cam)
+            else:
+                r.update_scene(d, camera=view)
+            if self.fast:
+                r.scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = 0
+                r.scene.flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = 0
+            if self.line_of_sight and view != self.eye_camera:
+                if isinstance(view, FollowView):
+                    _draw_line_of_sight(r.scene, info["eye_pos"], info["gaze_dir"], radius=0.0025 * view.distance)
+                else:
+                    self.env.eye.draw(r.scene)
+            images.append(r.render())
+        return np.concatenate(images, axis=1) if len(images) > 1 else images[0].copy()
+
+    def close(self) -> None:
+        self.renderer.close()
+
+
+def _recording_wrapper(env, render, sink, labeller, stride: int):
     import gymnasium as gym
 
     class FrameRecorder(gym.Wrapper):
-        """Renders after ``reset`` and after each ``step`` and hands the frame to ``sink``."""
+        """Renders after ``reset`` and after every ``stride``-th ``step`` (and the last) for ``sink``."""
 
         def reset(self, **kwargs):
             obs, info = self.env.reset(**kwargs)
+            self._steps = 0
             self._emit(info, None)
             return obs, info
 
         def step(self, action):
             obs, reward, terminated, truncated, info = self.env.step(action)
+            self._steps += 1
             final = None
             if info.get("is_success"):
-                final = "CAUGHT"
+                final = "SUCCESS" if "missed" not in info else "CAUGHT"
             elif terminated or truncated:
-                final = "MISSED" if info.get("missed") else ("TRUNCATED" if truncated else "ENDED")
-            self._emit(info, final)
+                final = _failure_word(info, truncated)
+            if final is not None or self._steps % stride == 0:
+                self._emit(info, final)
             return obs, reward, terminated, truncated, info
 
         def _emit(self, info, final):
-            frame = np.asarray(self.env.render())
+            frame = render(info)
             if labeller is not None:
                 frame = labeller(frame, info, final)
             sink(_even(frame))
@@ -122,19 +264,34 @@ def _recording_wrapper(env, sink, labeller):
     return FrameRecorder(env)
 
 
-def make_render_env(env_id: str, width: int, height: int, camera: str = "both"):
-    """``gym.make(env_id, render_mode="rgb_array", render_camera=camera, width, height)``; envs that
-    take no ``render_camera`` argument are made without it."""
-    import gymnasium as gym
+def _failure_word(info: dict, truncated: bool) -> str:
+    for key, word in (("missed", "MISSED"), ("tripped", "TRIPPED"), ("misstepped", "MISSTEPPED"),
+                      ("off_path", "OFF PATH"), ("fell", "FELL"), ("collided", "COLLIDED"),
+                      ("panel_hit", "PANEL HIT")):
+        if info.get(key):
+            return word
+    return "TRUNCATED" if truncated else "ENDED"
 
-    import visuomotor_gym  # noqa: F401  (registers the ids)
 
-    try:
-        return gym.make(env_id, render_mode="rgb_array", render_camera=camera, width=width, height=height)
-    except TypeError as exc:
-        if "render_camera" not in str(exc):
-            raise
-        return gym.make(env_id, render_mode="rgb_array", width=width, height=height)
+def resolve_views(env, camera: str) -> tuple:
+    """The views of ``camera`` for this env: ``both`` (scene view beside the eye camera), ``scene``,
+    ``eye``, or one of the env's own ``render_camera`` sets (its MJCF cameras: catch/reach
+    ``over_shoulder``, walker ``side``/``follow``, ...). ValueError naming the choices otherwise."""
+    from visuomotor_gym.registration import family_of
+
+    u = env.unwrapped
+    family = family_of(u.spec.id) if u.spec is not None else None
+    scene = SCENE_VIEWS.get(family) if family is not None else None
+    own = dict(getattr(u, "render_cameras", {}))
+    if scene is None:  # an unregistered env: its own scene set
+        scene = own.get("scene", own.get("both", ("",)))[0]
+    eye = u.eye_camera
+    views = {"both": (scene, eye), "scene": (scene,), "eye": (eye,)}
+    for name, cams in own.items():
+        views.setdefault(name, tuple(cams))
+    if camera not in views:
+        raise ValueError(f"camera={camera!r} is not one of {sorted(views)} for {u.spec.id if u.spec else family}")
+    return views[camera]
 
 
 def record_episode(
@@ -148,18 +305,23 @@ def record_episode(
     camera: str = "both",
     overlay: bool = True,
     overwrite: bool = False,
+    stride: int = 1,
+    quality: str = "fast",
 ) -> EpisodeTrace:
     """Play one episode of ``agent_spec`` on ``env_id`` with ``seed`` and write it to ``path`` (MP4, H.264).
 
-    Each camera image is ``width`` x ``height``; with ``camera="both"`` (scene beside eye) a frame is
-    ``2 * width`` wide (odd sizes are padded by one pixel). One frame per control step plus the
-    state after reset (``trace.steps + 1`` frames); ``fps=50`` is real time, the default 25 half
-    speed. ``overlay`` writes a small label (env, agent, seed, time, saccade, outcome) on every
-    frame. The video is written to a temporary file beside ``path`` and renamed when the episode
-    ends, so a failed run leaves no partial video. Refuses to replace an existing ``path``
-    (``FileExistsError``) unless ``overwrite``. Returns the episode's trace, with
-    ``trace.extras["video"] = {"path", "frames", "fps", "frame_size"}``.
+    Each view is ``width`` x ``height``; with ``camera="both"`` (scene view beside eye camera) a frame
+    is ``2 * width`` wide (odd sizes are padded by one pixel). A frame after reset and after every
+    ``stride``-th step and the last (``ceil(steps / stride) + 1`` frames); ``fps = 50 / stride`` is
+    real time, the default (stride 1, fps 25) half speed. ``quality``: ``"fast"`` (no shadows or
+    multisampling) or ``"high"``. ``overlay`` writes a small label (env, agent, seed, time, saccade,
+    outcome) on every frame. The video is written to a temporary file beside ``path`` and renamed
+    when the episode ends, so a failed run leaves no partial video. Refuses to replace an existing
+    ``path`` (``FileExistsError``) unless ``overwrite``. Returns the episode's trace, with
+    ``trace.extras["video"] = {"path", "frames", "fps", "frame_size", "stride", "seconds"}``.
     """
+    import time
+
     path = Path(path)
     if path.suffix.lower() not in VIDEO_SUFFIXES:
         raise ValueError(f"video path must end in one of {VIDEO_SUFFIXES}, got {str(path)!r}")
@@ -168,23 +330,33 @@ def record_episode(
                               "(pass overwrite=True, or --force on the command line)")
     if not (int(width) >= 16 and int(height) >= 16 and int(fps) >= 1):
         raise ValueError(f"width and height must be >= 16 pixels and fps >= 1, got {width}x{height} at {fps}")
+    if not int(stride) >= 1:
+        raise ValueError(f"stride must be >= 1 control step, got {stride!r}")
+    if quality not in QUALITIES:
+        raise ValueError(f"quality must be one of {QUALITIES}, got {quality!r}")
     _default_headless_gl()
+    import gymnasium as gym
     import imageio.v2 as imageio
 
+    import visuomotor_gym  # noqa: F401  (registers the ids)
     from visuomotor_gym.agents import make_agent
 
-    width, height, fps = int(width), int(height), int(fps)
+    start = time.perf_counter()
+    width, height, fps, stride = int(width), int(height), int(fps), int(stride)
     tmp = path.with_name(f".{path.stem}.partial{path.suffix}")
-    env = make_render_env(env_id, width, height, camera)
+    env = gym.make(env_id)
+    renderer = None
     try:
-        both = getattr(env.unwrapped, "render_camera", None) == "both"
-        panels = ("scene camera", "eye camera") if both else ()
+        views = resolve_views(env, camera)
+        policy = make_agent(agent_spec, env_id, env.action_space.shape[0], seed=seed)
+        renderer = FrameRenderer(env, views, width, height, quality=quality)
+        panels = ("scene view", "eye camera") if camera == "both" else ()
         header = f"{env_id} | {agent_spec} | seed {seed}"
         labeller = _Labeller(height, header, panels, width) if overlay else None
-        policy = make_agent(agent_spec, env_id, env.action_space.shape[0], seed=seed)
         path.parent.mkdir(parents=True, exist_ok=True)
+        # x264's "veryfast" preset: half the encoding time of the default ("medium") at the same size.
         writer = imageio.get_writer(tmp, format="FFMPEG", mode="I", fps=fps, codec="libx264", quality=7,
-                                    pixelformat="yuv420p", macro_block_size=1)
+                                    pixelformat="yuv420p", macro_block_size=1, output_params=["-preset", "veryfast"])
         frames: list[tuple[int, int]] = []  # (width, height) of every frame written
 
         def sink(frame):
@@ -192,7 +364,8 @@ def record_episode(
             frames.append((frame.shape[1], frame.shape[0]))
 
         try:
-            trace = run_episode(_recording_wrapper(env, sink, labeller), policy, seed, env_id, agent_spec)
+            trace = run_episode(_recording_wrapper(env, renderer.render, sink, labeller, stride), policy, seed,
+                                env_id, agent_spec)
         finally:
             writer.close()
         if path.exists() and not overwrite:  # appeared while we were recording
@@ -203,6 +376,9 @@ def record_episode(
         tmp.unlink(missing_ok=True)
         raise
     finally:
+        if renderer is not None:
+            renderer.close()
         env.close()
-    trace.extras["video"] = {"path": str(path), "frames": len(frames), "fps": fps, "frame_size": frames[0]}
+    trace.extras["video"] = {"path": str(path), "frames": len(frames), "fps": fps, "frame_size": frames[0],
+                             "stride": stride, "seconds": time.perf_counter() - start}
     return trace
