@@ -343,6 +343,54 @@ def test_record_writes_a_readable_mp4(tmp_path, capsys):
     assert len(frames) == 1 + math.ceil(trace.steps / 5)
 
 
+def _walker_share(env, views, info):
+    """Share of the pixels of ``views`` (160 x 120 each) showing the walker, and the body names seen."""
+    import mujoco
+
+    from visuomotor_gym.viz.video import FrameRenderer
+
+    m = env.unwrapped.model
+    renderer = FrameRenderer(env, views, 160, 120)
+    try:
+        renderer.renderer.enable_segmentation_rendering()
+        seg = renderer.render(info)
+    finally:
+        renderer.close()
+    ids, types = seg[..., 0], seg[..., 1]
+    geom = (types == int(mujoco.mjtObj.mjOBJ_GEOM)) & (ids >= 0)
+    bodies = m.geom_bodyid[ids[geom]]
+    pelvis = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "pelvis")
+    share = np.count_nonzero(m.body_rootid[bodies] == m.body_rootid[pelvis]) / ids.size
+    return share, {mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, int(b)) for b in np.unique(bodies)}
+
+
+@pytest.mark.render
+@pytest.mark.parametrize("env_id", ["ObstacleWalk-v0", "SteppingStones-v0", "ObstacleDodge-v0"])
+def test_the_walker_families_scene_view_shows_the_walker_and_its_targets(env_id):
+    """The follow view keeps the walker readable (>= 0.4 % of the image, ~25 x 25 pixels at 480 x 360),
+    and the targets in view: obstacles, stones, a pedestrian. The dodge scene's own top camera, the old
+    scene view, shows the walker on ~0.03 % of the image (a few pixels) and fails the same check."""
+    import gymnasium as gym
+
+    import visuomotor_gym  # noqa: F401
+    from visuomotor_gym.viz.video import resolve_views
+
+    env = gym.make(env_id)
+    try:
+        env.reset(seed=0)
+        for _ in range(150):  # 3 s of the nominal gait: the first pedestrian is on stage
+            _, _, terminated, truncated, info = env.step(np.zeros(env.action_space.shape, np.float32))
+            assert not (terminated or truncated)
+        share, seen = _walker_share(env, resolve_views(env, "scene"), info)
+        assert share >= 0.004, share
+        target = {"ObstacleWalk-v0": "obstacle", "SteppingStones-v0": "stone", "ObstacleDodge-v0": "pedestrian"}
+        assert any(target[env_id] in (name or "") for name in seen), seen
+        if env_id == "ObstacleDodge-v0":
+            assert _walker_share(env, ("dodge_top",), info)[0] < 0.001
+    finally:
+        env.close()
+
+
 def test_record_rejects_bad_arguments_without_playing(tmp_path):
     from visuomotor_gym.viz.video import record_episode
 

@@ -62,7 +62,7 @@ SCENE_VIEWS: dict[str, str | FollowView] = {
     # From behind, higher: the next stones ahead (the path turns by up to 60 deg, still in view).
     "stones": FollowView(distance=5.5, azimuth=20.0, elevation=-45.0, offset=(1.5, 0.0, -0.8)),
     # From behind and high: 6 m ahead and the pedestrians starting 4-6 m to either side.
-    "dodge": FollowView(distance=11.5, azimuth=0.0, elevation=-50.0, offset=(3.5, 0.0, -0.9), fovy=50.0),
+    "dodge": FollowView(distance=10.0, azimuth=0.0, elevation=-40.0, offset=(3.5, 0.0, -0.9), fovy=50.0),
 }
 
 
@@ -151,11 +151,13 @@ def _draw_line_of_sight(scene, eye_pos, gaze_dir, radius: float, max_range_m: fl
         geom = scene.geoms[scene.ngeom]
         mujoco.mjv_initGeom(geom, mujoco.mjtGeom.mjGEOM_CAPSULE, np.zeros(3), np.zeros(3), np.eye(3).ravel(), color)
         mujoco.mjv_connector(geom, mujoco.mjtGeom.mjGEOM_CAPSULE, radius, eye, end)
+        geom.segid = scene.ngeom  # as mjv_updateScene numbers its geoms (segmentation rendering reads it)
         scene.ngeom += 1
     if hit and scene.ngeom < scene.maxgeom:
         geom = scene.geoms[scene.ngeom]
         mujoco.mjv_initGeom(geom, mujoco.mjtGeom.mjGEOM_SPHERE, np.full(3, 3.0 * radius), end, np.eye(3).ravel(),
                             np.array([0.1, 0.9, 0.2, 1.0], dtype=np.float32))
+        geom.segid = scene.ngeom
         scene.ngeom += 1
 
 
