@@ -135,6 +135,18 @@ class _Labeller:
         return np.asarray(img)
 
 
+def _mark_decor(geom, index: int) -> None:
+    """A drawn geom is decoration of no model object (``mjv_initGeom`` leaves the slot's old object id,
+    which segmentation rendering would read as a model geom); its segmentation id is its index, as
+    ``mjv_updateScene`` numbers the scene's geoms."""
+    import mujoco
+
+    geom.objtype = int(mujoco.mjtObj.mjOBJ_UNKNOWN)
+    geom.objid = -1
+    geom.category = int(mujoco.mjtCatBit.mjCAT_DECOR)
+    geom.segid = index
+
+
 def _draw_line_of_sight(scene, eye_pos, gaze_dir, radius: float, max_range_m: float = 30.0) -> None:
     """A green capsule from the eye along the line of sight to where it meets the floor (a green dot
     there), or ``max_range_m / 4`` long when it does not meet the floor within ``max_range_m``."""
@@ -151,13 +163,13 @@ def _draw_line_of_sight(scene, eye_pos, gaze_dir, radius: float, max_range_m: fl
         geom = scene.geoms[scene.ngeom]
         mujoco.mjv_initGeom(geom, mujoco.mjtGeom.mjGEOM_CAPSULE, np.zeros(3), np.zeros(3), np.eye(3).ravel(), color)
         mujoco.mjv_connector(geom, mujoco.mjtGeom.mjGEOM_CAPSULE, radius, eye, end)
-        geom.segid = scene.ngeom  # as mjv_updateScene numbers its geoms (segmentation rendering reads it)
+        _mark_decor(geom, scene.ngeom)
         scene.ngeom += 1
     if hit and scene.ngeom < scene.maxgeom:
         geom = scene.geoms[scene.ngeom]
         mujoco.mjv_initGeom(geom, mujoco.mjtGeom.mjGEOM_SPHERE, np.full(3, 3.0 * radius), end, np.eye(3).ravel(),
                             np.array([0.1, 0.9, 0.2, 1.0], dtype=np.float32))
-        geom.segid = scene.ngeom
+        _mark_decor(geom, scene.ngeom)
         scene.ngeom += 1
 
 
