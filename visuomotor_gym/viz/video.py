@@ -51,6 +51,11 @@ class FollowView:
     elevation: float
     offset: tuple[float, float, float]
     fovy: float = 45.0
+    # Turn with the walker: azimuth and offset are then relative to the pelvis's heading, smoothed with
+    # a first-order filter of time constant heading_tau_s (modelling choice: 1 s averages out the
+    # gait's sway of the pelvis, ~2 steps, and still turns with the path within a few steps).
+    follow_heading: bool = False
+    heading_tau_s: float = 1.0
 
 
 # The scene view of each family: an MJCF camera name (catch, reach) or a FollowView (walker families).
@@ -59,8 +64,8 @@ SCENE_VIEWS: dict[str, str | FollowView] = {
     "reach": "scene_camera",
     # From behind and to the right, above: the legs and the next 3-4 m of walkway with its obstacles.
     "walk": FollowView(distance=5.0, azimuth=55.0, elevation=-28.0, offset=(1.6, 0.0, -0.6)),
-    # From behind, higher: the next stones ahead (the path turns by up to 60 deg, still in view).
-    "stones": FollowView(distance=5.5, azimuth=20.0, elevation=-45.0, offset=(1.5, 0.0, -0.8)),
+    # From behind the walker, higher, turning with it: the next stones ahead (the path turns by up to 60 deg).
+    "stones": FollowView(distance=5.0, azimuth=30.0, elevation=-50.0, offset=(1.5, 0.0, -0.8), follow_heading=True),
     # From behind and high: 6 m ahead and the pedestrians starting 4-6 m to either side.
     "dodge": FollowView(distance=10.0, azimuth=0.0, elevation=-40.0, offset=(3.5, 0.0, -0.9), fovy=50.0),
 }
@@ -202,6 +207,7 @@ class FrameRenderer:
         self.line_of_sight = line_of_sight
         self.eye_camera = getattr(u, "eye_camera", "")
         self._cameras = {}
+        self._headings: dict = {}
         self._pelvis = None
         for view in self.views:
             if isinstance(view, FollowView):
@@ -225,7 +231,13 @@ class FrameRenderer:
         for view in self.views:
             if isinstance(view, FollowView):
                 cam = self._cameras[view]
-                cam.lookat[:] = d.xpos[self._pelvis] + np.asarray(view.offset)
+                offset = np.asarray(view.offset, dtype=float)
+                if view.follow_heading:
+                    heading = self._heading(view, d)
+                    c, s = np.cos(heading), np.sin(heading)
+                    offset = np.array([c * offset[0] - s * offset[1], s * offset[0] + c * offset[1], offset[2]])
+                    cam.azimuth = view.azimuth + np.degrees(heading)
+                cam.lookat[:] = d.xpos[self._pelvis] + offset
                 r.model.vis.global_.fovy = view.fovy
                 r.update_scene(d, camera=cam)
             else:
@@ -240,6 +252,20 @@ class FrameRenderer:
                     self.env.eye.draw(r.scene)
             images.append(r.render())
         return np.concatenate(images, axis=1) if len(images) > 1 else images[0].copy()
+
+    def _heading(self, view: FollowView, data) -> float:
+        """The pelvis's heading (rad, about z), low-pass filtered per view over the frames rendered."""
+        x_axis = data.xmat[self._pelvis].reshape(3, 3)[:, 0]
+        now = float(np.arctan2(x_axis[1], x_axis[0]))
+        last = self._headings.get(view)
+        if last is None:
+            self._headings[view] = (now, float(data.time))
+            return now
+        value, t = last
+        alpha = 1.0 - np.exp(-max(float(data.time) - t, 0.0) / view.heading_tau_s)
+        value += alpha * float(np.angle(np.exp(1j * (now - value))))  # the short way round
+        self._headings[view] = (value, float(data.time))
+        return value
 
     def close(self) -> None:
         self.renderer.close()
