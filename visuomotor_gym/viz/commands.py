@@ -156,7 +156,7 @@ def cmd_record(args: argparse.Namespace) -> int:
     out = Path(args.out)
     if out.suffix.lower() not in VIDEO_SUFFIXES:
         return _fail("record", f"--out must end in one of {', '.join(VIDEO_SUFFIXES)}, got {str(out)!r}")
-    if not (args.width >= 16 and args.height >= 16 and args.fps >= 1 and args.stride >= 1):
+    if not (args.width >= 16 and args.height >= 16 and args.fps >= 1 and (args.stride is None or args.stride >= 1)):
         return _fail("record", f"--width/--height must be >= 16 pixels, --fps and --stride >= 1; got "
                                f"{args.width}x{args.height}, fps {args.fps}, stride {args.stride}")
     if args.quality not in QUALITIES:
@@ -209,7 +209,8 @@ def register(subparsers) -> None:
         "record",
         help="record one episode as an MP4 (scene view beside the eye camera)",
         description="Play one episode and write an MP4: a frame after reset and after every --stride-th 20 ms "
-        "control step (fps = 50 / stride is real time; the defaults, stride 1 and fps 25, half speed). "
+        "control step (fps = 50 / stride is real time; at the default 25 fps, catch and reach (stride 1) play at "
+        "half speed, the walker families (stride 2) in real time). "
         "Scene view: the fixed scene camera for catch and reach, a camera following the walker for walk, "
         "stones and dodge; the line of sight is drawn in green. Refuses to overwrite --out unless --force.",
     )
@@ -221,7 +222,8 @@ def register(subparsers) -> None:
                    help="width of each view (with --camera both the video is twice as wide)")
     p.add_argument("--height", type=int, default=360)
     p.add_argument("--fps", type=int, default=25, help="frames per second (default 25; 50 / stride is real time)")
-    p.add_argument("--stride", type=int, default=1, help="render every N-th control step (default 1: every step)")
+    p.add_argument("--stride", type=int, default=None,
+                   help="render every N-th control step (default: 1 for catch and reach, 2 for walk, stones, dodge)")
     p.add_argument("--camera", default="both",
                    help="both (scene view beside eye, every family), scene, eye, or a family's own MJCF camera "
                         "(catch/reach: over_shoulder; walker families: side, follow; ...); an unknown one is "

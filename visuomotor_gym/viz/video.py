@@ -2,9 +2,11 @@
 green dot where it meets the floor) beside the eye camera.
 
 **Timing**: the env runs at 50 control steps per second; a frame is rendered after ``reset`` and after
-every ``stride``-th step (the last step always), so ``fps = 50 / stride`` plays in real time. The
-defaults, ``stride=1`` and ``fps=25``, play at **half speed** (a 1 s throw lasts 2 s on screen, slow
-enough to see the saccades), as ``vmgym demo`` does.
+every ``stride``-th step (the last step always), so ``fps = 50 / stride`` plays in real time. With
+the default ``fps=25`` the catch and reach families (``stride`` 1 by default, episodes of 1-3 s) play
+at **half speed** (a 1 s throw lasts 2 s on screen, slow enough to see the saccades), as ``vmgym
+demo`` does; the walker families (``stride`` 2 by default, episodes of 10-20 s) in real time
+(:data:`DEFAULT_STRIDE`).
 
 **Scene views** (:data:`SCENE_VIEWS`): the catch and reach families use their scene's fixed camera
 (``scene_camera`` in the MJCF); the walker families (walk, stones, dodge) a camera defined here, not
@@ -37,6 +39,10 @@ from visuomotor_gym.bench.trace import EpisodeTrace, run_episode
 VIDEO_SUFFIXES = (".mp4", ".mkv", ".mov")
 QUALITIES = ("fast", "high")
 CONTROL_HZ = 50  # the envs' control rate (dt = 20 ms): fps = CONTROL_HZ / stride is real time
+# Frames per control step by family (modelling choice): every step for the short catch and reach
+# episodes (saccades of 40-60 ms span 2-3 frames); every other step for the walker families, whose
+# 10-20 s episodes would otherwise take twice as long to render and to watch.
+DEFAULT_STRIDE = {"catch": 1, "reach": 1, "walk": 2, "stones": 2, "dodge": 2}
 
 
 @dataclass(frozen=True)
@@ -345,7 +351,7 @@ def record_episode(
     camera: str = "both",
     overlay: bool = True,
     overwrite: bool = False,
-    stride: int = 1,
+    stride: int | None = None,
     quality: str = "fast",
 ) -> EpisodeTrace:
     """Play one episode of ``agent_spec`` on ``env_id`` with ``seed`` and write it to ``path`` (MP4, H.264).
@@ -353,7 +359,8 @@ def record_episode(
     Each view is ``width`` x ``height``; with ``camera="both"`` (scene view beside eye camera) a frame
     is ``2 * width`` wide (odd sizes are padded by one pixel). A frame after reset and after every
     ``stride``-th step and the last (``ceil(steps / stride) + 1`` frames); ``fps = 50 / stride`` is
-    real time, the default (stride 1, fps 25) half speed. ``quality``: ``"fast"`` (no shadows or
+    real time. ``stride=None`` takes the family's :data:`DEFAULT_STRIDE` (1 for catch and reach: half
+    speed at the default 25 fps; 2 for the walker families: real time). ``quality``: ``"fast"`` (no shadows or
     multisampling) or ``"high"``. ``overlay`` writes a small label (env, agent, seed, time, saccade,
     outcome) on every frame. The video is written to a temporary file beside ``path`` and renamed
     when the episode ends, so a failed run leaves no partial video. Refuses to replace an existing
@@ -370,7 +377,7 @@ def record_episode(
                               "(pass overwrite=True, or --force on the command line)")
     if not (int(width) >= 16 and int(height) >= 16 and int(fps) >= 1):
         raise ValueError(f"width and height must be >= 16 pixels and fps >= 1, got {width}x{height} at {fps}")
-    if not int(stride) >= 1:
+    if stride is not None and not int(stride) >= 1:
         raise ValueError(f"stride must be >= 1 control step, got {stride!r}")
     if quality not in QUALITIES:
         raise ValueError(f"quality must be one of {QUALITIES}, got {quality!r}")
@@ -382,6 +389,10 @@ def record_episode(
     from visuomotor_gym.agents import make_agent
 
     start = time.perf_counter()
+    if stride is None:
+        from visuomotor_gym.registration import family_of
+
+        stride = DEFAULT_STRIDE.get(family_of(env_id), 1)
     width, height, fps, stride = int(width), int(height), int(fps), int(stride)
     tmp = path.with_name(f".{path.stem}.partial{path.suffix}")
     env = gym.make(env_id)
