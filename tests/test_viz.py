@@ -381,6 +381,17 @@ def test_the_walker_families_scene_view_shows_the_walker_and_its_targets(env_id)
         for _ in range(150):  # 3 s of the nominal gait: the first pedestrian is on stage
             _, _, terminated, truncated, info = env.step(np.zeros(env.action_space.shape, np.float32))
             assert not (terminated or truncated)
+        # The recorder renders the env's own model (the task moved and resized the obstacles and stones
+        # at reset) and leaves its visual settings as they were.
+        from visuomotor_gym.viz.video import FrameRenderer
+
+        u = env.unwrapped
+        before = (u.model.vis.quality.offsamples, u.model.vis.global_.offwidth, u.model.vis.global_.fovy)
+        renderer = FrameRenderer(env, resolve_views(env, "both"), 2000, 100)
+        renderer.render(info)
+        assert renderer.renderer.model is u.model
+        renderer.close()
+        assert (u.model.vis.quality.offsamples, u.model.vis.global_.offwidth, u.model.vis.global_.fovy) == before
         share, seen = _walker_share(env, resolve_views(env, "scene"), info)
         assert share >= 0.004, share
         target = {"ObstacleWalk-v0": "obstacle", "SteppingStones-v0": "stone", "ObstacleDodge-v0": "pedestrian"}

@@ -16,9 +16,12 @@ chosen per family so that what the task is about stays in view: the next obstacl
 stones (stones), the pedestrians 4-6 m to either side (dodge).
 
 **Speed** (software OpenGL, Mesa llvmpipe, on a headless machine): shadows and 4x multisampling cost
-~8x the rest of a frame, so they are off unless ``quality="high"``; one :class:`mujoco.Renderer` (one
-GL context) renders both views of every frame. A walker episode of ~800 steps went from ~4 minutes
-to under a minute (issue 26; the numbers and command are in the viz branch's report).
+~4-8x the rest of a frame, so they are off unless ``quality="high"``; one :class:`mujoco.Renderer`
+(one GL context) renders both views of every frame; x264 encodes with its ``veryfast`` preset. One
+ObstacleWalk-v0 episode (iwao, seed 0, 765 steps) on a 2-core machine under load (~9.5): before,
+765 frames in 460 s wall, 146 CPU-s (190 ms CPU a frame); now 765 frames (``stride=1``) in 56-60 s
+wall, 28-30 CPU-s (37-39 ms CPU a frame), and with the walker default ``stride=2`` 383 frames in
+25 s wall, 15 CPU-s.
 
 The episode is played by :func:`visuomotor_gym.bench.trace.run_episode` itself (the policy sees
 observations only); a thin wrapper renders a frame after ``reset`` and after every ``stride``-th
@@ -195,20 +198,24 @@ class FrameRenderer:
     """
 
     def __init__(self, env, views, width: int, height: int, quality: str = "fast", line_of_sight: bool = True):
-        import copy
-
         import mujoco
 
         self._mujoco = mujoco
         u = env.unwrapped
         self.env = u
-        model = copy.copy(u.model)  # visual settings only: the env's own model is never touched
-        model.vis.global_.offwidth = max(int(model.vis.global_.offwidth), width)
-        model.vis.global_.offheight = max(int(model.vis.global_.offheight), height)
+        # The env's own model (a task resizes and moves its geoms at reset: a copy would go stale). The
+        # visual settings read when the GL context is made are changed for that moment only.
+        model = u.model
         self.fast = quality == "fast"
-        if self.fast:
-            model.vis.quality.offsamples = 0
-        self.renderer = mujoco.Renderer(model, height, width)
+        saved = (int(model.vis.global_.offwidth), int(model.vis.global_.offheight), int(model.vis.quality.offsamples))
+        try:
+            model.vis.global_.offwidth = max(saved[0], width)
+            model.vis.global_.offheight = max(saved[1], height)
+            if self.fast:
+                model.vis.quality.offsamples = 0
+            self.renderer = mujoco.Renderer(model, height, width)
+        finally:
+            model.vis.global_.offwidth, model.vis.global_.offheight, model.vis.quality.offsamples = saved
         self.views = tuple(views)
         self.line_of_sight = line_of_sight
         self.eye_camera = getattr(u, "eye_camera", "")
@@ -244,8 +251,12 @@ class FrameRenderer:
                     offset = np.array([c * offset[0] - s * offset[1], s * offset[0] + c * offset[1], offset[2]])
                     cam.azimuth = view.azimuth + np.degrees(heading)
                 cam.lookat[:] = d.xpos[self._pelvis] + offset
-                r.model.vis.global_.fovy = view.fovy
-                r.update_scene(d, camera=cam)
+                vis = self.env.model.vis.global_
+                fovy, vis.fovy = float(vis.fovy), view.fovy  # a free camera's field of view, for this view only
+                try:
+                    r.update_scene(d, camera=cam)
+                finally:
+                    vis.fovy = fovy
             else:
                 r.update_scene(d, camera=view)
             if self.fast:
