@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -201,6 +203,105 @@ def test_a_missed_episode_is_plotted_too(tmp_path):
 
 
 # ----------------------------------------------------------------------------------------------
+# Every family: a real short episode of its reference agent, plotted
+# ----------------------------------------------------------------------------------------------
+# (env id, agent, control steps: a few seconds, enough for saccades, footholds and a target in view,
+# titles each figure must have)
+FAMILY_EPISODES = {
+    "catch": ("EyeCatch-v0", "eyecatch", 125, ("Gaze vs ball", "Visual field", "Tangential velocity",
+                                               "Ball and hand paths")),
+    "reach": ("ShelfReach-v0", "faraway", 150, ("Top view", "Seen from the eye", "line of sight and the object",
+                                                "Hand to object")),
+    "walk": ("ObstacleWalk-v0", "iwao", 200, ("Top view", "Side view", "Gaze over time", "Look-ahead")),
+    "stones": ("SteppingStones-v0", "lookahead", 200, ("Top view", "Gaze over time", "Which stone")),
+    "dodge": ("ObstacleDodge-v0", "fajen_warren", 250, ("Top view", "Gaze over time", "each pedestrian",
+                                                        "distance to each pedestrian")),
+}
+
+
+def short_episode(env_id, agent, steps, seed=0):
+    import gymnasium as gym
+
+    import visuomotor_gym  # noqa: F401
+    from visuomotor_gym.agents import make_agent
+
+    env = gym.make(env_id, max_episode_steps=steps)
+    try:
+        policy = make_agent(agent, env_id, env.action_space.shape[0], seed=seed)
+        return run_episode(env, policy, seed, env_id, agent)
+    finally:
+        env.close()
+
+
+@pytest.mark.parametrize("family", sorted(FAMILY_EPISODES))
+def test_every_family_is_plotted_from_a_real_episode(family, tmp_path):
+    from matplotlib.collections import PathCollection
+
+    env_id, agent, steps, titles = FAMILY_EPISODES[family]
+    trace = short_episode(env_id, agent, steps)
+    assert plots.trace_family(trace) == family
+    assert trace.steps <= steps and np.count_nonzero(trace.saccade_onset) >= 1
+    fig = plots.episode_figure(trace)
+    got = [ax.get_title() for ax in fig.axes]
+    for title in titles:
+        assert any(title in t for t in got), (title, got)
+    assert env_id in fig.get_suptitle() and agent in fig.get_suptitle()
+    if family != "catch":
+        # The gaze points are drawn, coloured by time (a colour bar in seconds), some on the scene.
+        assert any(ax.get_ylabel() == "time (s)" for ax in fig.axes)
+        scatters = [c for c in fig.axes[0].collections if isinstance(c, PathCollection)
+                    and c.get_label().startswith("gaze")]
+        assert scatters and max(len(c.get_offsets()) for c in scatters) >= 5
+    path = plots.save_figure(fig, tmp_path / f"{family}.png")  # what plot_episode writes
+    img = iio.imread(path)
+    assert img.ndim == 3 and img.shape[0] >= 900 and img.shape[1] >= 1400 and path.stat().st_size > 80_000
+    rgb = img[..., :3].astype(float)
+    assert np.mean(rgb.min(axis=2) < 200) > 0.03 and np.mean(np.ptp(rgb, axis=2) > 60) > 0.005
+
+
+def test_gaze_points_meet_the_floor_and_the_boxes():
+    from visuomotor_gym.viz import family_plots as fp
+
+    n = 4
+    eye = np.tile([0.0, 0.0, 1.5], (n, 1))
+    down45 = np.array([1.0, 0.0, -1.0])
+    gaze = np.array([down45, down45, [1.0, 0.0, 0.0], [0.0, 1.0, -0.01]])
+    tr = synthetic_trace(n, gaze=gaze, eye=eye)
+    p = fp.gaze_points(tr)
+    np.testing.assert_allclose(p[0], [1.5, 0.0, 0.0], atol=1e-12)  # 45 deg down from 1.5 m: 1.5 m ahead
+    assert np.isnan(p[2]).all()  # level: never meets the floor
+    assert np.isnan(p[3]).all()  # meets it 150 m away, beyond the range drawn
+    box = (np.array([1.0, -0.5, 0.0]), np.array([1.2, 0.5, 0.3]))  # a 30 cm box between the eye and that point
+    p = fp.gaze_points(tr, boxes=[box])
+    np.testing.assert_allclose(p[0], [1.2, 0.0, 0.3], atol=1e-12)  # its top face, 1.2 m ahead
+    assert np.isinf(fp.ray_box_distance(eye[:1], -gaze[:1], *box)).all()  # behind the eye: no hit
+
+
+def test_footholds_are_the_still_planted_runs_of_a_sole():
+    from visuomotor_gym.viz import family_plots as fp
+
+    n = 30
+    feet = np.zeros((n, 2, 3))
+    feet[:, 0, :2] = [0.2, 0.1]  # left planted throughout
+    feet[:10, 1, :2] = [0.0, -0.1]  # right planted, swings (lifted, moving), planted again
+    feet[10:20, 1] = np.stack([np.linspace(0.0, 0.6, 10), np.full(10, -0.1), np.full(10, 0.1)], axis=1)
+    feet[20:, 1, :2] = [0.6, -0.1]
+    tr = synthetic_trace(n)
+    tr.task["feet_pos"] = feet
+    left, right = fp.footholds(tr)
+    np.testing.assert_allclose(left[:, :2], [[0.2, 0.1]])
+    np.testing.assert_allclose(right[:, :2], [[0.0, -0.1], [0.6, -0.1]])
+    np.testing.assert_allclose(right[:, 2:], [[0.0, 9 * DT], [20 * DT, 29 * DT]])
+
+
+def test_a_trace_of_no_known_family_is_refused():
+    tr = synthetic_trace(5)
+    tr.task = {}
+    with pytest.raises(ValueError, match="cannot tell the family"):
+        plots.episode_figure(tr)
+
+
+# ----------------------------------------------------------------------------------------------
 # Video and commands
 # ----------------------------------------------------------------------------------------------
 def _parser():
@@ -229,15 +330,76 @@ def test_record_writes_a_readable_mp4(tmp_path, capsys):
         record_episode("oracle", ENV_ID, 0, out, width=96, height=72)
     before = out.stat().st_mtime_ns
     # The command line refuses too, before playing anything, and says how to force it.
-    assert _run(["record", "--agent", "oracle", "--env", ENV_ID, "--out", str(out)]) == 1
+    assert _run(["record", "--agent", "oracle", "--env", ENV_ID, "--out", str(out)]) == 2
     err = capsys.readouterr().err
-    assert "already exists" in err and "--force" in err
+    assert "already exists" in err and "--force" in err and err.count("\n") == 1
     assert out.stat().st_mtime_ns == before
-    # --force replaces it (odd sizes padded to even for H.264).
+    # --force replaces it (odd sizes padded to even for H.264); --stride 5 keeps every 5th step and the last.
     assert _run(["record", "--agent", "oracle", "--env", ENV_ID, "--out", str(out), "--width", "33",
-                 "--height", "25", "--camera", "eye", "--force"]) == 0
+                 "--height", "25", "--camera", "eye", "--stride", "5", "--force"]) == 0
     assert str(out) in capsys.readouterr().out
-    assert iio.imread(out).shape[1:] == (26, 34, 3)
+    frames = iio.imread(out)
+    assert frames.shape[1:] == (26, 34, 3)
+    assert len(frames) == 1 + math.ceil(trace.steps / 5)
+
+
+def _walker_share(env, views, info):
+    """Share of the pixels of ``views`` (160 x 120 each) showing the walker, and the body names seen."""
+    import mujoco
+
+    from visuomotor_gym.viz.video import FrameRenderer
+
+    m = env.unwrapped.model
+    renderer = FrameRenderer(env, views, 160, 120)
+    try:
+        renderer.renderer.enable_segmentation_rendering()
+        seg = renderer.render(info)
+    finally:
+        renderer.close()
+    ids, types = seg[..., 0], seg[..., 1]
+    geom = (types == int(mujoco.mjtObj.mjOBJ_GEOM)) & (ids >= 0)
+    bodies = m.geom_bodyid[ids[geom]]
+    pelvis = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "pelvis")
+    share = np.count_nonzero(m.body_rootid[bodies] == m.body_rootid[pelvis]) / ids.size
+    return share, {mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, int(b)) for b in np.unique(bodies)}
+
+
+@pytest.mark.render
+@pytest.mark.parametrize("env_id", ["ObstacleWalk-v0", "SteppingStones-v0", "ObstacleDodge-v0"])
+def test_the_walker_families_scene_view_shows_the_walker_and_its_targets(env_id):
+    """The follow view keeps the walker readable (>= 0.4 % of the image, ~25 x 25 pixels at 480 x 360),
+    and the targets in view: obstacles, stones, a pedestrian. The dodge scene's own top camera, the old
+    scene view, shows the walker on ~0.03 % of the image (a few pixels) and fails the same check."""
+    import gymnasium as gym
+
+    import visuomotor_gym  # noqa: F401
+    from visuomotor_gym.viz.video import resolve_views
+
+    env = gym.make(env_id)
+    try:
+        env.reset(seed=0)
+        for _ in range(150):  # 3 s of the nominal gait: the first pedestrian is on stage
+            _, _, terminated, truncated, info = env.step(np.zeros(env.action_space.shape, np.float32))
+            assert not (terminated or truncated)
+        # The recorder renders the env's own model (the task moved and resized the obstacles and stones
+        # at reset) and leaves its visual settings as they were.
+        from visuomotor_gym.viz.video import FrameRenderer
+
+        u = env.unwrapped
+        before = (u.model.vis.quality.offsamples, u.model.vis.global_.offwidth, u.model.vis.global_.fovy)
+        renderer = FrameRenderer(env, resolve_views(env, "both"), 2000, 100)
+        renderer.render(info)
+        assert renderer.renderer.model is u.model
+        renderer.close()
+        assert (u.model.vis.quality.offsamples, u.model.vis.global_.offwidth, u.model.vis.global_.fovy) == before
+        share, seen = _walker_share(env, resolve_views(env, "scene"), info)
+        assert share >= 0.004, share
+        target = {"ObstacleWalk-v0": "obstacle", "SteppingStones-v0": "stone", "ObstacleDodge-v0": "pedestrian"}
+        assert any(target[env_id] in (name or "") for name in seen), seen
+        if env_id == "ObstacleDodge-v0":
+            assert _walker_share(env, ("dodge_top",), info)[0] < 0.001
+    finally:
+        env.close()
 
 
 def test_record_rejects_bad_arguments_without_playing(tmp_path):
@@ -247,14 +409,67 @@ def test_record_rejects_bad_arguments_without_playing(tmp_path):
         record_episode("oracle", ENV_ID, 0, tmp_path / "x.gif")
     with pytest.raises(ValueError, match="pixels"):
         record_episode("oracle", ENV_ID, 0, tmp_path / "x.mp4", width=4)
+    with pytest.raises(ValueError, match="stride"):
+        record_episode("oracle", ENV_ID, 0, tmp_path / "x.mp4", stride=0)
+    with pytest.raises(ValueError, match="quality"):
+        record_episode("oracle", ENV_ID, 0, tmp_path / "x.mp4", quality="ultra")
     assert _run(["record", "--agent", "oracle", "--env", ENV_ID, "--out", str(tmp_path / "x.gif")]) == 2
     assert not list(tmp_path.iterdir())
+
+
+def _one_line_exit_2(argv, capsys, *needles):
+    """The command exits 2 at once with one line on stderr that holds every needle."""
+    import time
+
+    start = time.perf_counter()
+    assert _run(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err, err
+    for needle in needles:
+        assert needle in err, (needle, err)
+    assert time.perf_counter() - start < 5.0  # refused before any episode is played or rendered
+    return err
+
+
+@pytest.mark.parametrize("command", ["plot", "record"])
+def test_outputs_env_and_agent_are_checked_before_any_work(command, tmp_path, capsys):
+    out_arg = (lambda p: str(p / "ep.mp4")) if command == "record" else str
+    base = [command, "--agent", "oracle", "--env", ENV_ID]
+    # An output under /proc, and one in a folder that cannot be written.
+    _one_line_exit_2(base + ["--out", out_arg(Path("/proc/vmgym-no-such"))], capsys, "cannot write")
+    blocker = tmp_path / "a-file"  # a folder that cannot be made: its parent is a file (root or not)
+    blocker.write_text("")
+    _one_line_exit_2(base + ["--out", out_arg(blocker / "sub")], capsys, "cannot write")
+    if os.geteuid() != 0:  # a read-only folder (root may write anywhere)
+        locked = tmp_path / "locked"
+        locked.mkdir()
+        locked.chmod(0o500)
+        try:
+            _one_line_exit_2(base + ["--out", out_arg(locked)], capsys, "cannot write")
+        finally:
+            locked.chmod(0o700)
+    # A bad env id and a bad agent: one line naming the choices.
+    _one_line_exit_2([command, "--agent", "oracle", "--env", "NoSuchEnv-v0", "--out", out_arg(tmp_path)], capsys,
+                     "unknown env id 'NoSuchEnv-v0'", "EyeCatch-v0")
+    _one_line_exit_2([command, "--agent", "no-such-agent", "--env", ENV_ID, "--out", out_arg(tmp_path)], capsys,
+                     "unknown agent 'no-such-agent'", "eyecatch")
+    # An existing output file is refused without --force and left alone.
+    target = (tmp_path / "ep.mp4") if command == "record" else tmp_path / commands.plot_filename(ENV_ID, "oracle", 0)
+    target.write_bytes(b"keep me")
+    _one_line_exit_2(base + ["--out", out_arg(tmp_path)], capsys, "already exists", "--force")
+    assert target.read_bytes() == b"keep me"
+    assert not list(tmp_path.glob(".vmgym-write-probe*"))
 
 
 def test_plot_command_from_a_run_and_from_saved_traces(oracle_trace, tmp_path, capsys):
     assert _run(["plot", "--agent", "oracle", "--env", ENV_ID, "--seed", "0", "--out", str(tmp_path)]) == 0
     expected = tmp_path / f"{ENV_ID}_oracle_seed0.png"
     assert capsys.readouterr().out.strip() == str(expected) and expected.stat().st_size > 50_000
+    assert _run(["plot", "--agent", "oracle", "--env", ENV_ID, "--seed", "0", "--out", str(tmp_path)]) == 2
+    assert "--force" in capsys.readouterr().err
+    assert _run(["plot", "--agent", "oracle", "--env", ENV_ID, "--seed", "0", "--out", str(tmp_path),
+                 "--force"]) == 0
+    capsys.readouterr()
 
     other = synthetic_trace(20, gaze=circle(20, 30.0))
     npz = tmp_path / "traces.npz"
@@ -269,6 +484,15 @@ def test_plot_command_from_a_run_and_from_saved_traces(oracle_trace, tmp_path, c
     assert "unknown agent" in capsys.readouterr().err
     name = commands.plot_filename("EyeCatch-v0", "eyecatch:alpha=1,b=x", 3)
     assert name == "EyeCatch-v0_eyecatch_alpha_1_b_x_seed3.png"
+
+
+def test_plot_help_says_what_it_draws_for_every_family(capsys):
+    with pytest.raises(SystemExit):
+        _parser().parse_args(["plot", "--help"])
+    text = capsys.readouterr().out
+    for family in plots.FAMILIES:
+        assert f"  {family}: " in text
+    assert "footholds" in text and "pedestrian" in text and "shelf" in text
 
 
 def test_commands_are_wired_into_vmgym(tmp_path, capsys):
@@ -304,5 +528,6 @@ def test_record_refuses_a_camera_the_env_does_not_have(tmp_path):
          "--camera", "over_shoulder", "--out", str(tmp_path / "w.mp4")],
         capture_output=True, text=True, timeout=300,
     )
-    assert proc.returncode == 2 and "render_camera='over_shoulder' is not one of" in proc.stderr
-    assert "Traceback" not in proc.stderr
+    assert proc.returncode == 2 and "camera='over_shoulder' is not one of" in proc.stderr
+    assert "'follow'" in proc.stderr and "'scene'" in proc.stderr
+    assert "Traceback" not in proc.stderr and not (tmp_path / "w.mp4").exists()

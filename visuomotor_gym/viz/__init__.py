@@ -1,9 +1,12 @@
 """Figures and videos of single episodes (needs the ``viz`` extra: matplotlib, imageio, imageio-ffmpeg).
 
-* :mod:`visuomotor_gym.viz.plots`: Eyecatch-style figures of an
-  :class:`~visuomotor_gym.bench.trace.EpisodeTrace` (gaze vs ball, Fig. 3/12; hand and eye
-  tangential velocity, Fig. 4; 3-D ball and hand paths) and the numeric helpers behind them;
-* :mod:`visuomotor_gym.viz.video`: play one episode and write an MP4 (scene camera beside the eye camera);
+* :mod:`visuomotor_gym.viz.plots`: the figure of an :class:`~visuomotor_gym.bench.trace.EpisodeTrace`
+  of any family (:func:`plot_episode`, :func:`episode_figure`); the catch family's Eyecatch-style
+  panels (gaze vs ball, Fig. 3/12; hand and eye tangential velocity, Fig. 4; 3-D ball and hand
+  paths) and the numeric helpers behind them;
+* :mod:`visuomotor_gym.viz.family_plots`: the reach, walk, stones and dodge figures (gaze point on
+  the scene coloured by time, targets, hand or feet and footholds, saccades, time series);
+* :mod:`visuomotor_gym.viz.video`: play one episode and write an MP4 (scene view beside the eye camera);
 * :mod:`visuomotor_gym.viz.commands`: the ``vmgym plot`` and ``vmgym record`` subcommands.
 
 Importing this package is cheap: matplotlib, imageio and MuJoCo are imported only when a plotting
@@ -16,6 +19,9 @@ import importlib
 
 _EXPORTS = {
     "plot_episode": "plots",
+    "episode_figure": "plots",
+    "gaze_points": "family_plots",
+    "footholds": "family_plots",
     "plot_gaze_vs_ball": "plots",
     "plot_gaze_path": "plots",
     "plot_tangential_velocities": "plots",

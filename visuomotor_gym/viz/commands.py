@@ -1,13 +1,16 @@
 """The ``vmgym plot`` and ``vmgym record`` subcommands (wired in by :func:`register`).
 
-    vmgym plot   --agent A --env ID [--seed S] --out DIR           play one episode and plot it
-    vmgym plot   --traces FILE.npz [--episode K] --out DIR         plot a saved episode
-    vmgym record --agent A --env ID [--seed S] --out FILE.mp4 [--width W --height H --fps F] [--force]
+    vmgym plot   --agent A --env ID [--seed S] --out DIR [--force]      play one episode and plot it
+    vmgym plot   --traces FILE.npz [--episode K] --out DIR [--force]    plot a saved episode
+    vmgym record --agent A --env ID [--seed S] --out FILE.mp4 [--width W --height H --fps F --stride N]
+                 [--camera C] [--quality fast|high] [--force]
 
 ``plot`` writes ``DIR/<env>_<agent>_seed<S>.png`` (characters other than letters, digits, ``.``,
-``-`` and ``_`` in the agent spec become ``_``) and overwrites it; ``record`` refuses to replace an
-existing video unless ``--force``. Both print the path they wrote. This module imports nothing
-heavy at import time: ``vmgym`` imports it on every call.
+``-`` and ``_`` in the agent spec become ``_``); ``record`` writes ``FILE``. Both check their
+arguments before any episode is played: an unknown env id or agent, an output that cannot be
+written (a folder that cannot be made or written to, such as one under ``/proc``), or an existing
+output file without ``--force`` gives one line on stderr and exit status 2. Both print the path
+they wrote. This module imports nothing heavy at import time: ``vmgym`` imports it on every call.
 """
 
 from __future__ import annotations
@@ -16,7 +19,24 @@ import argparse
 import os
 import re
 import sys
+import tempfile
 from pathlib import Path
+
+# What ``vmgym plot`` draws for each family (the command's help; visuomotor_gym.viz.plots and
+# visuomotor_gym.viz.family_plots draw it).
+PLOT_CONTENTS = {
+    "catch": "gaze vs ball azimuth/elevation over time with saccades (Eyecatch Fig. 3/12), hand and eye speed "
+             "(Fig. 4), the visual field, 3-D ball and hand paths",
+    "reach": "top and side view of the shelf: object, hand path, gaze point at the object's distance (coloured by "
+             "time); gaze and object angles, gaze-object angle, hand-object distance and hand speed over time",
+    "walk": "top view of the walkway: obstacles by kind and height, pelvis path, footholds, where the gaze meets the "
+            "floor or an obstacle (coloured by time); side view of obstacle and sole heights; gaze angles and "
+            "look-ahead distance over time",
+    "stones": "top view: numbered stones, pelvis path, footholds, gaze on the floor (coloured by time); gaze angles "
+              "and the stone under the gaze vs the feet's next stone over time",
+    "dodge": "top view: walker and pedestrian paths with times, the line of sight and where it meets a pedestrian "
+             "(coloured by time); gaze angles, gaze-to-pedestrian angles and distances over time",
+}
 
 
 def plot_filename(env_id: str, agent: str, seed: int) -> str:
@@ -26,6 +46,48 @@ def plot_filename(env_id: str, agent: str, seed: int) -> str:
         return re.sub(r"[^A-Za-z0-9._-]+", "_", str(text)).strip("_") or "x"
 
     return f"{safe(env_id)}_{safe(agent)}_seed{int(seed)}.png"
+
+
+def _fail(command: str, message: str) -> int:
+    print(f"vmgym {command}: {message}", file=sys.stderr)
+    return 2
+
+
+def writable_folder(folder: Path) -> str | None:
+    """None if ``folder`` exists (or can be made) and a file can be created in it; else why not."""
+    if folder.exists() and not folder.is_dir():
+        return f"{folder} exists and is not a folder"
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        with tempfile.NamedTemporaryFile(dir=folder, prefix=".vmgym-write-probe-"):
+            pass
+    except OSError as exc:
+        return f"cannot write to {folder} ({exc.strerror or exc})"
+    return None
+
+
+def check_output_file(command: str, path: Path, force: bool) -> str | None:
+    """None if ``path`` may be written (its folder is writable; it does not exist, or ``force``)."""
+    if path.is_dir():
+        return f"--out {path} is a folder; give a file name"
+    if path.exists() and not force:
+        return f"{path} already exists; refusing to overwrite it (pass --force to replace it)"
+    problem = writable_folder(path.parent if str(path.parent) else Path("."))
+    return None if problem is None else f"--out {path}: {problem}"
+
+
+def check_env_and_agent(env_id: str, agent: str) -> str | None:
+    """None if ``env_id`` is a registered id and ``agent`` a valid agent spec; else the reason."""
+    import visuomotor_gym  # noqa: F401  (registers the ids)
+    from visuomotor_gym.agents import parse_agent_spec
+    from visuomotor_gym.registration import family_of
+
+    try:
+        family_of(env_id)
+        parse_agent_spec(agent)
+    except ValueError as exc:
+        return str(exc)
+    return None
 
 
 def _play(agent: str, env_id: str, seed: int):
@@ -45,49 +107,63 @@ def _play(agent: str, env_id: str, seed: int):
 
 def cmd_plot(args: argparse.Namespace) -> int:
     os.environ.setdefault("MUJOCO_GL", "egl")
+    out_dir = Path(args.out)
     if args.traces is not None:
         if args.agent is not None or args.env is not None:
-            print("vmgym plot: give either --traces FILE (with --episode K) or --agent/--env/--seed, "
-                  "not both", file=sys.stderr)
-            return 2
+            return _fail("plot", "give either --traces FILE (with --episode K) or --agent/--env/--seed, not both")
         from visuomotor_gym.bench.trace import load_traces
 
         try:
             traces = load_traces(args.traces)
         except (OSError, KeyError, ValueError) as exc:
-            print(f"vmgym plot: cannot read traces from {args.traces}: {exc}", file=sys.stderr)
-            return 2
+            return _fail("plot", f"cannot read traces from {args.traces}: {exc}")
         if not 0 <= args.episode < len(traces):
-            print(f"vmgym plot: --episode {args.episode} is out of range; {args.traces} holds "
-                  f"{len(traces)} episode(s) (0..{len(traces) - 1})", file=sys.stderr)
-            return 2
+            return _fail("plot", f"--episode {args.episode} is out of range; {args.traces} holds "
+                                 f"{len(traces)} episode(s) (0..{len(traces) - 1})")
         trace = traces[args.episode]
+        target = out_dir / plot_filename(trace.env_id, trace.agent, trace.seed)
+        problem = check_output_file("plot", target, args.force)
+        if problem:
+            return _fail("plot", problem)
     else:
         if args.agent is None or args.env is None:
-            print("vmgym plot: give --agent A --env ID [--seed S], or --traces FILE.npz [--episode K]",
-                  file=sys.stderr)
-            return 2
+            return _fail("plot", "give --agent A --env ID [--seed S], or --traces FILE.npz [--episode K]")
+        problem = check_env_and_agent(args.env, args.agent)
+        target = out_dir / plot_filename(args.env, args.agent, args.seed)
+        problem = problem or check_output_file("plot", target, args.force)
+        if problem:
+            return _fail("plot", problem)
         from gymnasium.error import Error as GymError
 
         try:
             trace = _play(args.agent, args.env, args.seed)
-        except (ValueError, GymError) as exc:  # unknown agent or env id, bad override
-            print(f"vmgym plot: {exc}", file=sys.stderr)
-            return 2
+        except (ValueError, GymError) as exc:  # an agent that refuses this env, a bad override
+            return _fail("plot", str(exc))
     from visuomotor_gym.viz.plots import plot_episode
 
-    path = plot_episode(trace, Path(args.out) / plot_filename(trace.env_id, trace.agent, trace.seed))
+    try:
+        path = plot_episode(trace, target)
+    except ValueError as exc:  # a trace of no known family
+        return _fail("plot", str(exc))
     print(path)
     return 0
 
 
 def cmd_record(args: argparse.Namespace) -> int:
     os.environ.setdefault("MUJOCO_GL", "egl")
+    from visuomotor_gym.viz.video import QUALITIES, VIDEO_SUFFIXES
+
     out = Path(args.out)
-    if out.exists() and not args.force:
-        print(f"vmgym record: {out} already exists; refusing to overwrite it (pass --force to replace it)",
-              file=sys.stderr)
-        return 1
+    if out.suffix.lower() not in VIDEO_SUFFIXES:
+        return _fail("record", f"--out must end in one of {', '.join(VIDEO_SUFFIXES)}, got {str(out)!r}")
+    if not (args.width >= 16 and args.height >= 16 and args.fps >= 1 and (args.stride is None or args.stride >= 1)):
+        return _fail("record", f"--width/--height must be >= 16 pixels, --fps and --stride >= 1; got "
+                               f"{args.width}x{args.height}, fps {args.fps}, stride {args.stride}")
+    if args.quality not in QUALITIES:
+        return _fail("record", f"--quality must be one of {QUALITIES}, got {args.quality!r}")
+    problem = check_env_and_agent(args.env, args.agent) or check_output_file("record", out, args.force)
+    if problem:
+        return _fail("record", problem)
     from gymnasium.error import Error as GymError
 
     from visuomotor_gym.viz.plots import outcome
@@ -96,52 +172,65 @@ def cmd_record(args: argparse.Namespace) -> int:
     try:
         trace = record_episode(args.agent, args.env, args.seed, out, width=args.width, height=args.height,
                                fps=args.fps, camera=args.camera, overlay=not args.no_overlay,
-                               overwrite=args.force)
-    except (ValueError, FileExistsError, GymError) as exc:  # bad size/agent/env id, a race on --out
-        print(f"vmgym record: {exc}", file=sys.stderr)
-        return 2
+                               overwrite=args.force, stride=args.stride, quality=args.quality)
+    except (ValueError, FileExistsError, GymError) as exc:  # bad camera, an agent refusing the env, a race on --out
+        return _fail("record", str(exc))
     video = trace.extras["video"]
     w, h = video["frame_size"]
     print(f"{args.env} | {args.agent} | seed {args.seed}: {outcome(trace)}; "
-          f"{video['frames']} frames of {w}x{h} at {video['fps']} fps")
+          f"{video['frames']} frames of {w}x{h} at {video['fps']} fps (every {video['stride']} step(s)), "
+          f"recorded in {video['seconds']:.1f} s")
     print(out)
     return 0
 
 
 def register(subparsers) -> None:
     """Add ``plot`` and ``record`` to the ``vmgym`` subparsers (each sets ``func(args) -> int``)."""
+    per_family = "\n".join(f"  {family}: {text}" for family, text in PLOT_CONTENTS.items())
     p = subparsers.add_parser(
         "plot",
-        help="plot one episode: gaze vs ball (Eyecatch Fig. 3), hand/eye speed (Fig. 4), 3-D paths",
+        help="plot one episode of any family: gaze on the scene, targets, hand or feet, saccades, time series",
         description="Plot one episode to DIR/<env>_<agent>_seed<S>.png: play it (--agent --env --seed) "
-        "or read it from a traces file (--traces FILE.npz --episode K).",
+        "or read it from a traces file (--traces FILE.npz --episode K). Refuses to overwrite the PNG unless "
+        "--force. What the figure shows, per family:\n" + per_family,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("--traces", default=None, help="a .npz written by visuomotor_gym.bench.trace.save_traces")
     p.add_argument("--episode", type=int, default=0, help="episode index in --traces (default 0)")
-    p.add_argument("--agent", default=None, help="agent spec, e.g. oracle or eyecatch:param=value")
-    p.add_argument("--env", default=None, help="environment id, e.g. EyeCatch-v0")
+    p.add_argument("--agent", default=None, help="agent spec, e.g. oracle, eyecatch:param=value, iwao, faraway, "
+                                                 "lookahead, fajen_warren")
+    p.add_argument("--env", default=None, help="environment id, e.g. EyeCatch-v0 or ObstacleWalk-v0")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--out", default="outputs/plots", help="folder for the PNG (default outputs/plots)")
+    p.add_argument("--force", action="store_true", help="replace the PNG if it exists")
     p.set_defaults(func=cmd_plot)
 
     p = subparsers.add_parser(
         "record",
-        help="record one episode as an MP4 (scene camera beside the eye camera)",
-        description="Play one episode and write an MP4, one frame per 20 ms control step "
-        "(--fps 50 is real time, the default 25 half speed). Refuses to overwrite --out unless --force.",
+        help="record one episode as an MP4 (scene view beside the eye camera)",
+        description="Play one episode and write an MP4: a frame after reset and after every --stride-th 20 ms "
+        "control step (fps = 50 / stride is real time; at the default 25 fps, catch and reach (stride 1) play at "
+        "half speed, the walker families (stride 2) in real time). "
+        "Scene view: the fixed scene camera for catch and reach, a camera following the walker for walk, "
+        "stones and dodge; the line of sight is drawn in green. Refuses to overwrite --out unless --force.",
     )
     p.add_argument("--agent", required=True, help="agent spec, e.g. oracle or eyecatch:param=value")
     p.add_argument("--env", required=True, help="environment id, e.g. EyeCatch-v0")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--out", required=True, help="output video, e.g. outputs/episode.mp4")
     p.add_argument("--width", type=int, default=480,
-                   help="width of each camera image (with --camera both the video is twice as wide)")
+                   help="width of each view (with --camera both the video is twice as wide)")
     p.add_argument("--height", type=int, default=360)
-    p.add_argument("--fps", type=int, default=25, help="frames per second (50 = real time; default 25)")
+    p.add_argument("--fps", type=int, default=25, help="frames per second (default 25; 50 / stride is real time)")
+    p.add_argument("--stride", type=int, default=None,
+                   help="render every N-th control step (default: 1 for catch and reach, 2 for walk, stones, dodge)")
     p.add_argument("--camera", default="both",
-                   help="the env's render_camera: both (scene beside eye, every family), scene, eye, or a "
-                        "family's own (catch/reach: over_shoulder; walk: side, follow; ...); the env refuses "
-                        "an unknown one and lists its cameras")
+                   help="both (scene view beside eye, every family), scene, eye, or a family's own MJCF camera "
+                        "(catch/reach: over_shoulder; walker families: side, follow; ...); an unknown one is "
+                        "refused with the list")
+    p.add_argument("--quality", default="fast", choices=("fast", "high"),
+                   help="fast (default): no shadows or multisampling; high: the scene's shadows and 4x "
+                        "multisampling, ~8x slower in software OpenGL")
     p.add_argument("--no-overlay", action="store_true", help="no text label on the frames")
     p.add_argument("--force", action="store_true", help="replace --out if it exists")
     p.set_defaults(func=cmd_record)

@@ -393,11 +393,29 @@ def episode_summary(trace: EpisodeTrace) -> str:
             f"closest hand-ball {100 * closest:.1f} cm")
 
 
-def plot_episode(trace: EpisodeTrace, path, dpi: int = 110, origin: str = "eye") -> Path:
-    """One PNG with every panel: gaze vs ball over time (azimuth, elevation), hand and eye speeds,
-    the visual-field path and the 3-D paths, titled with env id, agent, seed and outcome.
-    Creates the parent folder; overwrites ``path``. Returns the path written."""
-    path = Path(path)
+# The field that tells a trace's family when its env id is not a registered one (a synthetic trace).
+_FAMILY_FIELDS = (("ball_pos", "catch"), ("object_pos", "reach"), ("obstacles", "walk"), ("stones", "stones"),
+                  ("pedestrian_pos", "dodge"))
+FAMILIES = tuple(family for _, family in _FAMILY_FIELDS)
+
+
+def trace_family(trace: EpisodeTrace) -> str:
+    """The family of a trace: from its registered env id, else from the task fields it holds."""
+    from visuomotor_gym.registration import family_of
+
+    try:
+        return family_of(str(trace.env_id))
+    except ValueError:
+        for name, family in _FAMILY_FIELDS:
+            if name in trace.task:
+                return family
+    raise ValueError(f"cannot tell the family of the trace of {trace.env_id!r}: not a registered id and none of "
+                     f"the fields {[name for name, _ in _FAMILY_FIELDS]} in its task fields {sorted(trace.task)}")
+
+
+def catch_figure(trace: EpisodeTrace, origin: str = "eye"):
+    """The catch family's figure: gaze vs ball over time (azimuth, elevation), hand and eye speeds,
+    the visual-field path and the 3-D paths, titled with env id, agent, seed and outcome."""
     fig = _new_figure((15, 11.5))
     grid = fig.add_gridspec(3, 2, width_ratios=(1.4, 1.0), height_ratios=(1.0, 1.0, 1.2))
     ax_az = fig.add_subplot(grid[0, 0])
@@ -415,6 +433,33 @@ def plot_episode(trace: EpisodeTrace, path, dpi: int = 110, origin: str = "eye")
     fig.suptitle(f"{trace.env_id}  |  agent {trace.agent}  |  seed {trace.seed}  |  {ok}"
                  + (f" at {trace.catch_time:.2f} s" if trace.caught else "")
                  + f"\n{episode_summary(trace)}", fontsize="large")
+    return fig
+
+
+def episode_figure(trace: EpisodeTrace, origin: str = "eye"):
+    """The figure of one episode for its family (:func:`trace_family`): :func:`catch_figure`, or the
+    reach/walk/stones/dodge figures of :mod:`visuomotor_gym.viz.family_plots`. ``origin`` is the
+    catch family's (see :func:`gaze_ball_angles`). Returns a matplotlib ``Figure`` (Agg canvas)."""
+    family = trace_family(trace)
+    if family == "catch":
+        return catch_figure(trace, origin=origin)
+    from visuomotor_gym.viz.family_plots import FIGURES
+
+    return FIGURES[family](trace)
+
+
+def save_figure(fig, path, dpi: int = 100) -> Path:
+    """Write ``fig`` to ``path`` (PNG) at ``dpi``, making the parent folder; returns the path."""
+    path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=dpi)
     return path
+
+
+def plot_episode(trace: EpisodeTrace, path, dpi: int | None = None, origin: str = "eye") -> Path:
+    """Write :func:`episode_figure` of ``trace`` to ``path`` (PNG) at ``dpi`` (default: 110 for catch,
+    100 for the other families' larger figures). Creates the parent folder; overwrites ``path``.
+    Returns the path written."""
+    if dpi is None:
+        dpi = 110 if trace_family(trace) == "catch" else 100
+    return save_figure(episode_figure(trace, origin=origin), path, dpi)
