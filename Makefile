@@ -20,6 +20,9 @@ PY := $(VENV)/bin/python
 PIP := $(PY) -m pip
 STAMP := $(VENV)/.installed
 export MUJOCO_GL ?= egl
+# One OpenBLAS kernel family on every x86 CPU, so episodes are bit-identical across machines (golden
+# digests, leaderboard replays): see visuomotor_gym/_blas.py.
+export OPENBLAS_CORETYPE ?= Haswell
 
 RAY_VENV ?= .venv-ray
 RAY_STAMP := $(RAY_VENV)/.installed

@@ -18,6 +18,10 @@ import sys
 import pytest
 
 os.environ.setdefault("MUJOCO_GL", "egl")
+# One OpenBLAS kernel family on every x86 CPU (visuomotor_gym._blas): the golden digests and the
+# leaderboard's recorded episodes were made with it. Effective only if numpy is not imported yet; the
+# Makefile exports it too.
+os.environ.setdefault("OPENBLAS_CORETYPE", "Haswell")
 
 
 def spawn_rollout(env_id: str, seed: int, actions: list[list[float]]) -> dict:

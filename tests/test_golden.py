@@ -16,7 +16,9 @@ def test_every_golden_episode_is_unchanged():
     current = compute()
     assert set(current) == set(golden), "the set of golden cases changed: regenerate deliberately"
     changed = sorted(k for k in golden if current[k] != golden[k])
-    assert not changed, f"{len(changed)} of {len(golden)} golden episodes changed: {changed}"
+    from visuomotor_gym._blas import kernel_note
+
+    assert not changed, f"{len(changed)} of {len(golden)} golden episodes changed{kernel_note()}: {changed}"
 
 
 def test_the_golden_cases_cover_catches_and_the_two_ball_release():
