@@ -5,12 +5,22 @@ versions, no env registry), so the check regenerates them and compares bytes. Th
 hand-written inline SVG (no JavaScript, no external files, no matplotlib version in the bytes):
 success rate with its 95 % Wilson interval per env id along the observability ladder, the gaze-realism
 components as a heat map, and policy latency (p50-p95, max) against the control period.
+
+**Text from entries is escaped** on both pages. In ``README.md`` (Markdown) names, env ids, agent
+specs and commits are code spans (:func:`md_code`: no link, image, HTML or autolink is read inside one;
+backticks replaced, ``|`` escaped, line breaks folded into spaces), and prose (a superseded entry's
+reason) is :func:`md_text`: HTML special characters as entities, Markdown punctuation backslash-escaped,
+line breaks folded and autolinks (``https://``, ``www.``, ``a@b``) broken by a zero-width space.
+The HTML page escapes everything with :func:`html.escape`. The page's layout fits its width: the
+tables wrap their cells and scroll inside their own box, and plot labels and legends are sized from
+the text they hold (checked in headless Chromium: no element past the viewport).
 """
 
 from __future__ import annotations
 
 import html
 import math
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -197,8 +207,30 @@ def _family(env_id: str) -> str:
 # ------------------------------------------------------------------------------ README.md
 
 
-def _md(text: str) -> str:
-    return text.replace("|", "\\|")
+_MD_PUNCT = re.compile(r"([\\`*_{}\[\]()#+!|~])")
+_AUTOLINK = re.compile(r"(?i)(?<=[a-z0-9])(?=(://|@))|(?<=www)(?=\.)")
+_SAFE_LINK = re.compile(r"agents/[A-Za-z0-9][A-Za-z0-9._:-]*")
+
+
+def _one_line(text) -> str:
+    """``text`` with every run of whitespace or control characters folded into one space."""
+    return " ".join(re.sub(r"[\x00-\x1f\x7f\u0085\u2028\u2029]", " ", str(text)).split())
+
+
+def md_code(text) -> str:
+    """``text`` as a Markdown code span inside a table cell: literal (no link, image, HTML, emphasis or
+    autolink is read inside a code span), one line, no backtick (replaced by '), ``|`` escaped (GFM
+    splits table cells before it reads code spans)."""
+    return "`" + _one_line(text).replace("`", "'").replace("|", "\\|") + "`"
+
+
+def md_text(text) -> str:
+    """``text`` as literal Markdown prose in a table cell: one line; ``& < >`` as HTML entities; the
+    punctuation Markdown reads (links, images, emphasis, code, tables, headings) backslash-escaped;
+    autolinks (``https://``, ``www.``, ``name@host``) broken by a zero-width space."""
+    out = html.escape(_one_line(text), quote=False)
+    out = _MD_PUNCT.sub(r"\\\1", out)
+    return _AUTOLINK.sub("&#8203;", out)
 
 
 def render_readme(lb: Leaderboard) -> str:
@@ -218,12 +250,12 @@ def render_readme(lb: Leaderboard) -> str:
         "[The page with plots](index.html) shows the same entries.",
         "",
         "| agent | env id | success rate [95 % CI] | gaze gain | gaze realism | latency p95 (self-reported) "
-        "| real time | episodes | seeds "
+        "| real time (self-reported) | episodes | seeds "
         "| verified | commit | date |",
         "|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
-        lines.append("| " + " | ".join(_md(c) for c in _cells_md(r)) + " |")
+        lines.append("| " + " | ".join(_cells_md(r)) + " |")
     if not rows:
         lines.append("| *no entries yet* |  |  |  |  |  |  |  |  |  |  |  |")
     if old:
@@ -238,15 +270,14 @@ def render_readme(lb: Leaderboard) -> str:
             lines.append(
                 "| "
                 + " | ".join(
-                    _md(c)
-                    for c in (
-                        f"`{r.name}`",
-                        f"`{r.env_id}`",
-                        fmt_rate(r),
-                        r.commit,
-                        r.date,
-                        f"`{r.entry.superseded['by']}`",
-                        r.entry.superseded["reason"],
+                    (
+                        md_code(r.name),
+                        md_code(r.env_id),
+                        md_text(fmt_rate(r)),
+                        md_text(r.commit),
+                        md_text(r.date),
+                        md_code(r.entry.superseded["by"]),
+                        md_text(r.entry.superseded["reason"]),
                     )
                 )
                 + " |"
@@ -285,7 +316,11 @@ def render_readme(lb: Leaderboard) -> str:
         "architecture record: nothing is unpickled);",
         "* a new entry whose re-play on every pinned seed disagrees with its records, or whose results "
         "(success and catch rates, gaze realism, reaction times, distances, env steps) differ from those "
-        "recomputed from the re-played episodes, or whose latency claim is more than 10x below CI's;",
+        "recomputed from the re-played episodes;",
+        "* a new entry whose commit does not hold the agent and policy file it claims, whose name looks like "
+        "another agent's (I/l/1, O/0, rn/m), or whose agent spec is not plain text or names another team's "
+        "files;",
+        "* a symbolic link or special file anywhere in the leaderboard folder (never followed);",
         f"* an existing entry whose re-played sample of {sample} pinned seeds (one per stratum, drawn "
         "from the base commit) disagrees with its recorded outcomes;",
         "* an entry deleted or rewritten relative to the main branch (entries are immutable: retire one by "
@@ -313,22 +348,26 @@ def render_readme(lb: Leaderboard) -> str:
 
 
 def _cells_md(r: Row) -> list[str]:
-    agent = f"[`{r.name}`]({r.policy})" if r.policy else f"`{r.name}`"
+    """The Markdown cells of a row, each escaped (:func:`md_code`, :func:`md_text`); the policy link
+    only for a path of the form the check allows (``agents/<name>__<env_id>.<ext>``)."""
+    agent = md_code(r.name)
+    if r.policy and _SAFE_LINK.fullmatch(r.policy):
+        agent = f"[{agent}]({r.policy})"
     if r.agent != r.name:
-        agent += f" (`{r.agent}`)"
+        agent += f" ({md_code(r.agent)})"
     return [
         agent,
-        f"`{r.env_id}`",
-        fmt_rate(r),
-        fmt_gain(r.gain),
-        fmt_score(r.realism),
-        fmt_ms(r.latency["p95"]),
+        md_code(r.env_id),
+        md_text(fmt_rate(r)),
+        md_text(fmt_gain(r.gain)),
+        md_text(fmt_score(r.realism)),
+        md_text(fmt_ms(r.latency["p95"])),
         "yes" if r.real_time else "no",
         str(r.episodes),
-        r.seeds,
-        r.verified,
-        f"`{r.commit}`",
-        r.date,
+        md_text(r.seeds),
+        md_text(r.verified),
+        md_code(r.commit),
+        md_text(r.date),
     ]
 
 
@@ -365,10 +404,15 @@ def svg_catch_rate(rows: list[Row], ladder: list[str]) -> str:
     if not rows or not ladder:
         return _empty("plot-catch-rate", label)
     names = _series(rows)
-    left, right, top, bottom = 64, 190, 20, 110
+    left, right, top, bottom = 64, 24, 20, 110
     step = 105
-    width, height = left + step * len(ladder) + right, 400
-    ph = height - top - bottom
+    width, plot_h = left + step * len(ladder) + right, 400
+    # The legend below the plot, in columns as wide as the longest name (no name is clipped).
+    col_w = 12 + 24 + text_width(max(names, key=len), LEGEND_PX)
+    cols = max(1, int((width - left) // col_w))
+    legend_rows = -(-len(names) // cols)
+    height = plot_h + 8 + 22 * legend_rows
+    ph = plot_h - top - bottom
     parts = _svg_open(width, height, "plot-catch-rate", label)
 
     def y(v):
@@ -398,7 +442,7 @@ def svg_catch_rate(rows: list[Row], ladder: list[str]) -> str:
             f'class="tick">{E(env_id)}</text>'
         )
     parts.append(
-        f'<text x="{left + step * len(ladder) / 2:.1f}" y="{height - 6}" text-anchor="middle" '
+        f'<text x="{left + step * len(ladder) / 2:.1f}" y="{plot_h - 6}" text-anchor="middle" '
         f'class="muted">more observable ← → less observable</text>'
     )
     colours = _colours(names)
@@ -437,13 +481,24 @@ def svg_catch_rate(rows: list[Row], ladder: list[str]) -> str:
                 + _line(xx - 4, hi, xx + 4, hi, color, "2")
                 + marker(xx, y(r.rate), r.name) + "</g>"
             )
-    lx = left + step * len(ladder) + 24
     for k, name in enumerate(names):
-        ly = top + 10 + 22 * k
+        lx, ly = left + 6 + col_w * (k % cols), plot_h + 8 + 22 * (k // cols) + 6
         parts.append(marker(lx, ly, name).replace(' class="point"', "")
                      + f'<text x="{lx + 12}" y="{ly + 4}" class="legend">{E(name)}</text>')
     parts.append("</svg>")
     return "\n".join(parts)
+
+
+# Widths of SVG text, for sizing labels and legends so that nothing is clipped: an upper bound of the
+# advance width of DejaVu Sans (0.63 em for its widest lower-case letters and digits; 'm' and 'w' are
+# 0.97 and 0.82 em, hence the margin) at the font sizes of the plot CSS below (modelling choice).
+EM_PER_CHAR = 0.66
+LEGEND_PX, TICK_PX = 12, 11
+
+
+def text_width(text: str, px: float) -> int:
+    """An upper bound of the width in CSS pixels of ``text`` at ``px`` (see :data:`EM_PER_CHAR`)."""
+    return int(math.ceil(len(text) * px * EM_PER_CHAR))
 
 
 def _blue(score: float) -> str:
@@ -464,8 +519,12 @@ def svg_realism(rows: list[Row]) -> str:
             if c not in comps:
                 comps.append(c)
     cols = ["overall", *comps]
-    label_w, cell_w, cell_h, head = 250, 74, 26, 150
-    width, height = label_w + cell_w * len(cols) + 110, head + cell_h * len(rows) + 44
+    label_w = max(250, 16 + max(text_width(f"{r.name} · {r.env_id}", TICK_PX) for r in rows))
+    cell_w, cell_h = 74, 26
+    longest = max(text_width(c, TICK_PX) for c in cols)  # column heads, rotated by 40 degrees
+    head = max(150, 16 + int(longest * math.sin(math.radians(40))))
+    tail = max(110, 16 + int(longest * math.cos(math.radians(40))))
+    width, height = label_w + cell_w * len(cols) + tail, head + cell_h * len(rows) + 44
     parts = _svg_open(width, height, "plot-realism", label)
     for j, c in enumerate(cols):
         cx = label_w + cell_w * (j + 0.5)
@@ -527,7 +586,8 @@ def svg_latency(rows: list[Row]) -> str:
     hi = math.ceil(math.log10(max(vals + periods)) + 1e-9)
     if hi <= lo:
         hi = lo + 1
-    label_w, plot_w, row_h, top = 250, 460, 24, 16
+    label_w = max(250, 16 + max(text_width(f"{r.name} · {r.env_id}", TICK_PX) for r in rows))
+    plot_w, row_h, top = 460, 24, 16
     width, height = label_w + plot_w + 40, top + row_h * len(rows) + 56
 
     def x(v):
@@ -582,10 +642,15 @@ body { font-family: "DejaVu Sans", "Helvetica Neue", Arial, sans-serif; margin: 
        color: #1b1b1b; padding: 0 16px; line-height: 1.45; }
 h1 { font-size: 26px; margin-bottom: 4px; } h2 { font-size: 19px; margin-top: 30px; }
 p.lede { color: #444; max-width: 900px; }
-table { border-collapse: collapse; font-size: 13px; width: 100%; }
-th, td { border-bottom: 1px solid #ddd; padding: 5px 7px; text-align: left; white-space: nowrap; }
+.table-wrap { max-width: 100%; overflow-x: auto; }
+table { border-collapse: collapse; font-size: 12px; width: 100%; }
+th, td { border-bottom: 1px solid #ddd; padding: 4px 5px; text-align: left; vertical-align: top; }
+td { white-space: nowrap; }
 th { background: #f3f5f8; font-weight: 600; }
+td.agent { white-space: normal; min-width: 12em; }
+td.agent code { overflow-wrap: anywhere; }
 td.num { text-align: right; font-variant-numeric: tabular-nums; }
+td.rate { white-space: normal; min-width: 6.5em; }
 tr.superseded td { color: #888; }
 td.why { white-space: normal; min-width: 16em; }
 code { font-size: 12px; }
@@ -603,14 +668,14 @@ footer { color: #777; font-size: 12px; margin-top: 30px; }
 
 def _cells_html(r: Row) -> str:
     agent = f"<code>{E(r.name)}</code>"
-    if r.policy:
+    if r.policy and _SAFE_LINK.fullmatch(r.policy):
         agent = f'<a href="{E(r.policy)}">{agent}</a>'
     if r.agent != r.name:
         agent += f" (<code>{E(r.agent)}</code>)"
     cells = [
-        ("", agent),
+        ("agent", agent),
         ("", f"<code>{E(r.env_id)}</code>"),
-        ("num", E(fmt_rate(r))),
+        ("num rate", E(fmt_rate(r))),
         ("num", E(fmt_gain(r.gain))),
         ("num", fmt_score(r.realism)),
         ("num", fmt_ms(r.latency["p95"])),
@@ -630,7 +695,8 @@ def render_html(lb: Leaderboard) -> str:
     sample = lb.protocol.rescore_sample if lb.protocol is not None else "?"
     head = (
         "<tr><th>agent</th><th>env id</th><th>success rate [95 % CI]</th><th>gaze gain</th><th>gaze realism</th>"
-        "<th>latency p95 (self-reported)</th><th>real time</th><th>episodes</th><th>seeds</th><th>verified</th>"
+        "<th>latency p95 (self-reported)</th><th>real time (self-reported)</th><th>episodes</th><th>seeds</th>"
+        "<th>verified</th>"
         "<th>commit</th><th>date</th></tr>"
     )
     body = "\n".join(f'<tr class="entry" data-entry="{E(r.key)}">{_cells_html(r)}</tr>' for r in rows)
@@ -655,13 +721,13 @@ def render_html(lb: Leaderboard) -> str:
         "<code>vmgym bench</code> on the standard protocol "
         '(<a href="protocol.json">protocol.json</a>), pinned '
         f"seeds per env id; CI re-plays a new entry on every pinned seed and existing entries on {sample} "
-        "seeds drawn from the base commit. Latency is self-reported (CI refuses a claim more than 10x "
-        "below its own measurement).</p>",
-        '<table id="leaderboard-table"><thead>',
+        "seeds drawn from the base commit. Latency is self-reported; CI measures it on its own machine and "
+        "prints its figure beside the claim (not a rule: it depends on the machine's load).</p>",
+        '<div class="table-wrap"><table id="leaderboard-table"><thead>',
         head,
         "</thead><tbody>",
         body,
-        "</tbody></table>",
+        "</tbody></table></div>",
     ]
     parts += [
         "<h2>Success rate along the observability ladder</h2>",
@@ -681,7 +747,7 @@ def render_html(lb: Leaderboard) -> str:
     if old:
         parts += [
             "<h2>Superseded entries</h2>",
-            '<table id="superseded-table"><thead><tr><th>agent</th><th>env id</th>'
+            '<div class="table-wrap"><table id="superseded-table"><thead><tr><th>agent</th><th>env id</th>'
             "<th>success rate [95 % CI]</th>"
             "<th>commit</th><th>date</th><th>superseded by</th><th>why</th></tr></thead><tbody>",
         ]
@@ -692,7 +758,7 @@ def render_html(lb: Leaderboard) -> str:
             f'<td class="why">{E(r.entry.superseded["reason"])}</td></tr>'
             for r in old
         ]
-        parts.append("</tbody></table>")
+        parts.append("</tbody></table></div>")
     parts += [
         "<h2>How the leaderboard is kept honest</h2>",
         '<ul class="rules">',
