@@ -539,8 +539,8 @@ def _hash_problems(lb: Leaderboard, entry: Entry) -> list[Problem]:
                 f"(the name `vmgym leaderboard submit` writes)",
             )
         ]
-    if path in lb.links:
-        return []  # a link: refused by the layout rule, never read
+    if path in lb.links:  # never read; the entry is not re-scored
+        return [Problem(where, "policy", f"the entry {entry.key} records this policy file, which is not a regular file")]
     try:
         data = read_regular(path)
     except ValueError:

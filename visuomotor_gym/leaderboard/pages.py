@@ -648,7 +648,8 @@ th, td { border-bottom: 1px solid #ddd; padding: 4px 5px; text-align: left; vert
 td { white-space: nowrap; }
 th { background: #f3f5f8; font-weight: 600; }
 td.agent { white-space: normal; min-width: 12em; }
-td.agent code { overflow-wrap: anywhere; }
+td.agent code, td.wrap code { overflow-wrap: anywhere; }
+td.wrap { white-space: normal; }
 td.num { text-align: right; font-variant-numeric: tabular-nums; }
 td.rate { white-space: normal; min-width: 6.5em; }
 tr.superseded td { color: #888; }
@@ -752,9 +753,9 @@ def render_html(lb: Leaderboard) -> str:
             "<th>commit</th><th>date</th><th>superseded by</th><th>why</th></tr></thead><tbody>",
         ]
         parts += [
-            f'<tr class="superseded" data-entry="{E(r.key)}"><td><code>{E(r.name)}</code></td><td><code>'
-            f'{E(r.env_id)}</code></td><td class="num">{E(fmt_rate(r))}</td><td><code>{E(r.commit)}</code>'
-            f'</td><td>{E(r.date)}</td><td><code>{E(r.entry.superseded["by"])}</code></td>'
+            f'<tr class="superseded" data-entry="{E(r.key)}"><td class="wrap"><code>{E(r.name)}</code></td><td><code>'
+            f'{E(r.env_id)}</code></td><td class="num rate">{E(fmt_rate(r))}</td><td><code>{E(r.commit)}</code>'
+            f'</td><td>{E(r.date)}</td><td class="wrap"><code>{E(r.entry.superseded["by"])}</code></td>'
             f'<td class="why">{E(r.entry.superseded["reason"])}</td></tr>'
             for r in old
         ]
