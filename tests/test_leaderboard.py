@@ -769,7 +769,6 @@ def test_ppo_npz_actor_equals_the_sb3_model_on_many_observations():
 
     import numpy as np
     from stable_baselines3 import PPO
-
     from visuomotor_gym.baselines.ppo.agent import NpzActor, npz_from_model, prove_npz_equals_model, read_npz
 
     old = COMMITTED / "agents" / "ppo-intercept__EyeCatch-v0.zip"  # our own committed file: trusted here

@@ -35,7 +35,8 @@ Rules (the ``kind`` of a :class:`~visuomotor_gym.leaderboard.problems.Problem`):
   gaze realism and its components, reaction times, miss distance, time to catch, env steps). Its
   latency is *measured* on those episodes, on this machine, and reported beside the self-reported
   figure (:attr:`CheckReport.latency`, a note per entry): it is not a pass/fail rule, since it depends
-  on the machine and its load (a byte copy of an honest entry must pass on a busy runner). An **existing** entry (not superseded) is re-played on ``rescore.sample`` seeds, one per
+  on the machine and its load (a byte copy of an honest entry must pass on a busy runner). An
+  **existing** entry (not superseded) is re-played on ``rescore.sample`` seeds, one per
   stratum, drawn from the base commit's sha and the entry key: fixed before any pull request, never
   from submitted bytes. Outcomes must agree (caught, diverged, steps exactly; times and distances
   within the protocol's tolerances);

@@ -178,8 +178,9 @@ class Leaderboard:
 
     def rel(self, path: Path) -> str:
         """``path`` relative to the leaderboard folder's parent (``leaderboard/results/x.json``)."""
-        try:
-            return str(Path(path).resolve().relative_to(self.root.resolve().parent))
+        path = Path(path)
+        try:  # the folder resolved, never the file itself (a link is named as the link)
+            return str((Path(os.path.realpath(path.parent)) / path.name).relative_to(self.root.resolve().parent))
         except ValueError:
             return str(path)
 
@@ -196,10 +197,15 @@ def read_regular(path: Path) -> bytes:
         fd = os.open(path, flags)
     except OSError as exc:
         raise ValueError(f"cannot open {path.name} as a regular file: {exc.strerror}") from None
-    with os.fdopen(fd, "rb") as fh:
-        if not stat.S_ISREG(os.fstat(fh.fileno()).st_mode):
+    try:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
             raise ValueError(f"{path.name} is not a regular file")
-        return fh.read()
+        with os.fdopen(os.dup(fd), "rb") as fh:
+            return fh.read()
+    except OSError as exc:
+        raise ValueError(f"cannot read {path.name}: {exc.strerror}") from None
+    finally:
+        os.close(fd)
 
 
 def _read_json(path: Path):
@@ -223,7 +229,7 @@ def _kind_of(path: Path) -> str | None:
     return "a special file (not a regular file)"
 
 
-def _refuse_link(lb: "Leaderboard", path: Path, what: str) -> None:
+def _refuse_link(lb: Leaderboard, path: Path, what: str) -> None:
     problem = Problem(
         lb.rel(path),
         "layout",
@@ -234,7 +240,7 @@ def _refuse_link(lb: "Leaderboard", path: Path, what: str) -> None:
     lb.problems.append(problem)
 
 
-def unsafe_paths(lb: "Leaderboard") -> None:
+def unsafe_paths(lb: Leaderboard) -> None:
     """Record every link or special file at or under ``lb.root`` (not following any) in ``lb.links``."""
     root = lb.root
     what = _kind_of(root)

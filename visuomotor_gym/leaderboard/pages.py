@@ -7,10 +7,10 @@ success rate with its 95 % Wilson interval per env id along the observability la
 components as a heat map, and policy latency (p50-p95, max) against the control period.
 
 **Text from entries is escaped** on both pages. In ``README.md`` (Markdown) names, env ids, agent
-specs and commits are code spans (:func:`md_code`: no link, image, HTML or autolink is read inside one;
-backticks replaced, ``|`` escaped, line breaks folded into spaces), and prose (a superseded entry's
-reason) is :func:`md_text`: HTML special characters as entities, Markdown punctuation backslash-escaped,
-line breaks folded and autolinks (``https://``, ``www.``, ``a@b``) broken by a zero-width space.
+specs and commits are code spans when plain (:func:`md_code`: no link, image, HTML or autolink is read
+inside one), else escaped like prose; prose (a superseded entry's reason) is :func:`md_text`: HTML
+special characters as entities, Markdown punctuation backslash-escaped, line breaks folded and
+autolinks (``https://``, ``www.``, ``a@b``) broken by a zero-width space.
 The HTML page escapes everything with :func:`html.escape`. The page's layout fits its width: the
 tables wrap their cells and scroll inside their own box, and plot labels and legends are sized from
 the text they hold (checked in headless Chromium: no element past the viewport).
@@ -207,7 +207,10 @@ def _family(env_id: str) -> str:
 # ------------------------------------------------------------------------------ README.md
 
 
-_MD_PUNCT = re.compile(r"([\\`*_{}\[\]()#+!|~])")
+# What Markdown reads inside a table cell: code, emphasis, strike-through, link and image brackets, the
+# cell separator and escapes ('(' and '!' only matter next to an unescaped '[' or ']'; '#' and '+' only
+# at a line start; '<', '>' and '&' become entities first).
+_MD_PUNCT = re.compile(r"([\\`*_\[\]|~])")
 _AUTOLINK = re.compile(r"(?i)(?<=[a-z0-9])(?=(://|@))|(?<=www)(?=\.)")
 _SAFE_LINK = re.compile(r"agents/[A-Za-z0-9][A-Za-z0-9._:-]*")
 
@@ -217,16 +220,21 @@ def _one_line(text) -> str:
     return " ".join(re.sub(r"[\x00-\x1f\x7f\u0085\u2028\u2029]", " ", str(text)).split())
 
 
+_PLAIN = re.compile(r"[A-Za-z0-9._:/=,+ -]*")
+
+
 def md_code(text) -> str:
-    """``text`` as a Markdown code span inside a table cell: literal (no link, image, HTML, emphasis or
-    autolink is read inside a code span), one line, no backtick (replaced by '), ``|`` escaped (GFM
-    splits table cells before it reads code spans)."""
-    return "`" + _one_line(text).replace("`", "'").replace("|", "\\|") + "`"
+    """``text`` as a Markdown code span inside a table cell when it is plain (letters, digits and
+    ``. _ : / = , + -``: identifiers, agent specs, commits), else as escaped prose (:func:`md_text`).
+    Nothing inside a code span is read as a link, image, HTML or autolink; the plain alphabet also
+    keeps out the backtick that would close it and the ``|`` that would split the cell."""
+    line = _one_line(text)
+    return f"`{line}`" if _PLAIN.fullmatch(line) else md_text(line)
 
 
 def md_text(text) -> str:
     """``text`` as literal Markdown prose in a table cell: one line; ``& < >`` as HTML entities; the
-    punctuation Markdown reads (links, images, emphasis, code, tables, headings) backslash-escaped;
+    punctuation Markdown reads in a cell (:data:`_MD_PUNCT`: links, images, emphasis, code) backslash-escaped;
     autolinks (``https://``, ``www.``, ``name@host``) broken by a zero-width space."""
     out = html.escape(_one_line(text), quote=False)
     out = _MD_PUNCT.sub(r"\\\1", out)
@@ -273,7 +281,7 @@ def render_readme(lb: Leaderboard) -> str:
                     (
                         md_code(r.name),
                         md_code(r.env_id),
-                        md_text(fmt_rate(r)),
+                        fmt_rate(r),
                         md_text(r.commit),
                         md_text(r.date),
                         md_code(r.entry.superseded["by"]),
@@ -290,9 +298,11 @@ def render_readme(lb: Leaderboard) -> str:
         "seeds, both re-scored entries (a foveated env on which it is small does not test looking); "
         "*gaze realism*: mean score in [0, 1] of the gaze components against the sourced human reference "
         "table (`visuomotor_gym/metrics/human_reference.json`); *latency*: policy compute time per control "
-        "step, as measured by the submitter (CI re-measures it on a new entry's re-scored episodes and "
-        "refuses a claim more than 10x below its own); *success rate*: episodes that met the task's goal "
-        "(on the catch env ids: the catch rate); *real time*: latency p95 below the control period; "
+        "step, as measured by the submitter on their machine (CI measures it again on a new entry's re-scored "
+        "episodes and prints its own figure beside this one in the check's log; not a rule, since it depends "
+        "on the machine and its load, and not a rank); *success rate*: episodes that met the task's goal "
+        "(on the catch env ids: the catch rate); *real time*: self-reported latency p95 below the control "
+        "period; "
         "*verified*: a new entry is re-played by CI on every pinned seed, and existing entries on "
         f"{sample} seeds drawn from the base commit.",
         "",
@@ -355,17 +365,17 @@ def _cells_md(r: Row) -> list[str]:
         agent = f"[{agent}]({r.policy})"
     if r.agent != r.name:
         agent += f" ({md_code(r.agent)})"
-    return [
+    return [  # numbers and words this module formats are plain; text from files is escaped
         agent,
         md_code(r.env_id),
-        md_text(fmt_rate(r)),
-        md_text(fmt_gain(r.gain)),
-        md_text(fmt_score(r.realism)),
-        md_text(fmt_ms(r.latency["p95"])),
+        fmt_rate(r),
+        fmt_gain(r.gain),
+        fmt_score(r.realism),
+        fmt_ms(r.latency["p95"]),
         "yes" if r.real_time else "no",
         str(r.episodes),
-        md_text(r.seeds),
-        md_text(r.verified),
+        r.seeds,
+        r.verified,
         md_code(r.commit),
         md_text(r.date),
     ]
@@ -498,7 +508,7 @@ LEGEND_PX, TICK_PX = 12, 11
 
 def text_width(text: str, px: float) -> int:
     """An upper bound of the width in CSS pixels of ``text`` at ``px`` (see :data:`EM_PER_CHAR`)."""
-    return int(math.ceil(len(text) * px * EM_PER_CHAR))
+    return math.ceil(len(text) * px * EM_PER_CHAR)
 
 
 def _blue(score: float) -> str:
@@ -774,6 +784,9 @@ def render_html(lb: Leaderboard) -> str:
         "<li>Policy files are JSON or <code>.npz</code> arrays with a JSON architecture record: nothing is "
         "unpickled.</li>",
         "<li>Entries are immutable: CI refuses deleting or rewriting one relative to the main branch.</li>",
+        "<li>A new entry's commit must hold the agent and policy file it claims; its name may not look like "
+        "another agent's (I/l/1, O/0, rn/m) and its agent spec must be plain text naming its own files. "
+        "Leaderboard files are regular files: a symbolic link is never followed.</li>",
         "<li>This page and README.md are regenerated and compared byte for byte.</li>",
         "</ul>",
         "<footer>Generated by <code>vmgym leaderboard build</code>; checked by <code>vmgym leaderboard check"
