@@ -618,13 +618,13 @@ window.addEventListener('load', () => {
       const r = el.getBoundingClientRect();
       return r.width > 0 && (r.right > document.documentElement.clientWidth + 0.5 || r.left < -0.5);
     }).map(el => [el.tagName, el.id || el.getAttribute('class') || '', el.getBoundingClientRect().right]),
-    // SVG text outside its plot's box: a clipped label or legend entry
+    // SVG text or point outside its plot's box: a clipped label, legend entry or point
     clipped: Array.from(document.querySelectorAll('svg.plot')).flatMap(svg => {
       const s = svg.getBoundingClientRect();
-      return Array.from(svg.querySelectorAll('text')).filter(t => {
+      return Array.from(svg.querySelectorAll('text, circle')).filter(t => {
         const r = t.getBoundingClientRect();
         return r.left < s.left - 0.5 || r.right > s.right + 0.5 || r.top < s.top - 0.5 || r.bottom > s.bottom + 0.5;
-      }).map(t => [svg.id, t.textContent]);
+      }).map(t => [svg.id, t.tagName, t.textContent]);
     }),
   };
   const pre = document.createElement('pre'); pre.id = 'probe'; pre.textContent = JSON.stringify(out);

@@ -428,8 +428,14 @@ def svg_catch_rate(rows: list[Row], ladder: list[str]) -> str:
     def y(v):
         return top + ph * (1.0 - v)
 
+    # Each env id spreads only the series that have an entry on it across its own column (a series'
+    # offset among all series would push points of many agents out of their column and off the plot).
+    present = {e: [n for n in names if any(r.name == n and r.env_id == e for r in rows)] for e in ladder}
+
     def x(env_id, k):
-        return left + step * (ladder.index(env_id) + 0.5) + (k - (len(names) - 1) / 2.0) * 9.0
+        here = present[env_id]
+        spread = min(9.0, (step - 16.0) / max(1, len(here) - 1))
+        return left + step * (ladder.index(env_id) + 0.5) + (here.index(names[k]) - (len(here) - 1) / 2.0) * spread
 
     for tick in range(0, 101, 20):
         yy = y(tick / 100.0)
