@@ -611,6 +611,21 @@ window.addEventListener('load', () => {
     points: Array.from(document.querySelectorAll('#plot-catch-rate circle.point')).map(c => box(c)),
     cells: document.querySelectorAll('#plot-realism g.cell').length,
     bars: document.querySelectorAll('#plot-latency g.latency').length,
+    viewport: document.documentElement.clientWidth,
+    scrollWidth: document.documentElement.scrollWidth,
+    // every element of the page past the viewport's right or left edge (tag, id or class, right edge)
+    outside: Array.from(document.body.querySelectorAll('*')).filter(el => {
+      const r = el.getBoundingClientRect();
+      return r.width > 0 && (r.right > document.documentElement.clientWidth + 0.5 || r.left < -0.5);
+    }).map(el => [el.tagName, el.id || el.getAttribute('class') || '', el.getBoundingClientRect().right]),
+    // SVG text or point outside its plot's box: a clipped label, legend entry or point
+    clipped: Array.from(document.querySelectorAll('svg.plot')).flatMap(svg => {
+      const s = svg.getBoundingClientRect();
+      return Array.from(svg.querySelectorAll('text, circle')).filter(t => {
+        const r = t.getBoundingClientRect();
+        return r.left < s.left - 0.5 || r.right > s.right + 0.5 || r.top < s.top - 0.5 || r.bottom > s.bottom + 0.5;
+      }).map(t => [svg.id, t.tagName, t.textContent]);
+    }),
   };
   const pre = document.createElement('pre'); pre.id = 'probe'; pre.textContent = JSON.stringify(out);
   document.body.appendChild(pre);
@@ -635,7 +650,7 @@ def test_page_renders_in_a_headless_browser(tmp_path):
     page = (COMMITTED / "index.html").read_text()
     probed = tmp_path / "probed.html"
     probed.write_text(page.replace("</body>", PROBE + "</body>"))
-    dom = browser.dump_dom(probed)
+    dom = browser.dump_dom(probed, width=1200, height=2600)
     start = dom.index('<pre id="probe">') + len('<pre id="probe">')
     probe = json.loads(html_lib.unescape(dom[start : dom.index("</pre>", start)]))
     assert probe["rows"] == n
@@ -648,14 +663,20 @@ def test_page_renders_in_a_headless_browser(tmp_path):
     # union of every family's components)
     components = {c for e in board.valid_entries if e.superseded is None for c in e.results["gaze_realism"]["components"]}
     assert probe["cells"] == n * (1 + len(components)) and probe["bars"] == n
+    # The page fits the viewport (issue 26): no element past its edges, no page-wide horizontal scroll,
+    # no plot label or legend entry clipped by its plot.
+    assert probe["viewport"] == 1200
+    assert probe["outside"] == [], probe["outside"][:10]
+    assert probe["scrollWidth"] <= probe["viewport"]
+    assert probe["clipped"] == [], probe["clipped"][:10]
 
     # A screenshot of the unmodified page: the right size, and the plots' colours are on it.
     # tall enough to reach the realism heat map below the entry table
-    png = browser.screenshot(COMMITTED / "index.html", tmp_path / "page.png", width=1200, height=2600)
+    png = browser.screenshot(COMMITTED / "index.html", tmp_path / "page.png", width=1200, height=3600)
     Image = pytest.importorskip("PIL.Image")
 
     image = Image.open(png).convert("RGB")
-    assert image.size == (1200, 2600)
+    assert image.size == (1200, 3600)
     colors = image.getcolors(maxcolors=1 << 20)
     count = {c: k for k, c in colors}
 
@@ -748,7 +769,6 @@ def test_ppo_npz_actor_equals_the_sb3_model_on_many_observations():
 
     import numpy as np
     from stable_baselines3 import PPO
-
     from visuomotor_gym.baselines.ppo.agent import NpzActor, npz_from_model, prove_npz_equals_model, read_npz
 
     old = COMMITTED / "agents" / "ppo-intercept__EyeCatch-v0.zip"  # our own committed file: trusted here

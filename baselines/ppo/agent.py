@@ -41,6 +41,28 @@ NPZ_RECORD = "policy.json"
 # MLPs while refusing zip bombs before anything is decompressed.
 NPZ_MAX_BYTES = 64 * 1024 * 1024
 NPZ_MAX_MEMBERS = 64
+# A budget on the network a policy file builds, checked from policy.json and the .npy headers before any
+# array is read or any layer allocated (a small file may name one large array from many layers).
+# Modelling choice: the committed ppo-npz policies have 3 layers, 6 arrays, 87,562 parameters and
+# 174,080 FLOPs per action (2 x multiply-adds); each bound leaves 40x or more room above them.
+NPZ_MAX_PARAMETERS = 4_000_000  # 46x; 16 MB of float32
+NPZ_MAX_LAYERS = 16  # 5x
+NPZ_MAX_WIDTH = 4096  # inputs or outputs of one layer (committed: 256)
+NPZ_MAX_FLOPS = 8_000_000  # per action, 46x (~ms on one CPU core)
+NPZ_MAX_RECORD_BYTES = 1024 * 1024  # policy.json (committed: ~5 KB)
+# meta scalars: key -> (type, low, high); None: no bound. Ranges are modelling choices around training's
+# values (clip 10, epsilon 1e-8, residuals 0.15 m and 3 deg) wide enough for any sensible setting.
+NPZ_META_NUMBERS = {
+    "clip_obs": (float, 1e-3, 1e3),
+    "epsilon": (float, 0.0, 1.0),
+    "intercept_residual_m": (float, 0.0, 10.0),
+    "gaze_residual_deg": (float, 0.0, 90.0),
+    "seed": (int, 0, None),
+    "timesteps": (int, 0, None),
+    "train_wall_s": (float, 0.0, None),
+}
+NPZ_META_STRINGS = ("algo", "env_id", "hand_action", "gaze_action")
+NPZ_META_BOOLS = ("belief",)
 NPZ_ACTIVATIONS = ("tanh", "relu", "elu", "leaky_relu", "silu", "gelu", "sigmoid")
 # Observations on which pack_npz proves the rebuilt actor equal to the SB3 model (modelling choice:
 # 2000 single-observation calls take well under a second and cover the clipped normalised range).
@@ -159,18 +181,54 @@ def _write_npz(record: dict, arrays: dict[str, np.ndarray]) -> bytes:
     return buf.getvalue()
 
 
+def _one_line(msg) -> str:
+    return " ".join(str(msg).split())
+
+
+def _npy_header(zf: zipfile.ZipFile, info: zipfile.ZipInfo) -> tuple[tuple[int, ...], np.dtype, int]:
+    """(shape, dtype, header length) of a ``.npy`` member from its header alone (nothing else is read);
+    the declared array must be a C-order float32/float64 array whose bytes fill the member exactly."""
+    name = info.filename
+    try:
+        with zf.open(info) as fh:
+            version = np.lib.format.read_magic(fh)
+            if version == (1, 0):
+                shape, fortran, dtype = np.lib.format.read_array_header_1_0(fh, max_header_size=10000)
+            elif version == (2, 0):
+                shape, fortran, dtype = np.lib.format.read_array_header_2_0(fh, max_header_size=10000)
+            else:
+                raise ValueError(f"unsupported .npy version {version}")
+            header = fh.tell() if fh.seekable() else None
+    except (ValueError, OSError, EOFError, SyntaxError, TypeError, zipfile.BadZipFile) as exc:
+        raise PolicyFileError(f"member {name!r} is not a plain .npy array: {_one_line(exc)}") from None
+    if dtype.hasobject or dtype.kind != "f" or dtype.itemsize not in (4, 8):
+        raise PolicyFileError(f"array {name!r} has dtype {dtype}; only float32/float64 allowed")
+    if fortran:
+        raise PolicyFileError(f"array {name!r} is in Fortran order; only C order is allowed")
+    if len(shape) > 2 or any((not isinstance(n, int)) or n < 0 or n > NPZ_MAX_PARAMETERS for n in shape):
+        raise PolicyFileError(f"array {name!r} declares shape {shape}: at most 2 dimensions of at most "
+                              f"{NPZ_MAX_PARAMETERS} each")
+    size = math.prod(shape) * dtype.itemsize
+    if header is None or info.file_size != header + size:
+        raise PolicyFileError(f"array {name!r} declares shape {shape} ({size} bytes) but the member holds "
+                              f"{info.file_size - (header or 0)} bytes of data")
+    return tuple(shape), dtype, header
+
+
 def read_npz(data: bytes) -> tuple[dict, dict[str, np.ndarray]]:
     """``(record, arrays)`` of a ``ppo-npz`` file, read without unpickling anything.
 
-    Refuses (``PolicyFileError``): a file that is not a zip, members other than ``policy.json`` and
-    ``*.npy``, more than :data:`NPZ_MAX_MEMBERS` members or :data:`NPZ_MAX_BYTES` uncompressed
-    (checked before decompressing), arrays that are not finite float32/float64 (an object array
-    needs pickle: ``allow_pickle=False`` refuses it), and a record of another format.
+    Refuses (``PolicyFileError``, one line): a file that is not a zip, members other than ``policy.json``
+    and ``*.npy``, more than :data:`NPZ_MAX_MEMBERS` members or :data:`NPZ_MAX_BYTES` uncompressed
+    (checked before decompressing), a ``.npy`` header declaring anything but a C-order float32/float64
+    array of at most 2 dimensions that fills its member exactly (checked before the data is read), a
+    network over the budget (:func:`network_budget`, from the record and the headers, before any
+    array is read), arrays that are not finite, and a record of another format.
     """
     try:
         zf = zipfile.ZipFile(io.BytesIO(data))
-    except zipfile.BadZipFile as exc:
-        raise PolicyFileError(f"not a {NPZ_FORMAT} policy file (not a zip: {exc})") from None
+    except (zipfile.BadZipFile, ValueError, OSError, EOFError) as exc:
+        raise PolicyFileError(f"not a {NPZ_FORMAT} policy file (not a zip: {_one_line(exc)})") from None
     with zf:
         infos = zf.infolist()
         if len(infos) > NPZ_MAX_MEMBERS:
@@ -183,34 +241,103 @@ def read_npz(data: bytes) -> tuple[dict, dict[str, np.ndarray]]:
             raise PolicyFileError("a member name appears twice")
         if NPZ_RECORD not in names:
             raise PolicyFileError(f"no {NPZ_RECORD} inside: not a {NPZ_FORMAT} policy file")
-        arrays: dict[str, np.ndarray] = {}
-        for name in names:
+        headers = {}
+        for info in infos:
+            name = info.filename
             if name == NPZ_RECORD:
+                if info.file_size > NPZ_MAX_RECORD_BYTES:
+                    raise PolicyFileError(f"{NPZ_RECORD} is {info.file_size} bytes, more than {NPZ_MAX_RECORD_BYTES}")
                 continue
             if not name.endswith(".npy") or "/" in name or name.startswith("."):
                 raise PolicyFileError(f"unexpected member {name!r} (only {NPZ_RECORD} and <name>.npy)")
-            raw = zf.read(name)
-            if len(raw) > NPZ_MAX_BYTES:  # a lying header: the stored size was smaller
-                raise PolicyFileError(f"member {name!r} is larger than declared")
+            headers[name] = (info, *_npy_header(zf, info))
+        try:
+            raw = zf.read(NPZ_RECORD)
+            if len(raw) > NPZ_MAX_RECORD_BYTES:
+                raise ValueError("larger than declared")
+            record = json.loads(raw.decode("utf-8"), parse_constant=lambda c: (_ for _ in ()).throw(ValueError(c)))
+        except (UnicodeDecodeError, ValueError, RecursionError, zipfile.BadZipFile, OSError) as exc:
+            raise PolicyFileError(f"{NPZ_RECORD} is not valid JSON: {_one_line(exc)}") from None
+        if not isinstance(record, dict) or record.get("format") != NPZ_FORMAT:
+            raise PolicyFileError(f"{NPZ_RECORD} is not a {NPZ_FORMAT} record")
+        if record.get("format_version") != NPZ_FORMAT_VERSION:
+            raise PolicyFileError(f"format_version must be {NPZ_FORMAT_VERSION}, got {record.get('format_version')!r}")
+        network_budget(record, {n[:-4]: h[1] for n, h in headers.items()})
+        arrays: dict[str, np.ndarray] = {}
+        for name, (info, shape, dtype, header) in headers.items():
             try:
-                array = np.lib.format.read_array(io.BytesIO(raw), allow_pickle=False)
-            except (ValueError, OSError, EOFError) as exc:
-                raise PolicyFileError(f"member {name!r} is not a plain .npy array: {exc}") from None
-            if array.dtype not in (np.float32, np.float64):
-                raise PolicyFileError(f"array {name!r} has dtype {array.dtype}; only float32/float64 allowed")
+                with zf.open(info) as fh:
+                    fh.read(header)
+                    buf = fh.read(info.file_size - header + 1)
+            except (zipfile.BadZipFile, OSError, EOFError, ValueError) as exc:
+                raise PolicyFileError(f"member {name!r} cannot be read: {_one_line(exc)}") from None
+            if len(buf) != info.file_size - header:
+                raise PolicyFileError(f"member {name!r} is not the size its header declares")
+            array = np.frombuffer(buf, dtype=dtype).reshape(shape)
             if not np.all(np.isfinite(array)):
                 raise PolicyFileError(f"array {name!r} holds NaN or inf")
             arrays[name[:-4]] = array
-        try:
-            record = json.loads(zf.read(NPZ_RECORD).decode("utf-8"),
-                                parse_constant=lambda c: (_ for _ in ()).throw(ValueError(c)))
-        except (UnicodeDecodeError, ValueError) as exc:
-            raise PolicyFileError(f"{NPZ_RECORD} is not valid JSON: {exc}") from None
-    if not isinstance(record, dict) or record.get("format") != NPZ_FORMAT:
-        raise PolicyFileError(f"{NPZ_RECORD} is not a {NPZ_FORMAT} record")
-    if record.get("format_version") != NPZ_FORMAT_VERSION:
-        raise PolicyFileError(f"format_version must be {NPZ_FORMAT_VERSION}, got {record.get('format_version')!r}")
     return record, arrays
+
+
+def network_budget(record: dict, shapes: dict[str, tuple[int, ...]]) -> dict[str, int]:
+    """Parameters, layers, array references and FLOPs per action of the network ``record`` builds from
+    arrays of ``shapes`` (nothing allocated); raises :class:`PolicyFileError` when it is malformed or
+    over :data:`NPZ_MAX_PARAMETERS`, :data:`NPZ_MAX_LAYERS`, :data:`NPZ_MAX_WIDTH`,
+    :data:`NPZ_MAX_FLOPS`, or when an array is referenced more than once (each layer owns its arrays)."""
+    net = record.get("network")
+    layers = net.get("layers") if isinstance(net, dict) else None
+    if not isinstance(layers, list) or not layers:
+        raise PolicyFileError("$.network.layers must be a non-empty list")
+    if len(layers) > NPZ_MAX_LAYERS:
+        raise PolicyFileError(f"$.network.layers has {len(layers)} layers, more than the {NPZ_MAX_LAYERS} allowed")
+    refs: list[str] = []
+    params = flops = 0
+    for i, layer in enumerate(layers):
+        if not isinstance(layer, dict):
+            raise PolicyFileError(f"$.network.layers[{i}] must be an object")
+        for key in ("weight", "bias"):
+            ref = layer.get(key)
+            if not isinstance(ref, str) or ref not in shapes:
+                raise PolicyFileError(f"$.network.layers[{i}].{key}: array {ref!r} is missing")
+            refs.append(ref)
+        w, b = shapes[layer["weight"]], shapes[layer["bias"]]
+        if len(w) != 2 or max(w) > NPZ_MAX_WIDTH:
+            raise PolicyFileError(f"$.network.layers[{i}]: weight {w} must be 2-D with at most {NPZ_MAX_WIDTH} "
+                                  f"inputs and outputs")
+        params += math.prod(w) + math.prod(b)
+        flops += 2 * math.prod(w) + math.prod(b)
+    repeated = sorted({r for r in refs if refs.count(r) > 1})
+    if repeated:
+        raise PolicyFileError(f"arrays {repeated} are referenced more than once: each layer owns its arrays")
+    if params > NPZ_MAX_PARAMETERS:
+        raise PolicyFileError(f"the network has {params} parameters, more than the {NPZ_MAX_PARAMETERS} allowed")
+    if flops > NPZ_MAX_FLOPS:
+        raise PolicyFileError(f"the network needs {flops} FLOPs per action, more than the {NPZ_MAX_FLOPS} allowed")
+    return {"parameters": params, "layers": len(layers), "references": len(refs), "flops": flops}
+
+
+def _check_meta(meta: dict, obs_dim: int) -> None:
+    """Every meta value the agent uses has its type and range (:data:`NPZ_META_NUMBERS`...)."""
+    for key, (kind, low, high) in NPZ_META_NUMBERS.items():
+        if key not in meta:
+            continue
+        v = meta[key]
+        ok = isinstance(v, (int, float)) and not isinstance(v, bool) and (kind is float or isinstance(v, int))
+        ok = ok and math.isfinite(v) and (low is None or v >= low) and (high is None or v <= high)
+        if not ok:
+            bound = f"in [{low}, {high if high is not None else 'inf'}]"
+            raise PolicyFileError(f"$.meta.{key} must be a finite {kind.__name__} {bound}, got {v!r}")
+    for key in NPZ_META_STRINGS:
+        if key in meta and not (isinstance(meta[key], str) and 0 < len(meta[key]) <= 100):
+            raise PolicyFileError(f"$.meta.{key} must be a string of 1-100 characters, got {meta[key]!r}")
+    for key in NPZ_META_BOOLS:
+        if key in meta and not isinstance(meta[key], bool):
+            raise PolicyFileError(f"$.meta.{key} must be true or false, got {meta[key]!r}")
+    if "obs_var" in meta and isinstance(meta["obs_var"], list) and any(
+        isinstance(x, (int, float)) and x < 0 for x in meta["obs_var"]
+    ):
+        raise PolicyFileError("$.meta.obs_var must hold variances >= 0")
 
 
 def _check_record(record: dict, arrays: dict[str, np.ndarray]) -> None:
@@ -229,8 +356,12 @@ def _check_record(record: dict, arrays: dict[str, np.ndarray]) -> None:
     meta = need(record, "meta", dict, "$")
     if need(meta, "algo", str, "$.meta") != "PPO":
         raise PolicyFileError(f"$.meta.algo must be 'PPO', got {meta['algo']!r}")
+    network_budget(record, {k: v.shape for k, v in arrays.items()})
     obs_dim = need(net, "obs_dim", int, "$.network")
     action_dim = need(net, "action_dim", int, "$.network")
+    if not 1 <= obs_dim <= NPZ_MAX_WIDTH or not 1 <= action_dim <= NPZ_MAX_WIDTH:
+        raise PolicyFileError(f"$.network.obs_dim / action_dim must be in [1, {NPZ_MAX_WIDTH}]")
+    _check_meta(meta, obs_dim)
     layers = need(net, "layers", list, "$.network")
     if not layers:
         raise PolicyFileError("$.network.layers is empty")
@@ -420,10 +551,17 @@ class PPOAgent:
 
     @classmethod
     def from_npz(cls, data: bytes, env_id: str | None = None) -> PPOAgent:
-        """The agent of a pickle-free ``ppo-npz`` file (:func:`pack_npz`); nothing is unpickled."""
-        record, arrays = read_npz(data)
-        agent = cls.__new__(cls)
-        agent._setup(None, record["meta"], env_id, actor=NpzActor(record, arrays))
+        """The agent of a pickle-free ``ppo-npz`` file (:func:`pack_npz`); nothing is unpickled. Every
+        failure is a :class:`PolicyFileError` with a one-line message."""
+        try:
+            record, arrays = read_npz(data)
+            agent = cls.__new__(cls)
+            agent._setup(None, record["meta"], env_id, actor=NpzActor(record, arrays))
+        except PolicyFileError as exc:
+            raise PolicyFileError(_one_line(exc)) from None
+        except (ValueError, TypeError, KeyError, IndexError, AttributeError, RuntimeError, MemoryError,
+                OverflowError, RecursionError) as exc:
+            raise PolicyFileError(f"not a loadable {NPZ_FORMAT} policy: {type(exc).__name__}: {_one_line(exc)}") from None
         return agent
 
     @classmethod

@@ -65,7 +65,9 @@ def screenshot(page, png, width: int = 1200, height: int = 1600, timeout: float 
     return png
 
 
-def dump_dom(page, timeout: float = 90.0, budget_ms: int = 5000) -> str:
-    """The DOM of ``page`` after it loaded and its scripts ran, serialised as HTML."""
+def dump_dom(page, timeout: float = 90.0, budget_ms: int = 5000, width: int = 1200, height: int = 1600) -> str:
+    """The DOM of ``page`` after it loaded and its scripts ran, serialised as HTML; laid out in a window of
+    ``width`` x ``height`` CSS pixels (the size :func:`screenshot` uses), so scripts measure that layout."""
     page = Path(page).resolve()
-    return _run([f"--virtual-time-budget={budget_ms}", "--dump-dom", page.as_uri()], timeout).stdout
+    args = [f"--window-size={width},{height}", f"--virtual-time-budget={budget_ms}", "--dump-dom", page.as_uri()]
+    return _run(args, timeout).stdout

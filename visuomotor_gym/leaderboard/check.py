@@ -4,17 +4,24 @@ Rules (the ``kind`` of a :class:`~visuomotor_gym.leaderboard.problems.Problem`):
 
 * ``protocol``: ``protocol.json`` passes ``protocol_schema.json`` (closed objects, tolerances at
   most 1 ms / 1 mm);
-* ``layout``: every file under ``results/`` is a results file or an entry record of a
-  ``<name>__<env_id>`` entry, each with its partner; every file under ``agents/`` belongs to an entry;
+* ``layout``: every file under the folder is a regular file (no symbolic link anywhere, no special
+  file; checked before anything is read, :func:`.entries.unsafe_paths`; a link the base already holds
+  unchanged is a note); every file under ``results/`` is a results file or an entry record of a
+  ``<name>__<env_id>`` entry, each with its partner; every file under ``agents/`` belongs to an entry,
+  and an entry's policy file is ``agents/<name>__<env_id><suffix>``;
   ``superseded.json`` passes ``superseded_schema.json``, lists entries that exist, each superseded
   ``by`` an entry of the same agent on the same env id;
 * ``results``: the results file passes the bench schema (closed at every level, ``run`` required)
   and its semantic checks (:func:`visuomotor_gym.bench.results.load_results`);
-* ``record``: the entry record passes ``entry_schema.json``;
+* ``record``: the entry record passes ``entry_schema.json`` (no control characters in any string); a
+  *new* entry's name is not a look-alike of another entry's (:func:`confusable_problems`) and its agent
+  spec is plain (:func:`agent_spec_problems`: a strict pattern; a path argument is a relative path
+  inside the entry's own team's files);
 * ``provenance``: the results name the commit they ran at, the command that produced them matches
   their agent, env id, episodes, seed and entry name, and the timestamp is not in the future. For a
   *new* entry (one that is not on the base ref) also: the commit exists in the history of the checked
-  tree, the tree was clean, and the run is not older than its commit;
+  tree, the tree was clean, the run is not older than its commit, and the commit holds the agent and
+  the policy file the entry claims (:func:`.history.claim_problems`);
 * ``consistency``: the record matches its results file (sha256, name, env id, agent), the run follows
   the protocol for its env id (episodes, first seed), the per-episode outcomes are exactly the pinned
   seeds and reproduce the results' caught and diverged counts, time to catch, miss distance,
@@ -25,9 +32,11 @@ Rules (the ``kind`` of a :class:`~visuomotor_gym.leaderboard.problems.Problem`):
 * ``rescore``: entries are re-played from their policy files, as the evaluator played them. A **new**
   entry is re-played on **every** pinned seed, and everything the results claim about play is
   recomputed from those episodes and compared (counts, success and catch rates with their intervals,
-  gaze realism and its components, reaction times, miss distance, time to catch, env steps), and its
-  self-reported latency p95 may not be more than :data:`LATENCY_FACTOR` below the p95 this check
-  measures. An **existing** entry (not superseded) is re-played on ``rescore.sample`` seeds, one per
+  gaze realism and its components, reaction times, miss distance, time to catch, env steps). Its
+  latency is *measured* on those episodes, on this machine, and reported beside the self-reported
+  figure (:attr:`CheckReport.latency`, a note per entry): it is not a pass/fail rule, since it depends
+  on the machine and its load (a byte copy of an honest entry must pass on a busy runner). An
+  **existing** entry (not superseded) is re-played on ``rescore.sample`` seeds, one per
   stratum, drawn from the base commit's sha and the entry key: fixed before any pull request, never
   from submitted bytes. Outcomes must agree (caught, diverged, steps exactly; times and distances
   within the protocol's tolerances);
@@ -43,6 +52,7 @@ entries skipped), and the rules that need git (history, the provenance commit) a
 from __future__ import annotations
 
 import hashlib
+import re
 import shlex
 import time
 from dataclasses import dataclass, field
@@ -54,16 +64,13 @@ from visuomotor_gym.leaderboard.entries import (
     Entry,
     Leaderboard,
     load_leaderboard,
+    read_regular,
     summary_from_records,
 )
 from visuomotor_gym.leaderboard.problems import KINDS, Problem
 
+POLICY_SUFFIX_RE = re.compile(r"\.[a-z0-9]{1,8}")
 SUMMARY_TOLERANCE = 1e-9  # results fields recomputed from the records: same floats, same order
-# A new entry's self-reported latency p95 may be at most this many times below the p95 the check
-# measures on its re-scored episodes. Modelling choice: machines differ (the committed Eyecatch
-# entries measured 0.35 ms idle and 4.4 ms while a training job shared the CPU: x12.5 in the other
-# direction, which is allowed); a claim 10x faster than CI measures is not a faster machine.
-LATENCY_FACTOR = 10.0
 # What a new entry's results must say about play, recomputed from its re-scored episodes.
 RECOMPUTED_FIELDS = (
     "episodes",
@@ -89,6 +96,8 @@ class CheckReport:
     rescored_entries: int = 0
     rescored_episodes: int = 0
     new_entries: list[str] = field(default_factory=list)  # keys of entries that are not on the base
+    # key -> (self-reported latency p95 ms, p95 this check measured on the re-scored episodes, steps)
+    latency: dict[str, tuple] = field(default_factory=dict)
     seconds: dict[str, float] = field(default_factory=dict)
 
     @property
@@ -174,7 +183,7 @@ def provenance_problems(entry: Entry, where: str) -> list[Problem]:
 def admission_provenance_problems(lb: Leaderboard, entry: Entry) -> list[Problem]:
     """A new entry's provenance against git: a clean tree, a commit in the history of the checked
     tree (HEAD), and a run no older than that commit (:func:`.history.commit_problems`)."""
-    from visuomotor_gym.leaderboard.history import commit_problems
+    from visuomotor_gym.leaderboard.history import claim_problems, commit_problems
 
     prov = entry.results["provenance"]
     where = lb.rel(entry.results_path)
@@ -190,8 +199,119 @@ def admission_provenance_problems(lb: Leaderboard, entry: Entry) -> list[Problem
             )
         )
     if prov["git_sha"] != "unknown":
-        out += commit_problems(lb.root, prov["git_sha"], prov["timestamp_utc"], where)
+        found = commit_problems(lb.root, prov["git_sha"], prov["timestamp_utc"], where)
+        out += found
+        if not found:
+            policy = None
+            if entry.policy is not None and (lb.root / entry.policy["file"]) not in lb.links:
+                try:
+                    policy = read_regular(lb.root / entry.policy["file"])
+                except ValueError:
+                    policy = None  # reported by the policy rule
+            out += claim_problems(lb.root, prov["git_sha"], entry.results["agent"], policy, where)
     return out
+
+
+# A new entry's agent spec: a registered agent name, then ':'-separated arguments of plain characters
+# (no spaces, quotes, brackets, '|', '<', '>', '!', '`': nothing Markdown or HTML reads). Length: the
+# longest committed spec is 68 characters (modelling choice: 4x room).
+SPEC_RE = re.compile(r"[a-z][a-z0-9_]*(:[A-Za-z0-9._/=,+-]+)*")
+MAX_SPEC_LENGTH = 256
+# A path argument (``ppo:<path>``): relative, each component starting with a letter or digit (no '..',
+# no hidden files, no absolute path, no '~').
+PATH_RE = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]*(/[A-Za-z0-9][A-Za-z0-9._-]*)*")
+TWIN_PREFIX = "gaze-blind-"
+
+
+def team(name: str) -> str:
+    """The agent an entry name belongs to: without the gaze-blind twin's prefix and the version suffix
+    (``gaze-blind-ppo-gated-v2`` -> ``ppo-gated``)."""
+    return family(name.removeprefix(TWIN_PREFIX))
+
+
+def agent_spec_problems(entry: Entry, where: str) -> list[Problem]:
+    """A new entry's agent spec is plain text (:data:`SPEC_RE`), and a path argument names the entry's
+    own team's files: a relative path (:data:`PATH_RE`) whose ``<name>__<env_id>`` components (policy
+    files are named so) all belong to the entry's team, and which holds at least one such component or
+    a folder named for the team: an entry cannot present another team's policy as its own."""
+    from visuomotor_gym.leaderboard.history import _agent_names
+
+    agent = entry.results["agent"]
+    if len(agent) > MAX_SPEC_LENGTH or not SPEC_RE.fullmatch(agent):
+        return [
+            Problem(
+                where,
+                "record",
+                f"agent spec {agent[:80]!r} is not plain: a new entry's spec is <agent>[:<argument>...] of at most "
+                f"{MAX_SPEC_LENGTH} letters, digits and . _ / = , + - (no spaces, quotes, brackets, '|', '<', '>')",
+            )
+        ]
+    try:
+        _names, path = _agent_names(agent)
+    except ValueError:
+        return []  # reported by the consistency rule
+    if path is None:
+        return []
+    own = team(entry.name)
+    if not PATH_RE.fullmatch(path):
+        return [
+            Problem(
+                where,
+                "record",
+                f"the agent spec's path {path!r} must be relative, inside the repository (no '..', no hidden or "
+                f"absolute paths)",
+            )
+        ]
+    parts = path.split("/")
+    claimed = {team(p.split("__")[0]) for p in parts if "__" in p}
+    others = sorted(claimed - {own})
+    if others or not (claimed or own in parts):
+        return [
+            Problem(
+                where,
+                "record",
+                f"the agent spec's path {path!r} is not the entry's own: the entry {entry.name!r} belongs to "
+                f"{own!r}, the path to {', '.join(map(repr, others)) if others else 'no team'}; name a file "
+                f"<{own}...>__<env_id>.npz or one in a folder named {own!r}",
+            )
+        ]
+    return []
+
+
+# Look-alike characters folded into one skeleton (modelling choice, the ASCII subset of Unicode's
+# confusables.txt that renders alike in the monospace and sans-serif fonts of GitHub and the page):
+# I, l, 1 and | ; O, o and 0 ; rn and m ; vv and w ; and the separators - _ . ; case is ignored.
+_FOLDS = (("rn", "m"), ("vv", "w"), ("I", "l"), ("1", "l"), ("|", "l"), ("0", "o"), ("_", "-"), (".", "-"))
+
+
+def skeleton(name: str) -> str:
+    """``name`` with look-alike characters folded: ``beIief_mpc`` and ``belief-mpc`` -> ``belief-mpc``."""
+    s = name
+    for a, b in _FOLDS[2:]:
+        s = s.replace(a, b)
+    s = s.lower()
+    for a, b in _FOLDS[:2]:
+        s = s.replace(a, b)
+    return s
+
+
+def confusable_problems(lb: Leaderboard, entry: Entry, where: str) -> list[Problem]:
+    """A new entry's team may not look like another team (:func:`skeleton` of :func:`team` equal, the
+    names different): ``beIief_mpc-v4`` next to ``belief_mpc`` is refused; ``belief_mpc-v4`` is a
+    version of it and is not."""
+    own = team(entry.name)
+    for other in sorted({team(e.name) for e in lb.entries if e.key != entry.key}):
+        if other != own and skeleton(other) == skeleton(own):
+            return [
+                Problem(
+                    where,
+                    "record",
+                    f"entry name {entry.name!r} looks like the existing {other!r} (both read {skeleton(own)!r} "
+                    f"with I/l/1, O/0, rn/m, case and - _ . folded): choose a name that cannot be mistaken for "
+                    f"another agent's",
+                )
+            ]
+    return []
 
 
 def results_hash_problems(lb: Leaderboard, entry: Entry) -> list[Problem]:
@@ -378,7 +498,9 @@ def policy_problems(lb: Leaderboard, entry: Entry, export: bool = True) -> list[
     found = _hash_problems(lb, entry)
     if found:
         return found
-    data = path.read_bytes()
+    if path in lb.links:
+        return []
+    data = read_regular(path)
     if export and fmt.reexport and entry.superseded is None:
         try:
             fresh = fmt.export(entry.results["agent"], entry.env_id)
@@ -408,9 +530,23 @@ def _hash_problems(lb: Leaderboard, entry: Entry) -> list[Problem]:
     pol = entry.policy
     path = lb.root / pol["file"]
     where = lb.rel(path)
-    if not path.is_file():
+    suffix = pol["file"][len(f"{AGENTS_DIR}/{entry.key}"):]
+    if not pol["file"].startswith(f"{AGENTS_DIR}/{entry.key}.") or not POLICY_SUFFIX_RE.fullmatch(suffix):
+        return [
+            Problem(
+                lb.rel(entry.record_path),
+                "policy",
+                f"policy.file is {pol['file']!r}; an entry's policy file is {AGENTS_DIR}/{entry.key}.<ext> "
+                f"(the name `vmgym leaderboard submit` writes)",
+            )
+        ]
+    if path in lb.links:  # never read; the entry is not re-scored
+        return [Problem(where, "policy", f"the entry {entry.key} records this policy file, which is not a regular file")]
+    try:
+        data = read_regular(path)
+    except ValueError:
         return [Problem(where, "policy", f"missing: the entry {entry.key} records this policy file")]
-    actual = hashlib.sha256(path.read_bytes()).hexdigest()
+    actual = hashlib.sha256(data).hexdigest()
     if actual != pol["sha256"]:
         return [
             Problem(
@@ -477,13 +613,13 @@ def superseded_problems(lb: Leaderboard) -> list[Problem]:
 
 def orphan_problems(lb: Leaderboard) -> list[Problem]:
     agents = lb.root / AGENTS_DIR
-    if not agents.is_dir():
+    if not agents.is_dir() or agents in lb.links:
         return []
     used = {(e.policy or {}).get("file") for e in lb.entries if e.record is not None}
     return [
         Problem(lb.rel(p), "layout", "policy file that no entry record references")
         for p in sorted(agents.iterdir())
-        if f"{AGENTS_DIR}/{p.name}" not in used
+        if f"{AGENTS_DIR}/{p.name}" not in used and p not in lb.links
     ]
 
 
@@ -537,9 +673,9 @@ def _differences(path: str, claimed, fresh, tol: float) -> list[str]:
 
 def summary_problems(lb: Leaderboard, entry: Entry, traces: list) -> list[Problem]:
     """A new entry's results, recomputed from its re-scored episodes (every pinned seed): every play
-    field of :data:`RECOMPUTED_FIELDS`, env steps and control period; and its latency claim."""
+    field of :data:`RECOMPUTED_FIELDS`, env steps and control period (latency is measured, not
+    compared: :func:`measured_latency`)."""
     from visuomotor_gym.metrics import summarize
-    from visuomotor_gym.metrics.summary import latency_summary
 
     r = entry.results
     where = lb.rel(entry.results_path)
@@ -572,19 +708,24 @@ def summary_problems(lb: Leaderboard, entry: Entry, traces: list) -> list[Proble
                 f"{_versions_note(r)}",
             )
         )
-    measured = latency_summary(traces)["p95"]
-    claimed = r["latency_ms"]["p95"]
-    if claimed is None or (measured == measured and claimed * LATENCY_FACTOR < measured):
-        out.append(
-            Problem(
-                where,
-                "rescore",
-                f"latency_ms.p95 = {claimed} ms is more than {LATENCY_FACTOR:g}x below the p95 this check "
-                f"measured on the re-scored episodes ({measured:.3g} ms): latency is self-reported, but "
-                f"not beyond a machine's difference",
-            )
-        )
     return out
+
+
+def measured_latency(entry: Entry, traces: list) -> tuple:
+    """(self-reported latency p95, the p95 measured on ``traces`` on this machine, policy steps timed)."""
+    from visuomotor_gym.metrics.summary import latency_summary
+
+    lat = latency_summary(traces)
+    return entry.results["latency_ms"]["p95"], lat["p95"], sum(int(t.steps) for t in traces)
+
+
+def latency_note(key: str, figures: tuple) -> str:
+    claimed, measured, steps = figures
+    shown = "n/a" if claimed is None else f"{claimed:.3g} ms"
+    return (
+        f"{key}: latency p95 self-reported {shown}, measured by this check {measured:.3g} ms over {steps} "
+        f"policy steps on this machine (shown, not a rule: machines and load differ)"
+    )
 
 
 @dataclass
@@ -613,8 +754,11 @@ def sample_for(lb: Leaderboard, entry: Entry, base_sha: str, sample: int | None 
     return _plan(lb, entry, False, base_sha, sample, None).seeds
 
 
-def rescore_entries(lb: Leaderboard, plans: list[_Plan], workers: int = 1, say=None) -> tuple[list[Problem], int]:
-    """Re-play every plan (one pool for all), compare; returns (problems, episodes played)."""
+def rescore_entries(
+    lb: Leaderboard, plans: list[_Plan], workers: int = 1, say=None, latency: dict | None = None
+) -> tuple[list[Problem], int]:
+    """Re-play every plan (one pool for all), compare; returns (problems, episodes played). ``latency``
+    (a dict) gets, per fully re-played entry, the figures of :func:`measured_latency`."""
     from visuomotor_gym.agents import is_deterministic
     from visuomotor_gym.leaderboard.rescore import chunk_jobs, run_jobs
 
@@ -628,7 +772,7 @@ def rescore_entries(lb: Leaderboard, plans: list[_Plan], workers: int = 1, say=N
         if unknown:
             problems.append(Problem(where, "rescore", f"seeds {unknown} are not among the entry's pinned seeds"))
             plan.seeds = [s for s in plan.seeds if s in pinned]
-        data = (lb.root / e.policy["file"]).read_bytes() if e.policy is not None else None
+        data = read_regular(lb.root / e.policy["file"]) if e.policy is not None else None
         fmt = e.policy["format"] if e.policy is not None else None
         jobs += chunk_jobs(
             e.key, e.env_id, r["agent"], fmt, data, is_deterministic(r["agent"]), r["seed"], r["episodes"],
@@ -668,6 +812,8 @@ def rescore_entries(lb: Leaderboard, plans: list[_Plan], workers: int = 1, say=N
         if plan.full and not found:
             traces = sorted((t for res in parts for t in res.traces), key=lambda t: t.seed)
             found += summary_problems(lb, e, traces)
+            if latency is not None and traces:
+                latency[e.key] = measured_latency(e, traces)
         problems += found
         if say:
             what = "every pinned seed, summary recomputed" if plan.full else "sampled seeds"
@@ -719,6 +865,11 @@ def check_leaderboard(
     else:
         b, found = history.load_base(lb.root, base, lb.rel)
         report.problems += found
+    if b is not None and lb.links:  # links the base already holds unchanged block no pull request
+        excused, notes = history.excused_links(b, lb.links)
+        report.problems = [p for p in report.problems if p not in {lb.links[x] for x in excused}]
+        lb.problems = [p for p in lb.problems if p not in {lb.links[x] for x in excused}]
+        report.notes += notes
     existing = b.entry_keys if b is not None else set()
     new_keys = {e.key for e in lb.entries if e.key not in existing}
     report.new_entries = sorted(new_keys)
@@ -731,6 +882,8 @@ def check_leaderboard(
         report.problems += provenance_problems(entry, lb.rel(entry.results_path))
         if b is not None and entry.key in new_keys:
             report.problems += admission_provenance_problems(lb, entry)
+            report.problems += agent_spec_problems(entry, lb.rel(entry.results_path))
+            report.problems += confusable_problems(lb, entry, lb.rel(entry.record_path))
         report.problems += consistency_problems(lb, entry)
         report.problems += policy_problems(lb, entry)
         static_ok[entry.key] = len(report.problems) == before and not results_hash_problems(lb, entry)
@@ -757,8 +910,9 @@ def check_leaderboard(
                 report.notes.append(f"{entry.key}: not re-scored (fix the problems above first)")
                 continue
             plans.append(_plan(lb, entry, entry.key in new_keys, b.sha if b else None, sample, seeds))
-        found, played = rescore_entries(lb, plans, workers=workers, say=say)
+        found, played = rescore_entries(lb, plans, workers=workers, say=say, latency=report.latency)
         report.problems += found
+        report.notes += [latency_note(k, v) for k, v in sorted(report.latency.items())]
         report.rescored_entries = len(plans)
         report.rescored_episodes = played
     elif not rescore:

@@ -5,12 +5,22 @@ versions, no env registry), so the check regenerates them and compares bytes. Th
 hand-written inline SVG (no JavaScript, no external files, no matplotlib version in the bytes):
 success rate with its 95 % Wilson interval per env id along the observability ladder, the gaze-realism
 components as a heat map, and policy latency (p50-p95, max) against the control period.
+
+**Text from entries is escaped** on both pages. In ``README.md`` (Markdown) names, env ids, agent
+specs and commits are code spans when plain (:func:`md_code`: no link, image, HTML or autolink is read
+inside one), else escaped like prose; prose (a superseded entry's reason) is :func:`md_text`: HTML
+special characters as entities, Markdown punctuation backslash-escaped, line breaks folded and
+autolinks (``https://``, ``www.``, ``a@b``) broken by a zero-width space.
+The HTML page escapes everything with :func:`html.escape`. The page's layout fits its width: the
+tables wrap their cells and scroll inside their own box, and plot labels and legends are sized from
+the text they hold (checked in headless Chromium: no element past the viewport).
 """
 
 from __future__ import annotations
 
 import html
 import math
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -197,8 +207,38 @@ def _family(env_id: str) -> str:
 # ------------------------------------------------------------------------------ README.md
 
 
-def _md(text: str) -> str:
-    return text.replace("|", "\\|")
+# What Markdown reads inside a table cell: code, emphasis, strike-through, link and image brackets, the
+# cell separator and escapes ('(' and '!' only matter next to an unescaped '[' or ']'; '#' and '+' only
+# at a line start; '<', '>' and '&' become entities first).
+_MD_PUNCT = re.compile(r"([\\`*_\[\]|~])")
+_AUTOLINK = re.compile(r"(?i)(?<=[a-z0-9])(?=(://|@))|(?<=www)(?=\.)")
+_SAFE_LINK = re.compile(r"agents/[A-Za-z0-9][A-Za-z0-9._:-]*")
+
+
+def _one_line(text) -> str:
+    """``text`` with every run of whitespace or control characters folded into one space."""
+    return " ".join(re.sub(r"[\x00-\x1f\x7f\u0085\u2028\u2029]", " ", str(text)).split())
+
+
+_PLAIN = re.compile(r"[A-Za-z0-9._:/=,+ -]*")
+
+
+def md_code(text) -> str:
+    """``text`` as a Markdown code span inside a table cell when it is plain (letters, digits and
+    ``. _ : / = , + -``: identifiers, agent specs, commits), else as escaped prose (:func:`md_text`).
+    Nothing inside a code span is read as a link, image, HTML or autolink; the plain alphabet also
+    keeps out the backtick that would close it and the ``|`` that would split the cell."""
+    line = _one_line(text)
+    return f"`{line}`" if _PLAIN.fullmatch(line) else md_text(line)
+
+
+def md_text(text) -> str:
+    """``text`` as literal Markdown prose in a table cell: one line; ``& < >`` as HTML entities; the
+    punctuation Markdown reads in a cell (:data:`_MD_PUNCT`: links, images, emphasis, code) backslash-escaped;
+    autolinks (``https://``, ``www.``, ``name@host``) broken by a zero-width space."""
+    out = html.escape(_one_line(text), quote=False)
+    out = _MD_PUNCT.sub(r"\\\1", out)
+    return _AUTOLINK.sub("&#8203;", out)
 
 
 def render_readme(lb: Leaderboard) -> str:
@@ -218,12 +258,12 @@ def render_readme(lb: Leaderboard) -> str:
         "[The page with plots](index.html) shows the same entries.",
         "",
         "| agent | env id | success rate [95 % CI] | gaze gain | gaze realism | latency p95 (self-reported) "
-        "| real time | episodes | seeds "
+        "| real time (self-reported) | episodes | seeds "
         "| verified | commit | date |",
         "|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
-        lines.append("| " + " | ".join(_md(c) for c in _cells_md(r)) + " |")
+        lines.append("| " + " | ".join(_cells_md(r)) + " |")
     if not rows:
         lines.append("| *no entries yet* |  |  |  |  |  |  |  |  |  |  |  |")
     if old:
@@ -238,15 +278,14 @@ def render_readme(lb: Leaderboard) -> str:
             lines.append(
                 "| "
                 + " | ".join(
-                    _md(c)
-                    for c in (
-                        f"`{r.name}`",
-                        f"`{r.env_id}`",
+                    (
+                        md_code(r.name),
+                        md_code(r.env_id),
                         fmt_rate(r),
-                        r.commit,
-                        r.date,
-                        f"`{r.entry.superseded['by']}`",
-                        r.entry.superseded["reason"],
+                        md_text(r.commit),
+                        md_text(r.date),
+                        md_code(r.entry.superseded["by"]),
+                        md_text(r.entry.superseded["reason"]),
                     )
                 )
                 + " |"
@@ -259,9 +298,11 @@ def render_readme(lb: Leaderboard) -> str:
         "seeds, both re-scored entries (a foveated env on which it is small does not test looking); "
         "*gaze realism*: mean score in [0, 1] of the gaze components against the sourced human reference "
         "table (`visuomotor_gym/metrics/human_reference.json`); *latency*: policy compute time per control "
-        "step, as measured by the submitter (CI re-measures it on a new entry's re-scored episodes and "
-        "refuses a claim more than 10x below its own); *success rate*: episodes that met the task's goal "
-        "(on the catch env ids: the catch rate); *real time*: latency p95 below the control period; "
+        "step, as measured by the submitter on their machine (CI measures it again on a new entry's re-scored "
+        "episodes and prints its own figure beside this one in the check's log; not a rule, since it depends "
+        "on the machine and its load, and not a rank); *success rate*: episodes that met the task's goal "
+        "(on the catch env ids: the catch rate); *real time*: self-reported latency p95 below the control "
+        "period; "
         "*verified*: a new entry is re-played by CI on every pinned seed, and existing entries on "
         f"{sample} seeds drawn from the base commit.",
         "",
@@ -285,7 +326,11 @@ def render_readme(lb: Leaderboard) -> str:
         "architecture record: nothing is unpickled);",
         "* a new entry whose re-play on every pinned seed disagrees with its records, or whose results "
         "(success and catch rates, gaze realism, reaction times, distances, env steps) differ from those "
-        "recomputed from the re-played episodes, or whose latency claim is more than 10x below CI's;",
+        "recomputed from the re-played episodes;",
+        "* a new entry whose commit does not hold the agent and policy file it claims, whose name looks like "
+        "another agent's (I/l/1, O/0, rn/m), or whose agent spec is not plain text or names another team's "
+        "files;",
+        "* a symbolic link or special file anywhere in the leaderboard folder (never followed);",
         f"* an existing entry whose re-played sample of {sample} pinned seeds (one per stratum, drawn "
         "from the base commit) disagrees with its recorded outcomes;",
         "* an entry deleted or rewritten relative to the main branch (entries are immutable: retire one by "
@@ -313,12 +358,16 @@ def render_readme(lb: Leaderboard) -> str:
 
 
 def _cells_md(r: Row) -> list[str]:
-    agent = f"[`{r.name}`]({r.policy})" if r.policy else f"`{r.name}`"
+    """The Markdown cells of a row, each escaped (:func:`md_code`, :func:`md_text`); the policy link
+    only for a path of the form the check allows (``agents/<name>__<env_id>.<ext>``)."""
+    agent = md_code(r.name)
+    if r.policy and _SAFE_LINK.fullmatch(r.policy):
+        agent = f"[{agent}]({r.policy})"
     if r.agent != r.name:
-        agent += f" (`{r.agent}`)"
-    return [
+        agent += f" ({md_code(r.agent)})"
+    return [  # numbers and words this module formats are plain; text from files is escaped
         agent,
-        f"`{r.env_id}`",
+        md_code(r.env_id),
         fmt_rate(r),
         fmt_gain(r.gain),
         fmt_score(r.realism),
@@ -327,8 +376,8 @@ def _cells_md(r: Row) -> list[str]:
         str(r.episodes),
         r.seeds,
         r.verified,
-        f"`{r.commit}`",
-        r.date,
+        md_code(r.commit),
+        md_text(r.date),
     ]
 
 
@@ -365,17 +414,28 @@ def svg_catch_rate(rows: list[Row], ladder: list[str]) -> str:
     if not rows or not ladder:
         return _empty("plot-catch-rate", label)
     names = _series(rows)
-    left, right, top, bottom = 64, 190, 20, 110
+    left, right, top, bottom = 64, 24, 20, 110
     step = 105
-    width, height = left + step * len(ladder) + right, 400
-    ph = height - top - bottom
+    width, plot_h = left + step * len(ladder) + right, 400
+    # The legend below the plot, in columns as wide as the longest name (no name is clipped).
+    col_w = 12 + 24 + text_width(max(names, key=len), LEGEND_PX)
+    cols = max(1, int((width - left) // col_w))
+    legend_rows = -(-len(names) // cols)
+    height = plot_h + 8 + 22 * legend_rows
+    ph = plot_h - top - bottom
     parts = _svg_open(width, height, "plot-catch-rate", label)
 
     def y(v):
         return top + ph * (1.0 - v)
 
+    # Each env id spreads only the series that have an entry on it across its own column (a series'
+    # offset among all series would push points of many agents out of their column and off the plot).
+    present = {e: [n for n in names if any(r.name == n and r.env_id == e for r in rows)] for e in ladder}
+
     def x(env_id, k):
-        return left + step * (ladder.index(env_id) + 0.5) + (k - (len(names) - 1) / 2.0) * 9.0
+        here = present[env_id]
+        spread = min(9.0, (step - 16.0) / max(1, len(here) - 1))
+        return left + step * (ladder.index(env_id) + 0.5) + (here.index(names[k]) - (len(here) - 1) / 2.0) * spread
 
     for tick in range(0, 101, 20):
         yy = y(tick / 100.0)
@@ -398,7 +458,7 @@ def svg_catch_rate(rows: list[Row], ladder: list[str]) -> str:
             f'class="tick">{E(env_id)}</text>'
         )
     parts.append(
-        f'<text x="{left + step * len(ladder) / 2:.1f}" y="{height - 6}" text-anchor="middle" '
+        f'<text x="{left + step * len(ladder) / 2:.1f}" y="{plot_h - 6}" text-anchor="middle" '
         f'class="muted">more observable ← → less observable</text>'
     )
     colours = _colours(names)
@@ -437,13 +497,24 @@ def svg_catch_rate(rows: list[Row], ladder: list[str]) -> str:
                 + _line(xx - 4, hi, xx + 4, hi, color, "2")
                 + marker(xx, y(r.rate), r.name) + "</g>"
             )
-    lx = left + step * len(ladder) + 24
     for k, name in enumerate(names):
-        ly = top + 10 + 22 * k
+        lx, ly = left + 6 + col_w * (k % cols), plot_h + 8 + 22 * (k // cols) + 6
         parts.append(marker(lx, ly, name).replace(' class="point"', "")
                      + f'<text x="{lx + 12}" y="{ly + 4}" class="legend">{E(name)}</text>')
     parts.append("</svg>")
     return "\n".join(parts)
+
+
+# Widths of SVG text, for sizing labels and legends so that nothing is clipped: an upper bound of the
+# advance width of DejaVu Sans (0.63 em for its widest lower-case letters and digits; 'm' and 'w' are
+# 0.97 and 0.82 em, hence the margin) at the font sizes of the plot CSS below (modelling choice).
+EM_PER_CHAR = 0.66
+LEGEND_PX, TICK_PX = 12, 11
+
+
+def text_width(text: str, px: float) -> int:
+    """An upper bound of the width in CSS pixels of ``text`` at ``px`` (see :data:`EM_PER_CHAR`)."""
+    return math.ceil(len(text) * px * EM_PER_CHAR)
 
 
 def _blue(score: float) -> str:
@@ -464,8 +535,12 @@ def svg_realism(rows: list[Row]) -> str:
             if c not in comps:
                 comps.append(c)
     cols = ["overall", *comps]
-    label_w, cell_w, cell_h, head = 250, 74, 26, 150
-    width, height = label_w + cell_w * len(cols) + 110, head + cell_h * len(rows) + 44
+    label_w = max(250, 16 + max(text_width(f"{r.name} · {r.env_id}", TICK_PX) for r in rows))
+    cell_w, cell_h = 74, 26
+    longest = max(text_width(c, TICK_PX) for c in cols)  # column heads, rotated by 40 degrees
+    head = max(150, 16 + int(longest * math.sin(math.radians(40))))
+    tail = max(110, 16 + int(longest * math.cos(math.radians(40))))
+    width, height = label_w + cell_w * len(cols) + tail, head + cell_h * len(rows) + 44
     parts = _svg_open(width, height, "plot-realism", label)
     for j, c in enumerate(cols):
         cx = label_w + cell_w * (j + 0.5)
@@ -527,7 +602,8 @@ def svg_latency(rows: list[Row]) -> str:
     hi = math.ceil(math.log10(max(vals + periods)) + 1e-9)
     if hi <= lo:
         hi = lo + 1
-    label_w, plot_w, row_h, top = 250, 460, 24, 16
+    label_w = max(250, 16 + max(text_width(f"{r.name} · {r.env_id}", TICK_PX) for r in rows))
+    plot_w, row_h, top = 460, 24, 16
     width, height = label_w + plot_w + 40, top + row_h * len(rows) + 56
 
     def x(v):
@@ -582,10 +658,16 @@ body { font-family: "DejaVu Sans", "Helvetica Neue", Arial, sans-serif; margin: 
        color: #1b1b1b; padding: 0 16px; line-height: 1.45; }
 h1 { font-size: 26px; margin-bottom: 4px; } h2 { font-size: 19px; margin-top: 30px; }
 p.lede { color: #444; max-width: 900px; }
-table { border-collapse: collapse; font-size: 13px; width: 100%; }
-th, td { border-bottom: 1px solid #ddd; padding: 5px 7px; text-align: left; white-space: nowrap; }
+.table-wrap { max-width: 100%; overflow-x: auto; }
+table { border-collapse: collapse; font-size: 12px; width: 100%; }
+th, td { border-bottom: 1px solid #ddd; padding: 4px 5px; text-align: left; vertical-align: top; }
+td { white-space: nowrap; }
 th { background: #f3f5f8; font-weight: 600; }
+td.agent { white-space: normal; min-width: 12em; }
+td.agent code, td.wrap code { overflow-wrap: anywhere; }
+td.wrap { white-space: normal; }
 td.num { text-align: right; font-variant-numeric: tabular-nums; }
+td.rate { white-space: normal; min-width: 6.5em; }
 tr.superseded td { color: #888; }
 td.why { white-space: normal; min-width: 16em; }
 code { font-size: 12px; }
@@ -603,14 +685,14 @@ footer { color: #777; font-size: 12px; margin-top: 30px; }
 
 def _cells_html(r: Row) -> str:
     agent = f"<code>{E(r.name)}</code>"
-    if r.policy:
+    if r.policy and _SAFE_LINK.fullmatch(r.policy):
         agent = f'<a href="{E(r.policy)}">{agent}</a>'
     if r.agent != r.name:
         agent += f" (<code>{E(r.agent)}</code>)"
     cells = [
-        ("", agent),
+        ("agent", agent),
         ("", f"<code>{E(r.env_id)}</code>"),
-        ("num", E(fmt_rate(r))),
+        ("num rate", E(fmt_rate(r))),
         ("num", E(fmt_gain(r.gain))),
         ("num", fmt_score(r.realism)),
         ("num", fmt_ms(r.latency["p95"])),
@@ -630,7 +712,8 @@ def render_html(lb: Leaderboard) -> str:
     sample = lb.protocol.rescore_sample if lb.protocol is not None else "?"
     head = (
         "<tr><th>agent</th><th>env id</th><th>success rate [95 % CI]</th><th>gaze gain</th><th>gaze realism</th>"
-        "<th>latency p95 (self-reported)</th><th>real time</th><th>episodes</th><th>seeds</th><th>verified</th>"
+        "<th>latency p95 (self-reported)</th><th>real time (self-reported)</th><th>episodes</th><th>seeds</th>"
+        "<th>verified</th>"
         "<th>commit</th><th>date</th></tr>"
     )
     body = "\n".join(f'<tr class="entry" data-entry="{E(r.key)}">{_cells_html(r)}</tr>' for r in rows)
@@ -655,13 +738,13 @@ def render_html(lb: Leaderboard) -> str:
         "<code>vmgym bench</code> on the standard protocol "
         '(<a href="protocol.json">protocol.json</a>), pinned '
         f"seeds per env id; CI re-plays a new entry on every pinned seed and existing entries on {sample} "
-        "seeds drawn from the base commit. Latency is self-reported (CI refuses a claim more than 10x "
-        "below its own measurement).</p>",
-        '<table id="leaderboard-table"><thead>',
+        "seeds drawn from the base commit. Latency is self-reported; CI measures it on its own machine and "
+        "prints its figure beside the claim (not a rule: it depends on the machine's load).</p>",
+        '<div class="table-wrap"><table id="leaderboard-table"><thead>',
         head,
         "</thead><tbody>",
         body,
-        "</tbody></table>",
+        "</tbody></table></div>",
     ]
     parts += [
         "<h2>Success rate along the observability ladder</h2>",
@@ -681,18 +764,18 @@ def render_html(lb: Leaderboard) -> str:
     if old:
         parts += [
             "<h2>Superseded entries</h2>",
-            '<table id="superseded-table"><thead><tr><th>agent</th><th>env id</th>'
+            '<div class="table-wrap"><table id="superseded-table"><thead><tr><th>agent</th><th>env id</th>'
             "<th>success rate [95 % CI]</th>"
             "<th>commit</th><th>date</th><th>superseded by</th><th>why</th></tr></thead><tbody>",
         ]
         parts += [
-            f'<tr class="superseded" data-entry="{E(r.key)}"><td><code>{E(r.name)}</code></td><td><code>'
-            f'{E(r.env_id)}</code></td><td class="num">{E(fmt_rate(r))}</td><td><code>{E(r.commit)}</code>'
-            f'</td><td>{E(r.date)}</td><td><code>{E(r.entry.superseded["by"])}</code></td>'
+            f'<tr class="superseded" data-entry="{E(r.key)}"><td class="wrap"><code>{E(r.name)}</code></td><td><code>'
+            f'{E(r.env_id)}</code></td><td class="num rate">{E(fmt_rate(r))}</td><td><code>{E(r.commit)}</code>'
+            f'</td><td>{E(r.date)}</td><td class="wrap"><code>{E(r.entry.superseded["by"])}</code></td>'
             f'<td class="why">{E(r.entry.superseded["reason"])}</td></tr>'
             for r in old
         ]
-        parts.append("</tbody></table>")
+        parts.append("</tbody></table></div>")
     parts += [
         "<h2>How the leaderboard is kept honest</h2>",
         '<ul class="rules">',
@@ -707,6 +790,9 @@ def render_html(lb: Leaderboard) -> str:
         "<li>Policy files are JSON or <code>.npz</code> arrays with a JSON architecture record: nothing is "
         "unpickled.</li>",
         "<li>Entries are immutable: CI refuses deleting or rewriting one relative to the main branch.</li>",
+        "<li>A new entry's commit must hold the agent and policy file it claims; its name may not look like "
+        "another agent's (I/l/1, O/0, rn/m) and its agent spec must be plain text naming its own files. "
+        "Leaderboard files are regular files: a symbolic link is never followed.</li>",
         "<li>This page and README.md are regenerated and compared byte for byte.</li>",
         "</ul>",
         "<footer>Generated by <code>vmgym leaderboard build</code>; checked by <code>vmgym leaderboard check"
