@@ -123,37 +123,28 @@ def _action_blocks(env_id: str) -> list[str]:
 
 
 def _leaderboard_rows(env_ids) -> list[str]:
-    """Current (not superseded) entries on ``env_ids``, ladder order, best first; gaze gain = success
-    minus that of a current entry of the agent's gaze-blind twin on the same id."""
+    """Current (not superseded) entries on ``env_ids``, as the leaderboard page orders and scores them
+    (:mod:`visuomotor_gym.leaderboard.pages`): the gaze gain against the better of the held and the best
+    static twin, and the held-twin difference."""
     if not (LEADERBOARD / "protocol.json").is_file():
         return []
     from visuomotor_gym.leaderboard.entries import load_leaderboard
+    from visuomotor_gym.leaderboard.pages import _rows, fmt_gain, fmt_rate, fmt_realism
 
-    lb = load_leaderboard(LEADERBOARD)
-    entries = [e for e in lb.valid_entries if e.superseded is None and e.env_id in env_ids]
-    if not entries:
+    current, _ = _rows(load_leaderboard(LEADERBOARD))
+    current = [r for r in current if r.env_id in env_ids]
+    if not current:
         return []
-
-    def rate(e):
-        r = e.results
-        return float(r.get("success_rate", r["catch_rate"]))
-
-    by_agent = {(e.env_id, e.results["agent"]): e for e in entries}
     order = list(env_ids)
-    entries.sort(key=lambda e: (order.index(e.env_id), -rate(e), e.name))
-    rows = ["| agent (spec) | env id | success [95 % CI] | gaze gain | gaze realism | latency p95 | episodes |",
-            "|---|---|---|---|---|---|---|"]
-    for e in entries:
-        r = e.results
-        ci = r.get("success_rate_ci95", r.get("catch_rate_ci95"))
-        twins = [f"gaze_blind:{r['agent']}"] + (["fixed_gaze"] if r["agent"] == "eyecatch" else [])
-        twin = next((by_agent[(e.env_id, t)] for t in twins if (e.env_id, t) in by_agent), None)
-        gain = f"{100 * (rate(e) - rate(twin)):+.1f} pts" if twin is not None else "–"
-        realism = r["gaze_realism"]["score"]
+    current.sort(key=lambda r: (order.index(r.env_id), -r.rate, r.name))
+    rows = ["| agent (spec) | env id | success [95 % CI] | gaze gain | held-twin difference | gaze realism "
+            "| latency p95 | episodes |",
+            "|---|---|---|---|---|---|---|---|"]
+    for r in current:
+        p95 = r.latency["p95"]
         rows.append(
-            f"| `{e.name}` (`{_cell(r['agent'])}`) | `{e.env_id}` | {100 * rate(e):.1f} % "
-            f"[{100 * ci[0]:.1f}, {100 * ci[1]:.1f}] | {gain} | "
-            f"{'–' if realism is None else f'{realism:.3f}'} | {r['latency_ms']['p95']:.2f} ms | {r['episodes']} |"
+            f"| `{r.name}` (`{_cell(r.agent)}`) | `{r.env_id}` | {fmt_rate(r)} | {fmt_gain(r.gain)} | "
+            f"{fmt_gain(r.held_gain)} | {fmt_realism(r)} | {'–' if p95 is None else f'{p95:.2f} ms'} | {r.episodes} |"
         )
     return rows
 
@@ -229,8 +220,11 @@ def family_page(family: str) -> str:
     if board:
         lines += [
             ("Current entries of the [leaderboard](../evaluation.md#the-leaderboard) on this family's ids "
-            "(pinned seeds, `vmgym bench`'s evaluator). *Gaze gain*: success minus that of the agent's "
-            "gaze-blind twin (`gaze_blind:<agent>`) on the same seeds."),
+            "(pinned seeds, `vmgym bench`'s evaluator). *Gaze gain*: success minus that of the better of the "
+            "agent's two twins on the same seeds, the held twin (`gaze_blind:<agent>`: gaze and head held where "
+            "reset put them) and the best static twin (`static_gaze:<posture>:<agent>`: one posture of eye and "
+            "neck searched on design seeds); `–` without a static twin entry. *Held-twin difference*: success "
+            "minus the held twin's. *(v1)*: realism scored with the first definition."),
             "",
             *board,
             "",

@@ -58,7 +58,12 @@ class Row:
     commit: str
     date: str
     policy: str | None  # policy file, relative to the leaderboard folder
-    gain: float | None = None  # success minus the gaze-blind twin's entry on the same env id (None: no twin)
+    # The gaze gain: success minus the better of the agent's two twins' entries on the same env id and seeds
+    # (the held twin and the best static twin); None without a static twin entry. held_gain: success minus
+    # the held twin's alone (None without one).
+    gain: float | None = None
+    held_gain: float | None = None
+    realism_version: int = 1  # the realism definition the entry was scored with (metrics.realism.REALISM_VERSION)
 
     @property
     def key(self) -> str:
@@ -98,6 +103,7 @@ def _rows(lb: Leaderboard) -> tuple[list[Row], list[Row]]:
                 caught=round(float(r.get("success_rate", r["catch_rate"])) * int(r["episodes"])),
                 episodes=int(r["episodes"]),
                 realism=r["gaze_realism"]["score"],
+                realism_version=int(r["gaze_realism"].get("version", 1)),
                 components=r["gaze_realism"]["components"],
                 latency=r["latency_ms"],
                 period_ms=float(r["control_period_ms"]),
@@ -122,22 +128,40 @@ def _rows(lb: Leaderboard) -> tuple[list[Row], list[Row]]:
 
 
 def twin_agents(agent: str) -> tuple[str, ...]:
-    """The agent specs that are ``agent``'s gaze-blind twin (``fixed_gaze`` is ``gaze_blind:eyecatch``)."""
+    """The agent specs that are ``agent``'s held (gaze-blind) twin (``fixed_gaze`` is ``gaze_blind:eyecatch``)."""
     return (f"gaze_blind:{agent}",) + (("fixed_gaze",) if agent == "eyecatch" else ())
 
 
+def is_static_twin(spec: str, agent: str) -> bool:
+    """Whether ``spec`` is ``agent``'s static twin (``static_gaze:[<posture>:]<agent>``)."""
+    from visuomotor_gym.bench.evaluate import static_twin_base
+
+    return static_twin_base(spec) == agent
+
+
 def _with_gaze_gains(rows: list[Row]) -> list[Row]:
-    """Each current entry with its gaze gain: its success rate minus that of a current entry of its
-    gaze-blind twin on the same env id and seeds (both re-scored entries); None when there is no twin."""
+    """Each current entry with its gaze gains, from its twins' own current (re-scored) entries on the same
+    env id and seeds: ``held_gain`` = its success rate minus the held twin's (``gaze_blind:<agent>``),
+    ``gain`` = its success rate minus the better of the held twin and the best static twin
+    (``static_gaze:<posture>:<agent>``; the newest entry of each). The gain needs the static twin: a
+    held twin alone is a poor static choice (it looks where reset put the eye), so without a static twin
+    entry the gain is unknown (None), and only the held-twin difference is shown."""
     import dataclasses
 
     current = [r for r in rows if r.entry.superseded is None]
     out = []
     for r in rows:
-        twins = [t for t in current if t.env_id == r.env_id and t.agent in twin_agents(r.agent)
-                 and t.seeds == r.seeds and t.episodes == r.episodes]
-        if twins and r.entry.superseded is None:
-            r = dataclasses.replace(r, gain=r.rate - max(twins, key=lambda t: t.date).rate)
+        if r.entry.superseded is None:
+            same = [t for t in current if t.env_id == r.env_id and t.seeds == r.seeds and t.episodes == r.episodes]
+            held = [t for t in same if t.agent in twin_agents(r.agent)]
+            static = [t for t in same if is_static_twin(t.agent, r.agent)]
+            held_rate = max(held, key=lambda t: t.date).rate if held else None
+            static_rate = max(static, key=lambda t: t.date).rate if static else None
+            r = dataclasses.replace(
+                r,
+                held_gain=None if held_rate is None else r.rate - held_rate,
+                gain=None if static_rate is None else r.rate - max(static_rate, held_rate or 0.0),
+            )
         out.append(r)
     return out
 
@@ -161,6 +185,13 @@ def fmt_ms(x) -> str:
     if x is None:
         return "n/a"
     return f"{x:.2f} ms" if x < 10 else f"{x:.1f} ms"
+
+
+def fmt_realism(row: Row) -> str:
+    """The realism score, marked ``(v1)`` when the entry was scored with the first definition (the mean of the
+    defined components, which a still eye could pass)."""
+    text = fmt_score(row.realism)
+    return text if row.realism_version >= 2 or row.realism is None else f"{text} (v1)"
 
 
 def fmt_score(x) -> str:
@@ -257,15 +288,15 @@ def render_readme(lb: Leaderboard) -> str:
         "vision or a bounce; each other family is scored on its foveated id. "
         "[The page with plots](index.html) shows the same entries.",
         "",
-        "| agent | env id | success rate [95 % CI] | gaze gain | gaze realism | latency p95 (self-reported) "
-        "| real time (self-reported) | episodes | seeds "
+        "| agent | env id | success rate [95 % CI] | gaze gain | held-twin difference | gaze realism "
+        "| latency p95 (self-reported) | real time (self-reported) | episodes | seeds "
         "| verified | commit | date |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
         lines.append("| " + " | ".join(_cells_md(r)) + " |")
     if not rows:
-        lines.append("| *no entries yet* |  |  |  |  |  |  |  |  |  |  |  |")
+        lines.append("| *no entries yet* |  |  |  |  |  |  |  |  |  |  |  |  |")
     if old:
         lines += [
             "",
@@ -293,11 +324,18 @@ def render_readme(lb: Leaderboard) -> str:
     sample = proto.rescore_sample if proto is not None else "?"
     lines += [
         "",
-        "*gaze gain*: the success rate minus that of the agent's gaze-blind twin (the same agent with its gaze "
-        "and head actions held: `gaze_blind:<agent>`, or `fixed_gaze` for `eyecatch`) on the same env id and "
-        "seeds, both re-scored entries (a foveated env on which it is small does not test looking); "
-        "*gaze realism*: mean score in [0, 1] of the gaze components against the sourced human reference "
-        "table (`visuomotor_gym/metrics/human_reference.json`); *latency*: policy compute time per control "
+        "*gaze gain*: the success rate minus that of the better of the agent's two twins on the same env id "
+        "and seeds, each a re-scored entry of its own: the *held twin* (the same agent with its gaze and head "
+        "actions held where reset put them: `gaze_blind:<agent>`, or `fixed_gaze` for `eyecatch`) and the "
+        "*best static twin* (`static_gaze:<posture>:<agent>`: gaze, vergence and head replaced by one constant "
+        "posture in the body frame, searched on design seeds by `python -m visuomotor_gym.static_gaze search`; "
+        "the posture is in the spec, so it replays); `–` where no static twin was entered. A small gain means a "
+        "fixed posture does as well as the agent's eye movements: the env does not yet test *moving* the eye; "
+        "*held-twin difference*: the success rate minus the held twin's alone; "
+        "*gaze realism*: the smallest of the group scores (when the eye moves; where it lands) of the gaze "
+        "components against the sourced human reference tables (`visuomotor_gym/metrics/`; an undefined "
+        "component scores 0, so a still or a random eye scores low); entries entered before the realism "
+        "of version 2 keep the score they were entered with; *latency*: policy compute time per control "
         "step, as measured by the submitter on their machine (CI measures it again on a new entry's re-scored "
         "episodes and prints its own figure beside this one in the check's log; not a rule, since it depends "
         "on the machine and its load, and not a rank); *success rate*: episodes that met the task's goal "
@@ -370,7 +408,8 @@ def _cells_md(r: Row) -> list[str]:
         md_code(r.env_id),
         fmt_rate(r),
         fmt_gain(r.gain),
-        fmt_score(r.realism),
+        fmt_gain(r.held_gain),
+        fmt_realism(r),
         fmt_ms(r.latency["p95"]),
         "yes" if r.real_time else "no",
         str(r.episodes),
@@ -694,7 +733,8 @@ def _cells_html(r: Row) -> str:
         ("", f"<code>{E(r.env_id)}</code>"),
         ("num rate", E(fmt_rate(r))),
         ("num", E(fmt_gain(r.gain))),
-        ("num", fmt_score(r.realism)),
+        ("num", E(fmt_gain(r.held_gain))),
+        ("num", E(fmt_realism(r))),
         ("num", fmt_ms(r.latency["p95"])),
         ("", "yes" if r.real_time else "no"),
         ("num", str(r.episodes)),
@@ -711,14 +751,15 @@ def render_html(lb: Leaderboard) -> str:
     ladder = list(lb.protocol.env_ids) if lb.protocol is not None else []
     sample = lb.protocol.rescore_sample if lb.protocol is not None else "?"
     head = (
-        "<tr><th>agent</th><th>env id</th><th>success rate [95 % CI]</th><th>gaze gain</th><th>gaze realism</th>"
+        "<tr><th>agent</th><th>env id</th><th>success rate [95 % CI]</th><th>gaze gain</th>"
+        "<th>held-twin difference</th><th>gaze realism</th>"
         "<th>latency p95 (self-reported)</th><th>real time (self-reported)</th><th>episodes</th><th>seeds</th>"
         "<th>verified</th>"
         "<th>commit</th><th>date</th></tr>"
     )
     body = "\n".join(f'<tr class="entry" data-entry="{E(r.key)}">{_cells_html(r)}</tr>' for r in rows)
     if not rows:
-        body = '<tr><td colspan="11">no entries yet</td></tr>'
+        body = '<tr><td colspan="13">no entries yet</td></tr>'
     ladder_items = "".join(
         f"<li><code>{E(e.env_id)}</code>: {E(e.sees)} ({e.episodes} episodes, seeds "
         f"{e.seed}–{e.seed + e.episodes - 1})</li>"
@@ -734,7 +775,9 @@ def render_html(lb: Leaderboard) -> str:
         "<h1>visuomotor_gym leaderboard</h1>",
         '<p class="lede">Agents catch thrown balls, reach, walk over obstacles and step on stones seeing only '
         "through a human-like eye: sharp only near the line of sight, noisy, blind during saccades. The gaze "
-        "gain is the success rate minus that of the agent's gaze-blind twin. Every number comes from the evaluator of "
+        "gain is the success rate minus that of the better of the agent's two twins: the held twin (gaze and head held "
+        "where reset put them) and the best static twin (one posture of eye and neck, searched on design seeds). "
+        "Every number comes from the evaluator of "
         "<code>vmgym bench</code> on the standard protocol "
         '(<a href="protocol.json">protocol.json</a>), pinned '
         f"seeds per env id; CI re-plays a new entry on every pinned seed and existing entries on {sample} "

@@ -56,6 +56,9 @@ import numpy as np
 
 from visuomotor_gym.metrics import gaze, hand
 
+#: The realism definition: 2 = this module's rule (undefined scores 0, the smallest group score); results
+#: written with the mean of the defined components (version 1) carry no ``version``.
+REALISM_VERSION = 2
 REFERENCE_FILE = "human_reference.json"
 REQUIRED_FIELDS = ("value", "low", "high", "unit", "source", "notes", "group")
 #: The component groups (each reference entry names one); the score is the smallest group score.
@@ -156,7 +159,7 @@ def score_components(per_episode: Sequence[Mapping[str, float]], reference: Mapp
     for name, entry in reference.items():
         groups.setdefault(entry["group"], []).append(components[name]["score"])
     total = min(float(np.mean(v)) for v in groups.values()) if n and groups else float("nan")
-    return {"score": total, "components": components}
+    return {"score": total, "components": components, "version": REALISM_VERSION}
 
 
 def group_scores(result: Mapping, reference: Mapping) -> dict[str, float]:
