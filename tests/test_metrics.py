@@ -455,7 +455,7 @@ def test_summarize_is_json_serialisable_with_documented_keys():
     assert s["episodes"] == 4 and s["caught"] == 1 and s["diverged"] == 1
     assert s["catch_rate"] == pytest.approx(0.25)
     assert s["catch_rate_ci95"] == pytest.approx(list(M.wilson_interval(1, 4)))
-    assert set(s["gaze_realism"]) == {"score", "components"}
+    assert set(s["gaze_realism"]) == {"score", "components", "version"} and s["gaze_realism"]["version"] == 2
     assert set(s["gaze_realism"]["components"]) == set(COMPONENTS)
     assert set(s["latency_ms"]) == {"p50", "p95", "max"}
     assert s["latency_ms"]["max"] == pytest.approx(1e3 * lat[-1])
