@@ -63,7 +63,9 @@ def test_blind_to_every_percept(env_id, base):
     rng = np.random.default_rng(0)
     obs, _ = env.reset(seed=3)
     moved = 0
-    for _ in range(40):
+    want = _unit(20.0, -25.0)
+    errors, heads = [], []
+    for k in range(40):
         a, _ = seen.predict(obs)
         blind = obs.copy()
         for s in percepts:
@@ -77,9 +79,15 @@ def test_blind_to_every_percept(env_id, base):
             np.testing.assert_array_equal(a[act[block]], c[act[block]], err_msg=block)
         moved += bool(np.any(a[act["gaze"]] != 0.0))
         obs, _, terminated, truncated, _ = env.step(a)
+        if k >= 15:  # after the first saccades and the neck's move: the eye is at the posture, every family
+            gaze = obs[rot].reshape(3, 3)[:, 0]
+            errors.append(math.degrees(math.acos(min(1.0, float(gaze @ want)))))
+            heads.append(np.degrees(obs[u.layout.slices["head_qpos"]]))
         if terminated or truncated:
             break
     assert moved >= 1  # the posture was reached by at least one saccade (the gaze request is not constant)
+    assert errors and np.mean(errors) < DEAD_BAND_DEG, errors
+    np.testing.assert_allclose(np.mean(heads, axis=0), [10.0, -20.0], atol=2.0)
     env.close()
 
 

@@ -602,18 +602,34 @@ def update_postures(record: dict, path: Path | None = None, source: str | None =
     path.write_text(json.dumps(data, indent=2) + "\n")
 
 
+def _grid_text(stages: list) -> str:
+    """The search's stages in a few words (``coarse 20 deg / 16 seeds; refine 10, 5; neck +-20``)."""
+    by = {st["name"]: st for st in stages}
+    if "explicit" in by:
+        return f"{by['explicit']['postures']} explicit postures"
+    parts = [(f"coarse {by['coarse']['step_deg']:g} deg ({by['coarse']['postures']} postures) / "
+              f"{by['coarse']['episodes']} seeds")]
+    refine = [f"{st['step_deg']:g}" for st in stages if st["name"].startswith("refine")]
+    if refine:
+        parts.append("refine " + ", ".join(refine) + " deg")
+    neck = by.get("neck")
+    parts.append(f"neck +-{neck['step_deg']:g} deg" if neck and neck["step_deg"] > 0 else "no neck stage")
+    return "; ".join(parts)
+
+
 def summary_table(folder: Path) -> str:
     """A markdown table of every search results JSON in ``folder`` (env, agent, posture, rates)."""
     rows = ["# Best static twins (`static_gaze:<agent>`)", "",
-            "Each agent with its gaze, fixation and head held at one body-frame posture (line of sight "
-            "`az`/`el`, neck `neck_yaw`/`neck_pitch`, degrees, positive = left/up; fixation `fix`, m), the "
-            "posture searched on the design seeds (100000-100039) by `python -m visuomotor_gym.static_gaze "
-            "search` (its command, grid, stages and every posture's score are in the JSON next to this file), "
-            "then played on the 200 pinned seeds (0-199) with the common evaluator. Regenerate this table "
-            "with `python -m visuomotor_gym.static_gaze summary docs/reproductions/data/static_gaze --out "
-            "docs/reproductions/data/static_gaze/summary.md`.", "",
-            "| env id | agent | posture (deg; fixation m) | design seeds | pinned seeds 0-199 | search wall time |",
-            "|---|---|---|---|---|---|"]
+            ("Each agent with its gaze, fixation and head held at one body-frame posture (line of sight "
+             "`az`/`el`, neck `neck_yaw`/`neck_pitch`, degrees, positive = left/up; fixation `fix`, m), the "
+             "posture searched on the design seeds (100000-100039) by `python -m visuomotor_gym.static_gaze "
+             "search` (its command, grid, stages and every posture's score are in the JSON next to this file), "
+             "then played on the 200 pinned seeds (0-199) with the common evaluator. Regenerate this table "
+             "with `python -m visuomotor_gym.static_gaze summary docs/reproductions/data/static_gaze --out "
+             "docs/reproductions/data/static_gaze/summary.md`."), "",
+            ("| env id | agent | posture (deg; fixation m) | design seeds | pinned seeds 0-199 | grid | "
+             "episodes played | search wall time |"),
+            "|---|---|---|---|---|---|---|---|"]
     for path in sorted(Path(folder).glob("*__*.json")):
         r = json.loads(path.read_text())
         c = r["chosen"]
@@ -622,7 +638,7 @@ def summary_table(folder: Path) -> str:
                        if pinned else "not run")
         rows.append(f"| {r['env_id']} | `{r['agent']}` | `{Posture(**{k: c[k] for k in POSTURE_KEYS}).as_spec()}` | "
                     f"{c['successes']}/{c['episodes']} ({100 * c['success']:.1f} %) | {pinned_text} | "
-                    f"{r['wall_time_s'] / 60:.0f} min |")
+                    f"{_grid_text(r['stages'])} | {r.get('episodes_played', '')} | {r['wall_time_s'] / 60:.0f} min |")
     return "\n".join(rows) + "\n"
 
 
