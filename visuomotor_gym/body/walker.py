@@ -88,9 +88,11 @@ GAIT_RULES = {
     "pelvis_lead_m": Num(-0.3, 0.3),
     "heel_strike_deg": Num(0.0, 60.0),
     "toe_off_deg": Num(0.0, 80.0),
-    "swing_rise": Num(0.0, 1.0),
-    "swing_fall": Num(0.0, 1.0),
-    "swing_move": Pair(Num(0.0, 1.0), strict=True),
+    # Each phase of the swing lasts >= 5 % of it, the horizontal move >= half of it: shorter ones ask the
+    # servos for speeds the physics cannot follow (a 1e-6 move diverges at once).
+    "swing_rise": Num(0.05, 0.5),
+    "swing_fall": Num(0.5, 0.95),
+    "swing_move": Pair(Num(0.0, 1.0), min_width=0.5),
     "arm_swing_deg": Num(0.0, 90.0),
     "max_reach": Num(0.5, 1.0, high_open=True),
     "max_turn_deg": Num(0.0, 90.0),

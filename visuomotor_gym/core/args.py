@@ -155,10 +155,12 @@ class Int:
 @dataclass(frozen=True)
 class Pair:
     """A ``(low, high)`` range: two finite numbers, each inside ``bounds`` (a :class:`Num`), with
-    ``low <= high`` (``low < high`` when ``strict``). Lists and arrays become tuples of floats."""
+    ``low <= high`` (``low < high`` when ``strict``; ``high - low >= min_width`` when given). Lists and
+    arrays become tuples of floats."""
 
     bounds: Num = Num()
     strict: bool = False
+    min_width: float = 0.0
 
     def __call__(self, value: Any, name: str) -> tuple[float, float]:
         pair = _sequence(value, name, 2, "(low, high) pair")
@@ -166,6 +168,8 @@ class Pair:
         if lo > hi or (self.strict and lo == hi):
             raise ValueError(f"{name} must be a (low, high) pair with low {'<' if self.strict else '<='} high; "
                              f"got {value!r}")
+        if hi - lo < self.min_width:
+            raise ValueError(f"{name} must be a (low, high) pair with high - low >= {self.min_width:g}; got {value!r}")
         return (lo, hi)
 
 

@@ -216,7 +216,13 @@ class ObstacleWalkTask:
         return distance
 
     def reset_info(self) -> dict:
-        return {"course_length": self.course.length, "obstacles": self.course.obstacles.copy()}
+        """The course (true state, scoring only). Fixed shapes whatever the seed, so that Gymnasium's vector
+        envs can stack it: ``obstacles`` is (pool size, 6), its first ``n_obstacles`` rows the course's
+        obstacles (:attr:`Course.obstacles`), the rest NaN."""
+        obstacles = self.course.obstacles
+        padded = np.full((len(self.pool), obstacles.shape[1]), np.nan)
+        padded[: len(obstacles)] = obstacles
+        return {"course_length": float(self.course.length), "obstacles": padded, "n_obstacles": len(obstacles)}
 
     # --- what the evaluator records ----------------------------------------------------------
     def trace_episode_fields(self) -> dict:
