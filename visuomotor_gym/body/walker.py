@@ -99,8 +99,7 @@ GAIT_RULES = {
 }
 # Orders between fields: the gait's phases follow one another, the nominal footstep is a commandable one.
 GAIT_ORDER = (
-    ("double_support_s", "<", "heel_off_s"),
-    ("heel_off_s", "<", "step_s"),
+    ("double_support_s", "<", "step_s"),
     ("min_step_width_m", "<=", "step_width_m"),
     ("nominal_step_m", "in", "step_range_m"),
     ("nominal_clearance_m", "in", "clearance_range_m"),
@@ -168,6 +167,11 @@ class GaitParams:
 
     def __post_init__(self) -> None:
         args.check_fields(self, GAIT_RULES, GAIT_ORDER)
+        mid, toe_off = 0.5 * (self.step_s + self.double_support_s), self.step_s + self.double_support_s
+        if not mid < self.heel_off_s < toe_off:  # the phases in order (WalkerGait, in physics steps)
+            raise args.ParamValueError(type(self).__name__, (
+                f"heel_off_s must lie between mid-stance, (step_s + double_support_s) / 2 = {mid:g} s, and toe-off, "
+                f"step_s + double_support_s = {toe_off:g} s; got {self.heel_off_s!r}"))
 
 
 def _smooth(s: float) -> float:

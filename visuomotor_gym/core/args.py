@@ -105,17 +105,19 @@ class ParamValueError(ValueError):
     """A field of a parameter dataclass out of its rule: ``<owner>.<field> must be ...``. ``owner`` is
     the class name, or the constructor argument's name once :func:`coerce` has re-raised it."""
 
-    def __init__(self, owner: str, detail: str) -> None:
-        self.owner, self.detail = owner, detail
-        super().__init__(f"{owner}.{detail}")
+    def __init__(self, owner: str, detail: str | None = None) -> None:
+        # One argument: a whole message (Gymnasium's make re-raises a TypeError as type(e)(message)).
+        self.owner, self.detail = (owner, detail) if detail is not None else ("", owner)
+        super().__init__(f"{owner}.{detail}" if detail is not None else owner)
 
 
 class ParamTypeError(TypeError):
     """As :class:`ParamValueError`, for a value of the wrong type."""
 
-    def __init__(self, owner: str, detail: str) -> None:
-        self.owner, self.detail = owner, detail
-        super().__init__(f"{owner}.{detail}")
+    def __init__(self, owner: str, detail: str | None = None) -> None:
+        # One argument: a whole message (Gymnasium's make re-raises a TypeError as type(e)(message)).
+        self.owner, self.detail = (owner, detail) if detail is not None else ("", owner)
+        super().__init__(f"{owner}.{detail}" if detail is not None else owner)
 
 
 @dataclass(frozen=True)
