@@ -22,7 +22,7 @@ import pytest
 import visuomotor_gym  # noqa: F401  (registers the ids)
 from visuomotor_gym.body.walker import GAIT_RULES, GaitParams
 from visuomotor_gym.control.hand import HAND_RULES, HandControlParams
-from visuomotor_gym.core.args import Flag, Int, Many, Num, Pair, Weights
+from visuomotor_gym.core.args import Choice, Flag, Int, Many, Num, Optional, Pair, Weights, field_rule
 from visuomotor_gym.oculomotor.plant import OCULOMOTOR_RULES, OculomotorParams
 from visuomotor_gym.scenarios.throws import THROW_RULES, ThrowDistribution
 from visuomotor_gym.tasks.obstacle_dodge import CROWD_RULES, CrowdDistribution
@@ -71,6 +71,10 @@ def _bad_numbers(rule: Num) -> list:
 
 def bad_values(rule, default) -> list:
     """Values the rule must refuse, from the rule's kind and the field's default."""
+    if isinstance(rule, Optional):  # None is legitimate (the mechanism off)
+        return [b for b in bad_values(rule.rule, default) if b is not None]
+    if isinstance(rule, Choice):
+        return ["no such choice", 1, None]
     if isinstance(rule, Num):
         return _bad_numbers(rule)
     if isinstance(rule, Int):
@@ -102,8 +106,12 @@ def bad_values(rule, default) -> list:
             ((10.0, INF),), "ab"]
 
 
-CASES = [(cls, f.name, bad) for cls, rules in CLASSES.items() for f in dataclasses.fields(cls)
-         for bad in bad_values(rules[f.name], getattr(cls(), f.name))]
+def rule(cls, f):
+    return field_rule(f, CLASSES[cls], getattr(cls(), f.name))
+
+
+CASES = [(cls, f.name, bad) for cls in CLASSES for f in dataclasses.fields(cls)
+         for bad in bad_values(rule(cls, f), getattr(cls(), f.name))]
 
 
 def _id(case):
@@ -112,11 +120,14 @@ def _id(case):
 
 
 def test_every_field_has_a_declared_rule():
+    """In the class's rules dict or in the field's metadata (``bounds`` / ``choices``); a boolean needs none
+    (True or False is all it can be)."""
     for cls, rules in CLASSES.items():
         names = {f.name for f in dataclasses.fields(cls)}
-        missing = sorted(names - set(rules))
+        missing = sorted(f.name for f in dataclasses.fields(cls) if f.name not in rules
+                         and not {"bounds", "choices"} & set(f.metadata) and not isinstance(f.default, bool))
         assert not missing, (f"{cls.__name__} fields without a declared rule: {missing}; declare their bounds next to "
-                             f"the class (its *_RULES dict)")
+                             f"the class (its *_RULES dict) or in the field's metadata")
         assert not set(rules) - names, f"{cls.__name__}: rules for fields it does not have: {set(rules) - names}"
 
 
@@ -141,10 +152,10 @@ def test_the_table_covers_every_dataclass_argument_of_every_env():
 
 
 def test_the_defaults_construct_and_satisfy_their_rules():
-    for cls, rules in CLASSES.items():
+    for cls in CLASSES:
         obj = cls()
         for f in dataclasses.fields(cls):
-            rules[f.name](getattr(obj, f.name), f.name)  # no exception
+            rule(cls, f)(getattr(obj, f.name), f.name)  # no exception
 
 
 @pytest.mark.parametrize("case", CASES, ids=[_id(c) for c in CASES])
@@ -156,9 +167,8 @@ def test_bad_field_is_refused_naming_the_class_and_field(case):
     assert "\n" not in str(excinfo.value)
 
 
-ENV_CASES = [(env_id, arg, name, bad) for cls, rules, env_id, arg in TABLE if env_id is not None
-             for f in dataclasses.fields(cls) for name in [f.name]
-             for bad in bad_values(rules[name], getattr(cls(), name))]
+ENV_CASES = [(env_id, arg, f.name, bad) for cls, _, env_id, arg in TABLE if env_id is not None
+             for f in dataclasses.fields(cls) for bad in bad_values(rule(cls, f), getattr(cls(), f.name))]
 
 
 def test_bad_fields_through_gym_make_name_the_argument_and_write_no_mujoco_log(tmp_path, monkeypatch):

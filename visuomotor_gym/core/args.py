@@ -227,6 +227,42 @@ def _element(v: Any, name: str, bounds: Num, whole: Any) -> float:
     return x
 
 
+@dataclass(frozen=True)
+class Optional:
+    """``None`` (a mechanism off) or a value the inner rule accepts."""
+
+    rule: Any
+
+    def __call__(self, value: Any, name: str) -> Any:
+        return None if value is None else self.rule(value, name)
+
+
+@dataclass(frozen=True)
+class Choice:
+    """One of the allowed strings (see :func:`choice`)."""
+
+    allowed: tuple
+
+    def __call__(self, value: Any, name: str) -> Any:
+        return choice(value, self.allowed, name)
+
+
+def field_rule(f, rules: dict, value: Any):
+    """The rule of dataclass field ``f``: its entry in ``rules``; else one its metadata declares
+    (``"bounds": (low, high)`` with ``"low_open"`` and ``"optional"``, or ``"choices"``); else the one its
+    value's type implies (None: nothing to check, e.g. a string without choices)."""
+    if f.name in rules:
+        return rules[f.name]
+    meta = f.metadata
+    if "bounds" in meta:
+        low, high = meta["bounds"]
+        rule = Num(low, high, low_open=bool(meta.get("low_open", False)))
+        return Optional(rule) if meta.get("optional") else rule
+    if "choices" in meta:
+        return Choice(tuple(meta["choices"]))
+    return _implied_rule(value)
+
+
 def _implied_rule(value: Any):
     """The check a field without a declared rule gets, from its value's type (None: no check)."""
     if isinstance(value, bool) or type(value).__name__ == "bool_":
@@ -259,7 +295,8 @@ def check_fields(obj: Any, rules: dict, order: tuple = ()) -> None:
 
     ``rules``: field name -> rule (:class:`Num`, :class:`Int`, :class:`Pair`, :class:`Many`,
     :class:`Weights`, :class:`Flag`, or any ``rule(value, name) -> value`` raising ValueError/TypeError); fields not in it
-    get the rule their value's type implies. Sequences are stored back as tuples of floats.
+    get the rule their metadata declares or their value's type implies (:func:`field_rule`). Sequences are
+    stored back as tuples of floats.
     ``order``: ``(a, op, b)`` relations between fields, ``op`` one of ``<``, ``<=`` (numbers) or
     ``in`` (number ``a`` inside the range field ``b``); ``"name[i]"`` names an element of a range.
     Raises :class:`ParamValueError` / :class:`ParamTypeError` naming ``<Class>.<field>``.
@@ -267,7 +304,7 @@ def check_fields(obj: Any, rules: dict, order: tuple = ()) -> None:
     owner = type(obj).__name__
     for f in fields(obj):
         value = getattr(obj, f.name)
-        rule = rules.get(f.name) or _implied_rule(value)
+        rule = field_rule(f, rules, value)
         if rule is None:
             continue
         try:
