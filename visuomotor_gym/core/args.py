@@ -4,7 +4,7 @@ and what is allowed (Gymnasium users meet these first, before any physics runs).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
+from dataclasses import MISSING, dataclass, fields
 from numbers import Integral, Real
 from typing import Any
 
@@ -247,10 +247,19 @@ class Choice:
         return choice(value, self.allowed, name)
 
 
-def field_rule(f, rules: dict, value: Any):
+def _default(f, value: Any) -> Any:
+    """The field's default (its type decides the implied rule), or ``value`` when it has none."""
+    if f.default is not MISSING:
+        return f.default
+    if f.default_factory is not MISSING:
+        return f.default_factory()
+    return value
+
+
+def field_rule(f, rules: dict, default: Any):
     """The rule of dataclass field ``f``: its entry in ``rules``; else one its metadata declares
-    (``"bounds": (low, high)`` with ``"low_open"`` and ``"optional"``, or ``"choices"``); else the one its
-    value's type implies (None: nothing to check, e.g. a string without choices)."""
+    (``"bounds": (low, high)`` with ``"low_open"`` and ``"optional"``, or ``"choices"``); else the one the
+    type of its ``default`` implies (None: nothing to check, e.g. a string without choices)."""
     if f.name in rules:
         return rules[f.name]
     meta = f.metadata
@@ -260,7 +269,7 @@ def field_rule(f, rules: dict, value: Any):
         return Optional(rule) if meta.get("optional") else rule
     if "choices" in meta:
         return Choice(tuple(meta["choices"]))
-    return _implied_rule(value)
+    return _implied_rule(default)
 
 
 def _implied_rule(value: Any):
@@ -304,7 +313,7 @@ def check_fields(obj: Any, rules: dict, order: tuple = ()) -> None:
     owner = type(obj).__name__
     for f in fields(obj):
         value = getattr(obj, f.name)
-        rule = field_rule(f, rules, value)
+        rule = field_rule(f, rules, _default(f, value))
         if rule is None:
             continue
         try:
