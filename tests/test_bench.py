@@ -389,7 +389,7 @@ def test_bench_command_end_to_end(tmp_path, capsys):
     # a second run refuses to overwrite, before evaluating anything
     before = out.read_text()
     args = _bench_parser().parse_args(argv)
-    assert args.func(args) == 1
+    assert args.func(args) == 2
     assert "already exists; refusing to overwrite it (pass --force" in capsys.readouterr().err
     assert out.read_text() == before
 
