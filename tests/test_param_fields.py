@@ -11,7 +11,6 @@ each must be refused with ValueError/TypeError naming ``<Class>.<field>`` (direc
 from __future__ import annotations
 
 import dataclasses
-import inspect
 import math
 import typing
 

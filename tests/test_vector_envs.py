@@ -28,7 +28,7 @@ def _run(env_id: str, mode: str) -> None:
         obs, info = envs.reset(seed=SEEDS)
         assert obs.shape == (2, *envs.single_observation_space.shape) and np.all(np.isfinite(obs))
         for _ in range(3):
-            obs, reward, terminated, truncated, info = envs.step(np.zeros((2, *envs.single_action_space.shape),
+            obs, reward, _, _, info = envs.step(np.zeros((2, *envs.single_action_space.shape),
                                                                           np.float32))
             assert np.all(np.isfinite(obs)) and reward.shape == (2,)
             assert info["time"].shape == (2,)

@@ -134,7 +134,7 @@ def _probe(policy, agent: str, env, env_id: str, seed: int) -> None:
         action = np.asarray(action, dtype=float)
         if action.shape != env.action_space.shape:
             raise ValueError(f"its action has shape {action.shape}, the env takes {env.action_space.shape}")
-    except Exception as exc:  # noqa: BLE001  (whatever the agent raises becomes the one-line refusal)
+    except Exception as exc:  # whatever the agent raises becomes the one-line refusal
         from visuomotor_gym.registration import family_of
 
         raise ValueError(f"agent {agent!r} cannot act on {env_id} ({family_of(env_id)} family): "

@@ -48,6 +48,7 @@ resolved at 500 Hz; ``record=True`` keeps that substep trace for tests and plots
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections import deque
 from dataclasses import dataclass
@@ -73,7 +74,7 @@ def _gain_points(value, name: str) -> tuple[tuple[float, float], ...]:
         raise ValueError(f"{name} must be {allowed}, got {value!r}") from None
     if not (1 <= len(points) <= 16
             and all(math.isfinite(s) and math.isfinite(g) and 0.0 <= s <= 1000.0 and 0.0 < g <= 1.5 for s, g in points)
-            and all(a[0] < b[0] for a, b in zip(points, points[1:]))):
+            and all(a[0] < b[0] for a, b in itertools.pairwise(points))):
         raise ValueError(f"{name} must be {allowed}, got {value!r}")
     return points
 
