@@ -24,6 +24,7 @@ LAYERS = {
     "visuomotor_gym.scenarios": 0,
     "visuomotor_gym.handpath": 0,
     "visuomotor_gym._native": 0,  # the optional compiled kernels: import nothing of the package
+    "visuomotor_gym.core.args": 0,  # argument and parameter-field checks: import nothing of the package
     "visuomotor_gym.core": 1,
     "visuomotor_gym.body": 2,
     "visuomotor_gym.tasks": 3,

@@ -266,7 +266,7 @@ def test_reset_with_empty_or_no_options_is_fine(env):
         ({"bounce_wall": 1}, TypeError, r"bounce_wall must be True or False"),
         ({"record_plant": "yes"}, TypeError, r"record_plant must be True or False"),
         ({"throw_distribution": {"second_max_flight_s": 0.0}, "n_balls": 2}, ValueError, r"second_max_flight_s"),
-        ({"throw_distribution": {"second_stagger_s": (-0.1, 0.2)}}, ValueError, r"second_stagger_s must be positive"),
+        ({"throw_distribution": {"second_stagger_s": (-0.1, 0.2)}}, ValueError, r"throw_distribution.second_stagger_s must hold finite numbers in \(0, 5\]"),
         ({"width": -1}, ValueError, r"width must be an integer in \[1, 8192\]"),
         ({"height": 2.5}, TypeError, r"height must be an integer"),
         ({"catch_radius": 0.0}, ValueError, r"catch_radius must be in \(0, 0.5\]"),

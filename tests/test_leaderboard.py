@@ -487,7 +487,7 @@ def test_submit_writes_entries_that_pass_and_refuses_to_overwrite(tmp_path, caps
                 "--no-progress",
             ]
         )
-        == 1
+        == 2
     )
     assert "entries are immutable" in capsys.readouterr().err
     assert (

@@ -94,7 +94,7 @@ def test_ppo_entry_is_submitted_and_rescored_from_its_packed_file(tiny_run, tmp_
 
 def test_run_folders_are_never_overwritten(tmp_path):
     (tmp_path / "EyeCatchOracle-v0" / "same").mkdir(parents=True)
-    with pytest.raises(SystemExit, match="already exists"):
+    with pytest.raises(train.TrainArgumentError, match="already exists"):
         train.main(["--env", "EyeCatchOracle-v0", "--out", str(tmp_path), "--run-name", "same", "--timesteps", "10"])
 
 
@@ -104,7 +104,7 @@ def test_hyperparameters_resolve_default_then_env_then_overrides():
     assert config["belief"] is True and config["intercept_shaping"] == 0.5
     assert config["learning_rate"] == 1e-4  # override
     assert config["n_envs"] == 8  # default
-    with pytest.raises(SystemExit, match="key=value"):
+    with pytest.raises(train.TrainArgumentError, match="key=value"):
         train.load_config(train.parse_args(["--set", "not_a_key=1"]))
 
 

@@ -152,8 +152,43 @@ def _parse_value(text: str) -> Any:
     return text
 
 
+# The env families (visuomotor_gym.registration.FAMILIES) each agent is built for; an agent not listed
+# plays every family (random, zero; ppo: its policy file says what it was trained on; gaze_blind: its
+# base agent's families).
+AGENT_FAMILIES: dict[str, tuple[str, ...]] = {
+    "eyecatch": ("catch",),
+    "fixed_gaze": ("catch",),
+    "oracle": ("catch",),
+    "belief_intercept": ("catch",),
+    "belief_mpc": ("catch", "stones", "dodge"),
+    "iwao": ("walk",),
+    "faraway": ("reach",),
+    "fajen_warren": ("dodge",),
+    "lookahead": ("stones",),
+}
+
+
+def check_agent_family(spec: str, env_id: str) -> None:
+    """ValueError (one line naming the agent and the env's family) if ``spec``'s agent is not built for
+    ``env_id``'s family; an unknown agent or env id raises as :func:`parse_agent_spec` /
+    :func:`~visuomotor_gym.registration.family_of` do."""
+    from visuomotor_gym.registration import FAMILIES, family_of
+
+    name, overrides = parse_agent_spec(spec)
+    if name in _WRAPPERS:
+        return check_agent_family(overrides["base"], env_id)
+    families = AGENT_FAMILIES.get(name)
+    family = family_of(env_id)
+    if families is not None and family not in families:
+        ids = ", ".join(min(FAMILIES[f], key=len) for f in families if FAMILIES.get(f))
+        names = families[0] if len(families) == 1 else f"{', '.join(families[:-1])} and {families[-1]}"
+        raise ValueError(f"agent {name!r} plays the {names} famil{'ies' if len(families) > 1 else 'y'} "
+                         f"(e.g. {ids}), not {env_id}'s {family} family")
+
+
 def make_agent(spec: str, env_id: str, action_dim: int, seed: int = 0) -> Policy:
-    """Build the agent named by ``spec`` for ``env_id``."""
+    """Build the agent named by ``spec`` for ``env_id`` (refused if it is not built for the env's family)."""
+    check_agent_family(spec, env_id)
     name, overrides = parse_agent_spec(spec)
     factory = _REGISTRY[name][0]
     return factory(env_id=env_id, action_dim=action_dim, seed=seed, **overrides)

@@ -17,6 +17,41 @@ import sys
 from pathlib import Path
 
 
+# Bounds of the counts every subcommand takes, checked before any work or allocation (modelling choices:
+# 500 x the leaderboard protocol's 200 episodes; 256 worker processes; seeds of 31 bits, as every
+# seeding API takes them). ``--episodes 10**12`` allocated its seed list until the OS killed it.
+MAX_EPISODES = 100_000
+MAX_WORKERS = 256
+MAX_SEED = 2**31 - 1
+
+
+def argument_problem(args: argparse.Namespace) -> str | None:
+    """One line saying what is wrong with the parsed arguments any subcommand shares (counts, seed,
+    workers, the env id and whether the agent plays its family), or None. Imports nothing heavy unless
+    an agent is named."""
+    for name, low, high in (("episodes", 1, MAX_EPISODES), ("workers", 1, MAX_WORKERS), ("seed", 0, MAX_SEED)):
+        value = getattr(args, name, None)
+        if value is not None and not low <= value <= high:
+            return f"--{name} must be in [{low}, {high}], got {value}"
+    episodes, seed = getattr(args, "episodes", None), getattr(args, "seed", None)
+    if episodes is not None and seed is not None and seed + episodes - 1 > MAX_SEED:
+        return f"--seed {seed} + --episodes {episodes} runs past the largest seed, {MAX_SEED}"
+    agent, env = getattr(args, "agent", None), getattr(args, "env", None)
+    envs = [env] if isinstance(env, str) else list(env or [])
+    envs = [e for e in envs if e != "all"]  # leaderboard submit --env all: the protocol's ids
+    if agent is not None and envs:
+        from visuomotor_gym.agents import check_agent_family
+        from visuomotor_gym.registration import ENV_IDS
+
+        try:  # an unknown env id is the subcommand's to refuse (bench: the known ids; submit: the protocol's)
+            for env_id in envs:
+                if env_id.removeprefix("visuomotor_gym:") in ENV_IDS:
+                    check_agent_family(agent, env_id.removeprefix("visuomotor_gym:"))
+        except (ValueError, TypeError) as exc:
+            return str(exc)
+    return None
+
+
 def _cmd_envs(args: argparse.Namespace) -> int:
     from visuomotor_gym.registration import ENV_SPECS
 
@@ -44,6 +79,13 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     from visuomotor_gym.viz.plots import plot_episode
     from visuomotor_gym.viz.video import record_episode
 
+    from visuomotor_gym.bench.evaluate import validate_inputs
+
+    try:  # the agent and the env before anything is written or run
+        validate_inputs(args.agent, args.env, args.episodes, args.seed)
+    except (ValueError, TypeError) as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
     out = Path(args.out)
     try:
         out.mkdir(parents=True, exist_ok=True)
@@ -71,10 +113,16 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 
 
 def _cmd_train(args: argparse.Namespace) -> int:
-    """Forward to the PPO training script (its own flags; ``vmgym train ppo --help``)."""
+    """Forward to the PPO training script (its own flags; ``vmgym train ppo --help``); a refused argument
+    is one line and status 2, before anything is written or trained."""
+    from visuomotor_gym.baselines.ppo.train import TrainArgumentError
     from visuomotor_gym.baselines.ppo.train import main as train_ppo
 
-    train_ppo(args.train_args)
+    try:
+        train_ppo(args.train_args)
+    except TrainArgumentError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
     return 0
 
 
@@ -110,11 +158,15 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Run one subcommand. Status 0: done; 2: an argument refused (one line on stderr, before any work:
+    argparse's own errors, the checks of :func:`argument_problem` and each subcommand's); 1: the work
+    failed (results invalid, a leaderboard rule broken); 130: interrupted."""
     args = build_parser().parse_args(argv)
-    if getattr(args, "episodes", 1) < 1:
-        print("--episodes must be >= 1", file=sys.stderr)
-        return 2
     try:
+        problem = argument_problem(args)
+        if problem:
+            print(f"error: {problem}", file=sys.stderr)
+            return 2
         return int(args.func(args) or 0)
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)

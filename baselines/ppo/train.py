@@ -31,6 +31,21 @@ import numpy as np
 import yaml
 
 
+class TrainArgumentError(ValueError):
+    """A refused argument of the training script: one line, raised before anything is written or trained
+    (``vmgym train ppo`` prints it and exits with status 2, as ``python -m`` does)."""
+
+
+# Bounds of the numeric flags (modelling choices: 10**10 transitions is years of CPU time; a week of
+# minutes; seeds of 31 bits; 256 training envs).
+MAX_TIMESTEPS = 10**10
+MAX_MINUTES = 7 * 24 * 60.0
+MAX_SEED = 2**31 - 1
+MAX_N_ENVS = 256
+CHOICES = {"belief": ("", "yes", "no", "true", "false", "1", "0"), "hand_action": ("", "absolute", "intercept"),
+           "gaze_action": ("", "free", "gated", "frozen")}
+
+
 @dataclass
 class Args:
     """Command-line arguments (each field is a flag: ``--env``, ``--timesteps`` ...)."""
@@ -99,10 +114,65 @@ def parse_args(argv=None) -> Args:
     return Args(**vars(parser.parse_args(argv)))
 
 
+def check_args(args: Args) -> None:
+    """Refuse a bad flag (:class:`TrainArgumentError`, one line) before any work: the env id registered,
+    counts inside their bounds, choices among theirs, the hyperparameter file readable, the run folder
+    new and its parent writable."""
+    import tempfile
+
+    from visuomotor_gym.bench.evaluate import check_env_id
+
+    try:
+        check_env_id(args.env)
+    except (ValueError, TypeError) as exc:
+        raise TrainArgumentError(f"--env: {exc}") from None
+    for name, low, high in (("timesteps", 1, MAX_TIMESTEPS), ("seed", 0, MAX_SEED)):
+        value = getattr(args, name)
+        if not low <= value <= high:
+            raise TrainArgumentError(f"--{name} must be in [{low}, {high}], got {value}")
+    if not 0.0 <= args.minutes <= MAX_MINUTES:  # NaN fails too
+        raise TrainArgumentError(f"--minutes must be in [0, {MAX_MINUTES:g}] (0: no limit), got {args.minutes}")
+    for name, allowed in CHOICES.items():
+        value = getattr(args, name)
+        if (value.lower() if name == "belief" else value) not in allowed:
+            raise TrainArgumentError(f"--{name.replace('_', '-')} must be one of {[a for a in allowed if a]}, "
+                                     f"got {value!r}")
+    if args.hyperparams and not Path(args.hyperparams).is_file():
+        raise TrainArgumentError(f"--hyperparams {args.hyperparams} is not a file")
+    if "/" in args.run_name or args.run_name in (".", ".."):
+        raise TrainArgumentError(f"--run-name must be a folder name, not a path: {args.run_name!r}")
+    run_dir = Path(args.out) / args.env / (args.run_name or "x")
+    if args.run_name and run_dir.exists():
+        raise TrainArgumentError(f"{run_dir} already exists: pick another --run-name (runs are never overwritten)")
+    for ancestor in [run_dir.parent, *run_dir.parent.parents]:
+        if ancestor.exists():
+            if not ancestor.is_dir():
+                raise TrainArgumentError(f"--out {args.out}: {ancestor} is a file, not a folder")
+            try:  # proven by a folder made and removed there (/proc passes os.access for root)
+                with tempfile.TemporaryDirectory(dir=ancestor, prefix=".vmgym-probe-"):
+                    pass
+            except OSError as exc:
+                raise TrainArgumentError(f"--out {args.out}: cannot write in {ancestor} ({exc.strerror or exc})") from None
+            break
+
+
+def _check_config(config: dict) -> None:
+    n_envs = config.get("n_envs")
+    if isinstance(n_envs, bool) or not isinstance(n_envs, int) or not 1 <= n_envs <= MAX_N_ENVS:
+        raise TrainArgumentError(f"n_envs must be an integer in [1, {MAX_N_ENVS}], got {n_envs!r}")
+    if config.get("algo") not in ("PPO", "RecurrentPPO"):
+        raise TrainArgumentError(f"algo must be PPO or RecurrentPPO, got {config.get('algo')!r}")
+
+
 def load_config(args: Args) -> dict:
     """Hyperparameters: ``default``, then the env id's entry, then ``--set`` overrides."""
     if args.hyperparams:
-        table = yaml.safe_load(Path(args.hyperparams).read_text())
+        try:
+            table = yaml.safe_load(Path(args.hyperparams).read_text())
+        except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
+            raise TrainArgumentError(f"--hyperparams {args.hyperparams}: cannot read it ({exc})".replace("\n", " "))
+        if not isinstance(table, dict) or not isinstance(table.get("default"), dict):
+            raise TrainArgumentError(f"--hyperparams {args.hyperparams}: a YAML mapping with a 'default' entry expected")
     else:
         table = yaml.safe_load(resources.files("visuomotor_gym.baselines.ppo").joinpath("hyperparams.yml").read_text())
     config = copy.deepcopy(table["default"])
@@ -116,7 +186,7 @@ def load_config(args: Args) -> dict:
     for item in args.set:
         key, eq, value = item.partition("=")
         if not eq or key not in config:
-            raise SystemExit(f"--set {item!r}: expected key=value with key in {sorted(config)}")
+            raise TrainArgumentError(f"--set {item!r}: expected key=value with key in {sorted(config)}")
         parsed = yaml.safe_load(value)
         if isinstance(parsed, str):  # YAML 1.1 reads "1e-4" as a string
             try:
@@ -137,13 +207,13 @@ def load_config(args: Args) -> dict:
     config.setdefault("gaze_action", "free")
     config.setdefault("gaze_residual_deg", 3.0)
     if config["gaze_action"] not in ("free", "gated", "frozen"):
-        raise SystemExit(f"gaze_action must be 'free', 'gated' or 'frozen', got {config['gaze_action']!r}")
+        raise TrainArgumentError(f"gaze_action must be 'free', 'gated' or 'frozen', got {config['gaze_action']!r}")
     if config["gaze_action"] != "free" and config["hand_action"] != "intercept":
-        raise SystemExit(f"gaze_action={config['gaze_action']} needs hand_action=intercept (and the belief features)")
+        raise TrainArgumentError(f"gaze_action={config['gaze_action']} needs hand_action=intercept (and the belief features)")
     if config["hand_action"] not in ("absolute", "intercept"):
-        raise SystemExit(f"hand_action must be 'absolute' or 'intercept', got {config['hand_action']!r}")
+        raise TrainArgumentError(f"hand_action must be 'absolute' or 'intercept', got {config['hand_action']!r}")
     if config["hand_action"] == "intercept" and not config["belief"]:
-        raise SystemExit("hand_action=intercept needs the belief features (belief: true): the residual is "
+        raise TrainArgumentError("hand_action=intercept needs the belief features (belief: true): the residual is "
                          "relative to the belief's interception point")
     return config
 
@@ -219,8 +289,11 @@ def run_meta(model, train_env, config: dict, args: Args, wall_s: float) -> dict:
 
 
 def main(argv=None) -> Path:
+    """Train; a refused flag raises :class:`TrainArgumentError` before anything is written."""
     args = parse_args(argv)
+    check_args(args)
     config = load_config(args)
+    _check_config(config)
 
     import torch
     from stable_baselines3 import PPO
@@ -323,4 +396,8 @@ def main(argv=None) -> Path:
 
 
 if __name__ == "__main__":
-    main()
+    try:
+        main()
+    except TrainArgumentError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        sys.exit(2)

@@ -217,7 +217,8 @@ def _refuse_existing(paths: list[Path | None], force: bool) -> str | None:
 
 
 def main_bench(args: argparse.Namespace) -> int:
-    """Run ``vmgym bench``; returns the exit status (0 ok, 1 results invalid/exist, 2 bad arguments)."""
+    """Run ``vmgym bench``; returns the exit status (0 ok, 1 results invalid or not written after the run, 2 an
+    argument refused before it: bad values, an output that exists without ``--force``)."""
     from visuomotor_gym.bench.evaluate import evaluate, validate_inputs
     from visuomotor_gym.bench.results import ResultsError, build_results, write_results
     from visuomotor_gym.bench.trace import save_traces
@@ -235,7 +236,7 @@ def main_bench(args: argparse.Namespace) -> int:
     refusal = _refuse_existing([out, traces_path], args.force)  # before spending time on the run
     if refusal:
         print(f"error: {refusal}", file=sys.stderr)
-        return 1
+        return 2
     try:
         validate_inputs(args.agent, args.env, args.episodes, args.seed, args.workers)
         if args.address is not None and args.backend != "ray":

@@ -110,12 +110,35 @@ def validate_inputs(agent: str, env_id: str, episodes: int, seed: int, workers: 
     _check_int("workers", workers, 1)
     env = make_env(env_id)
     try:
-        make_agent(agent, env_id, action_dim=int(env.action_space.shape[0]), seed=seed)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"cannot build agent {agent!r} for {env_id}: {exc}") from exc
+        try:
+            policy = make_agent(agent, env_id, action_dim=int(env.action_space.shape[0]), seed=seed)
+        except (TypeError, ValueError) as exc:
+            raise ValueError(f"cannot build agent {agent!r} for {env_id}: {exc}") from exc
+        _probe(policy, agent, env, env_id, seed)
     finally:
         env.close()
     return env_id
+
+
+def _probe(policy, agent: str, env, env_id: str, seed: int) -> None:
+    """One action on the first observation (a throwaway agent and env: the run builds its own), so that an
+    agent that cannot act on this env's observations (a policy trained on another family...) is refused
+    here, in one line, rather than in a worker's traceback."""
+    import numpy as np
+
+    obs, _ = env.reset(seed=seed)
+    try:
+        if hasattr(policy, "reset"):
+            policy.reset()
+        action, _ = policy.predict(obs, state=None, episode_start=np.ones(1, dtype=bool), deterministic=True)
+        action = np.asarray(action, dtype=float)
+        if action.shape != env.action_space.shape:
+            raise ValueError(f"its action has shape {action.shape}, the env takes {env.action_space.shape}")
+    except Exception as exc:  # whatever the agent raises becomes the one-line refusal
+        from visuomotor_gym.registration import family_of
+
+        raise ValueError(f"agent {agent!r} cannot act on {env_id} ({family_of(env_id)} family): "
+                         f"{type(exc).__name__}: {exc}".replace("\n", " ")) from exc
 
 
 def make_env(env_id: str):

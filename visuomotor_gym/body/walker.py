@@ -59,10 +59,52 @@ import mujoco
 import numpy as np
 
 from visuomotor_gym.body import walker_names as wn
+from visuomotor_gym.core import args
+from visuomotor_gym.core.args import Num, Pair
 
 DEG = math.pi / 180.0
 LEFT, RIGHT = 0, 1
 _INTEGRATION = mujoco.mjtState.mjSTATE_INTEGRATION
+
+
+# What each GaitParams field accepts (visuomotor_gym.core.args.check_fields). Modelling choices: the
+# ranges the scripted gait was built and tested for (a walker with ~0.86 m legs: 0.43 m thigh and shank,
+# envs_assets/walker_body.xml), generous around the defaults; none is sourced. The timings must also be
+# whole numbers of physics steps (WalkerGait checks that: it knows the model's timestep).
+GAIT_RULES = {
+    "step_s": Num(0.2, 2.0),
+    "double_support_s": Num(0.0, 1.0, low_open=True),
+    "heel_off_s": Num(0.0, 2.0, low_open=True),
+    "nominal_step_m": Num(0.05, 1.5),
+    "step_range_m": Pair(Num(0.05, 1.5)),
+    "lateral_range_m": Pair(Num(-0.5, 0.5)),
+    "step_width_m": Num(0.0, 0.5),
+    "min_step_width_m": Num(0.0, 0.5),
+    "nominal_clearance_m": Num(0.0, 0.6, low_open=True),
+    "clearance_range_m": Pair(Num(0.0, 0.6, low_open=True)),
+    "pelvis_height_m": Num(0.5, 1.0),
+    "bob_m": Num(0.0, 0.2),
+    "sway_m": Num(0.0, 0.2),
+    "pelvis_lead_m": Num(-0.3, 0.3),
+    "heel_strike_deg": Num(0.0, 60.0),
+    "toe_off_deg": Num(0.0, 80.0),
+    # Each phase of the swing lasts >= 5 % of it, the horizontal move >= half of it: shorter ones ask the
+    # servos for speeds the physics cannot follow (a 1e-6 move diverges at once).
+    "swing_rise": Num(0.05, 0.5),
+    "swing_fall": Num(0.5, 0.95),
+    "swing_move": Pair(Num(0.0, 1.0), min_width=0.5),
+    "arm_swing_deg": Num(0.0, 90.0),
+    "max_reach": Num(0.5, 1.0, high_open=True),
+    "max_turn_deg": Num(0.0, 90.0),
+}
+# Orders between fields: the gait's phases follow one another, the nominal footstep is a commandable one.
+GAIT_ORDER = (
+    ("double_support_s", "<", "step_s"),
+    ("min_step_width_m", "<=", "step_width_m"),
+    ("nominal_step_m", "in", "step_range_m"),
+    ("nominal_clearance_m", "in", "clearance_range_m"),
+    ("swing_rise", "<", "swing_fall"),
+)
 
 
 @dataclass(frozen=True)
@@ -122,6 +164,14 @@ class GaitParams:
     # between the two, above ALLSTEPS'
     # +-30 deg path changes (Xie et al. 2020) plus the ~10 deg the alternating feet add.
     max_turn_deg: float = 45.0
+
+    def __post_init__(self) -> None:
+        args.check_fields(self, GAIT_RULES, GAIT_ORDER)
+        mid, toe_off = 0.5 * (self.step_s + self.double_support_s), self.step_s + self.double_support_s
+        if not mid < self.heel_off_s < toe_off:  # the phases in order (WalkerGait, in physics steps)
+            raise args.ParamValueError(type(self).__name__, (
+                f"heel_off_s must lie between mid-stance, (step_s + double_support_s) / 2 = {mid:g} s, and toe-off, "
+                f"step_s + double_support_s = {toe_off:g} s; got {self.heel_off_s!r}"))
 
 
 def _smooth(s: float) -> float:

@@ -23,7 +23,20 @@ import mujoco
 import numpy as np
 
 from visuomotor_gym import _native
+from visuomotor_gym.core import args
+from visuomotor_gym.core.args import Num
 from visuomotor_gym.geometry import solve3
+
+
+# What each HandControlParams field accepts (visuomotor_gym.core.args.check_fields): non-negative, and
+# bounded by modelling choices (5x the human hand's 2 m/s, a setpoint step of at most half a turn).
+HAND_RULES = {
+    "max_speed_m_s": Num(0.0, 10.0),
+    "damping": Num(0.0, 1.0),
+    "torso_weight": Num(0.0, 10.0),
+    "posture_gain": Num(0.0, 1.0),
+    "max_joint_step_rad": Num(0.0, 3.15),
+}
 
 
 @dataclass(frozen=True)
@@ -37,10 +50,7 @@ class HandControlParams:
     max_joint_step_rad: float = 0.35  # largest setpoint change per control step
 
     def __post_init__(self) -> None:
-        for name in self.__dataclass_fields__:
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value >= 0.0):
-                raise ValueError(f"HandControlParams.{name} must be finite and >= 0, got {value!r}")
+        args.check_fields(self, HAND_RULES)
 
 
 class HandController:

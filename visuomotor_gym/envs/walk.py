@@ -119,6 +119,11 @@ class ObstacleWalkEnv(VisuomotorEnv):
     (``info["physics_diverged"]``). Truncated only by the registered ``max_episode_steps`` (2000
     steps = 40 s, three times the nominal walk of the longest course).
 
+    The reset ``info`` holds the course (true state, for scoring only): ``course_length`` and
+    ``obstacles``, an array of one row per obstacle (centre x, centre y, depth, width, height, kind)
+    padded with NaN rows to the scene's 16 obstacles, of which the first ``n_obstacles`` are the
+    course's (a fixed shape, so that ``gymnasium.make_vec`` can stack it).
+
     ## Arguments
 
     | argument | default | meaning |

@@ -164,6 +164,9 @@ def main_build(args: argparse.Namespace) -> int:
     from visuomotor_gym.leaderboard.entries import load_leaderboard
     from visuomotor_gym.leaderboard.pages import write_pages
 
+    if not Path(args.dir).is_dir():
+        _err(f"--dir {args.dir} is not a folder (the leaderboard folder holds protocol.json)")
+        return 2
     lb = load_leaderboard(args.dir)
     if lb.problems or lb.protocol is None:
         _err("the leaderboard has problems; fix them before building the pages:")
@@ -194,6 +197,16 @@ def _submit_input_problem(args: argparse.Namespace, envs: list[str], protocol) -
         return f"--name: {exc}"
     if args.from_results is not None and not Path(args.from_results).is_file():
         return f"--from-results {args.from_results} is not a file"
+    from visuomotor_gym.leaderboard.entries import RECORD_SUFFIX, RESULTS_DIR, entry_key
+
+    name = args.name if args.name is not None else default_name(args.agent)
+    for env_id in envs:  # entries are immutable: refused here rather than after the policy export
+        key = entry_key(name, env_id)
+        record = Path(args.dir) / RESULTS_DIR / f"{key}{RECORD_SUFFIX}"
+        results = Path(args.dir) / RESULTS_DIR / f"{key}.json"
+        attaching = args.from_results is not None and Path(args.from_results).resolve() == results.resolve()
+        if record.exists() or (results.exists() and not attaching):
+            return f"entry {key} exists ({results.name}): entries are immutable; submit under another --name"
     from visuomotor_gym.bench.evaluate import validate_inputs
 
     first = protocol.for_env(envs[0])

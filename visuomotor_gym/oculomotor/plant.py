@@ -48,6 +48,7 @@ resolved at 500 Hz; ``record=True`` keeps that substep trace for tests and plots
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections import deque
 from dataclasses import dataclass
@@ -55,11 +56,50 @@ from dataclasses import dataclass
 import numpy as np
 
 from visuomotor_gym import _native
+from visuomotor_gym.core import args
+from visuomotor_gym.core.args import Num, Pair
 from visuomotor_gym.geometry import angle_between, cross, unit_from_angles
 
 DEG = math.pi / 180.0
 _ZERO = (0.0, 0.0, 0.0)  # "no pursuit drive" (compared by identity in the hot loop)
 SACCADE_HISTORY = 256  # saccades kept without record=True: far more than an episode holds (<= 5 per second)
+
+
+def _gain_points(value, name: str) -> tuple[tuple[float, float], ...]:
+    """``pursuit_gain_points``: 1-16 (target deg/s, gain) pairs, speeds increasing in [0, 1000], gains in (0, 1.5]."""
+    allowed = "1-16 (deg/s, gain) pairs with increasing speeds in [0, 1000] and gains in (0, 1.5]"
+    try:
+        points = tuple((float(s), float(g)) for s, g in value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be {allowed}, got {value!r}") from None
+    if not (1 <= len(points) <= 16
+            and all(math.isfinite(s) and math.isfinite(g) and 0.0 <= s <= 1000.0 and 0.0 < g <= 1.5 for s, g in points)
+            and all(a[0] < b[0] for a, b in itertools.pairwise(points))):
+        raise ValueError(f"{name} must be {allowed}, got {value!r}")
+    return points
+
+
+# What each OculomotorParams field accepts (visuomotor_gym.core.args.check_fields). Positive rates and
+# thresholds, non-negative times; the upper bounds are modelling choices well beyond the sourced values
+# in the field comments (a 180 deg saccade threshold, 1 s of pursuit latency,
+# 3000 deg/s eye speeds); eye ranges within +-90 deg, fixation between 1 cm and 1 km.
+OCULOMOTOR_RULES = {
+    "saccade_threshold_deg": Num(0.0, 180.0, low_open=True),
+    "saccade_refractory_s": Num(0.0, 100.0),  # long ones switch saccades off (a test uses 10 s)
+    "main_sequence_intercept_s": Num(0.0, 1.0),
+    "main_sequence_slope_s_per_deg": Num(0.0, 0.1, low_open=True),
+    "saccade_peak_deg_s": Num(0.0, 3000.0, low_open=True),
+    "saccade_endpoint_noise": Num(0.0, 1.0),
+    "pursuit_max_deg_s": Num(0.0, 3000.0, low_open=True),
+    "pursuit_latency_s": Num(0.0, 1.0),
+    "pursuit_gain_points": _gain_points,
+    "pursuit_accel_max_deg_s2": Num(0.0, 1e5, low_open=True),
+    "eye_azimuth_range_deg": Pair(Num(-90.0, 90.0), strict=True),
+    "eye_elevation_range_deg": Pair(Num(-90.0, 90.0), strict=True),
+    "fixation_range_m": Pair(Num(0.01, 1000.0), strict=True),
+    "vergence_max_diopter_s": Num(0.0, 1000.0, low_open=True),
+    "head_max_deg_s": Num(0.0, 3000.0, low_open=True),
+}
 
 
 @dataclass(frozen=True)
@@ -89,36 +129,7 @@ class OculomotorParams:
     head_max_deg_s: float = 300.0  # head peak speed (4-8/s x amplitude, Eyecatch 4.2)
 
     def __post_init__(self) -> None:
-        positive = (
-            "saccade_threshold_deg",
-            "main_sequence_slope_s_per_deg",
-            "saccade_peak_deg_s",
-            "pursuit_max_deg_s",
-            "pursuit_accel_max_deg_s2",
-            "vergence_max_diopter_s",
-            "head_max_deg_s",
-        )
-        for name in positive:
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value > 0.0):
-                raise ValueError(f"OculomotorParams.{name} must be finite and > 0, got {value!r}")
-        for name in ("eye_azimuth_range_deg", "eye_elevation_range_deg", "fixation_range_m"):
-            lo, hi = getattr(self, name)
-            if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
-                raise ValueError(f"OculomotorParams.{name} must be (low, high) with low < high, got {(lo, hi)!r}")
-        if self.fixation_range_m[0] <= 0:
-            raise ValueError("OculomotorParams.fixation_range_m must be positive")
-        points = self.pursuit_gain_points
-        if not (len(points) >= 1 and all(len(q) == 2 for q in points)
-                and all(math.isfinite(s) and math.isfinite(g) and s >= 0.0 and 0.0 < g <= 1.5 for s, g in points)
-                and all(a[0] < b[0] for a, b in zip(points, points[1:]))):
-            raise ValueError("OculomotorParams.pursuit_gain_points must be (deg/s, gain) pairs with increasing "
-                             f"speeds and gains in (0, 1.5], got {points!r}")
-        for name in ("saccade_refractory_s", "main_sequence_intercept_s", "saccade_endpoint_noise",
-                     "pursuit_latency_s"):
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value >= 0.0):
-                raise ValueError(f"OculomotorParams.{name} must be finite and >= 0, got {value!r}")
+        args.check_fields(self, OCULOMOTOR_RULES)
 
     def pursuit_gain(self, target_speed_deg_s: float) -> float:
         """Steady-state pursuit gain (eye / target velocity) at a target speed (deg/s)."""

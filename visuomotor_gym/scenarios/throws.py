@@ -30,8 +30,32 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from visuomotor_gym.core import args
+from visuomotor_gym.core.args import Num, Pair
+
 GRAVITY = np.array([0.0, 0.0, -9.81])
 BALL_RADIUS = 0.025
+
+
+# What each ThrowDistribution field accepts (visuomotor_gym.core.args.check_fields): modelling choices
+# around the defaults (releases within 20 m, flights of at most 5 s, arrivals within 2 m of the seat
+# axis and 3 m up, a gaze jitter of at most 30 deg); the longest second flight must exceed the shortest
+# first one.
+THROW_RULES = {
+    "release_x_m": Pair(Num(0.5, 20.0)),
+    "release_y_m": Pair(Num(-10.0, 10.0)),
+    "release_z_m": Pair(Num(0.0, 5.0)),
+    "flight_time_s": Pair(Num(0.0, 5.0, low_open=True)),
+    "arrival_x_m": Pair(Num(-2.0, 2.0)),
+    "arrival_y_m": Pair(Num(-2.0, 2.0)),
+    "arrival_z_m": Pair(Num(0.0, 3.0)),
+    "gaze_jitter_deg": Num(0.0, 30.0),
+    "wall_clearance_m": Pair(Num(0.0, 10.0, low_open=True)),
+    "second_release_lateral_m": Pair(Num(0.0, 10.0)),
+    "second_stagger_s": Pair(Num(0.0, 5.0, low_open=True)),
+    "second_arrival_gap_s": Pair(Num(0.0, 5.0, low_open=True)),
+    "second_max_flight_s": Num(0.0, 10.0, low_open=True),
+}
 
 
 @dataclass(frozen=True)
@@ -54,23 +78,7 @@ class ThrowDistribution:
     second_max_flight_s: float = 1.6  # longer flights are released later instead
 
     def __post_init__(self) -> None:
-        for name, value in self.__dict__.items():
-            if isinstance(value, tuple):
-                ok = len(value) == 2 and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)
-                if not (ok and np.isfinite(value[0]) and np.isfinite(value[1]) and value[0] <= value[1]):
-                    raise ValueError(f"ThrowDistribution.{name} must be a finite (min, max) pair with min <= max, "
-                                     f"got {value!r}")
-            elif isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value < 0:
-                raise ValueError(f"ThrowDistribution.{name} must be a finite number >= 0, got {value!r}")
-        positive = ("flight_time_s", "second_stagger_s", "second_arrival_gap_s", "wall_clearance_m")
-        for name in positive:
-            if getattr(self, name)[0] <= 0:
-                raise ValueError(f"ThrowDistribution.{name} must be positive, got {getattr(self, name)!r}")
-        if self.second_max_flight_s <= self.flight_time_s[0]:
-            raise ValueError(
-                f"ThrowDistribution.second_max_flight_s must exceed the shortest flight time "
-                f"{self.flight_time_s[0]} s, got {self.second_max_flight_s!r}"
-            )
+        args.check_fields(self, THROW_RULES, (("flight_time_s[0]", "<", "second_max_flight_s"),))
 
 
 @dataclass(frozen=True)

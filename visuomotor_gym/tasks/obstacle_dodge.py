@@ -39,6 +39,8 @@ import mujoco
 import numpy as np
 
 from visuomotor_gym.body import walker_names as wn
+from visuomotor_gym.core import args
+from visuomotor_gym.core.args import Num, Pair
 from visuomotor_gym.core.observation import Block
 from visuomotor_gym.core.retina import VisualTarget
 
@@ -51,6 +53,26 @@ NOMINAL_SPEED = 1.3  # m/s, the walker's nominal gait (visuomotor_gym.body.walke
 PARK = (-30.0, 30.0, -5.0)
 REWARD_TERMS = ("goal", "collision", "progress")
 DEFAULT_REWARD_WEIGHTS = {"goal": 1.0, "collision": -1.0, "progress": 0.0}
+
+
+# What each CrowdDistribution field accepts (visuomotor_gym.core.args.check_fields): modelling choices
+# around the defaults (positive walking speeds up to a sprint, crossing directions short of parallel to
+# the path, a probability in [0, 1], times and distances of one 200 m walk at most).
+CROWD_RULES = {
+    "goal_m": Pair(Num(1.0, 200.0)),
+    "first_onset_s": Pair(Num(0.0, 120.0)),
+    "onset_gap_s": Pair(Num(0.0, 120.0)),
+    "side_m": Pair(Num(0.0, 50.0, low_open=True)),
+    "speed_m_s": Pair(Num(0.0, 5.0, low_open=True)),
+    "angle_deg": Num(0.0, 80.0),
+    "timing_s": Num(0.0, 20.0),
+    "veer_p": Num(0.0, 1.0),
+    "veer_timing_s": Pair(Num(0.0, 20.0)),
+    "veer_distance_m": Pair(Num(0.0, 50.0)),
+    "veer_s": Num(0.0, 20.0),
+    "min_crossing_m": Num(0.0, 200.0),
+    "goal_clear_m": Num(0.0, 200.0),
+}
 
 
 @dataclass(frozen=True)
@@ -70,6 +92,9 @@ class CrowdDistribution:
     veer_s: float = 1.0  # Jovancevic, Sullivan & Hayhoe: the veer lasted ~1 s
     min_crossing_m: float = 3.0  # crossing points between this far from the start ...
     goal_clear_m: float = 1.0  # ... and this far before the goal
+
+    def __post_init__(self) -> None:
+        args.check_fields(self, CROWD_RULES)
 
 
 @dataclass(frozen=True)

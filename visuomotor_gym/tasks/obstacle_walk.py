@@ -39,6 +39,8 @@ import mujoco
 import numpy as np
 
 from visuomotor_gym.body import walker_names as wn
+from visuomotor_gym.core import args
+from visuomotor_gym.core.args import Num, Pair, Weights
 from visuomotor_gym.core.observation import Block
 from visuomotor_gym.core.retina import PointTarget
 
@@ -52,6 +54,27 @@ BAR, BOX, MAT = 0, 1, 2
 REWARD_TERMS = ("finish", "trip", "misstep", "off_path", "progress")
 DEFAULT_REWARD_WEIGHTS = {"finish": 1.0, "trip": -1.0, "misstep": -1.0, "off_path": -1.0, "progress": 0.0}
 OBSTACLE_RGBA = {BAR: (0.80, 0.25, 0.20, 1.0), BOX: (0.85, 0.55, 0.15, 1.0), MAT: (0.08, 0.08, 0.08, 1.0)}
+
+
+# What each CourseDistribution field accepts (visuomotor_gym.core.args.check_fields): modelling choices,
+# generous around the defaults (a course a walker can be put on: positive sizes, obstacles at most 1 m
+# high, offsets within 2 m of the path's centre line).
+COURSE_RULES = {
+    "length_m": Pair(Num(1.0, 200.0)),
+    "first_m": Pair(Num(0.0, 200.0)),
+    "gap_m": Pair(Num(0.0, 50.0)),
+    "finish_clear_m": Num(0.0, 200.0),
+    "kind_p": Weights(3),
+    "height_m": Pair(Num(0.0, 1.0, low_open=True)),
+    "walkway_width_m": Num(0.0, 100.0, low_open=True),  # a test lifts the walkway with 40 m
+    "bar_depth_m": Num(0.0, 2.0, low_open=True),
+    "box_depth_m": Pair(Num(0.0, 2.0, low_open=True)),
+    "box_width_m": Pair(Num(0.0, 5.0, low_open=True)),
+    "mat_size_m": Num(0.0, 5.0, low_open=True),
+    "mat_height_m": Num(0.0, 0.1, low_open=True),
+    "offset_m": Pair(Num(-2.0, 2.0)),
+    "mat_offset_m": Pair(Num(-2.0, 2.0)),
+}
 
 
 @dataclass(frozen=True)
@@ -72,6 +95,9 @@ class CourseDistribution:
     mat_height_m: float = 0.01
     offset_m: tuple[float, float] = (-0.15, 0.15)  # boxes: centre beside the path's centre line
     mat_offset_m: tuple[float, float] = (-0.3, 0.3)
+
+    def __post_init__(self) -> None:
+        args.check_fields(self, COURSE_RULES)
 
 
 @dataclass(frozen=True)
@@ -190,7 +216,13 @@ class ObstacleWalkTask:
         return distance
 
     def reset_info(self) -> dict:
-        return {"course_length": self.course.length, "obstacles": self.course.obstacles.copy()}
+        """The course (true state, scoring only). Fixed shapes whatever the seed, so that Gymnasium's vector
+        envs can stack it: ``obstacles`` is (pool size, 6), its first ``n_obstacles`` rows the course's
+        obstacles (:attr:`Course.obstacles`), the rest NaN."""
+        obstacles = self.course.obstacles
+        padded = np.full((len(self.pool), obstacles.shape[1]), np.nan)
+        padded[: len(obstacles)] = obstacles
+        return {"course_length": float(self.course.length), "obstacles": padded, "n_obstacles": len(obstacles)}
 
     # --- what the evaluator records ----------------------------------------------------------
     def trace_episode_fields(self) -> dict:

@@ -21,11 +21,26 @@ import numpy as np
 
 from visuomotor_gym.body import reach_names
 from visuomotor_gym.body.reach_body import home_hand_position
+from visuomotor_gym.core import args
+from visuomotor_gym.core.args import Many, Num, Pair
 from visuomotor_gym.core.observation import Block
 from visuomotor_gym.core.retina import VisualTarget
 from visuomotor_gym.vision import foveation
 
 DEG = math.pi / 180.0
+
+
+# What each ShelfLayout field accepts (visuomotor_gym.core.args.check_fields): modelling choices around the
+# layout of envs_assets/reach.xml (azimuths within a turn, targets within the seated reach's 1.5 m).
+SHELF_RULES = {
+    "tower_azimuth_deg": Many(3, Num(-180.0, 180.0)),
+    "depth_m": Pair(Num(0.1, 1.5), strict=True),
+    "level0_z_m": Num(0.0, 2.0),
+    "level_step_m": Num(0.0, 0.5, low_open=True),
+    "object_radius_m": Num(0.0, 0.2, low_open=True),
+    "object_half_height_m": Num(0.0, 0.3, low_open=True),
+    "panel_gap_m": Num(0.0, 1.0),
+}
 
 
 @dataclass(frozen=True)
@@ -49,6 +64,9 @@ class ShelfLayout:
     # Back panel of each tower, this far behind the far depth (modelling choice: ~7 cm of room for the palm,
     # which extends 5 cm past the catch site along the forearm).
     panel_gap_m: float = 0.12
+
+    def __post_init__(self) -> None:
+        args.check_fields(self, SHELF_RULES)
 
     def targets(self) -> np.ndarray:
         """(30, 3) object-centre positions, in the order tower, level, depth (near first)."""

@@ -40,6 +40,8 @@ import mujoco
 import numpy as np
 
 from visuomotor_gym.body import walker_names as wn
+from visuomotor_gym.core import args
+from visuomotor_gym.core.args import Int, Num, Pair
 from visuomotor_gym.core.observation import Block
 from visuomotor_gym.core.retina import PointTarget
 
@@ -60,6 +62,22 @@ LAST_STONE_RGBA = (0.20, 0.65, 0.30, 1.0)
 STONE_RGBA = (0.62, 0.60, 0.55, 1.0)
 
 
+# What each CourseDistribution field accepts (visuomotor_gym.core.args.check_fields): modelling choices
+# around the defaults; ``n_stones`` is bounded by the stones of the scene (STONE_POOL), turns stay short
+# of 90 deg. Whether the gait can step from stone to stone at all is checked with the gait's parameters
+# (check_steppable).
+STONES_RULES = {
+    "n_stones": Int(1, STONE_POOL),
+    "spacing_m": Pair(Num(0.1, 2.0)),
+    "heading_change_deg": Num(0.0, 89.0),
+    "max_heading_deg": Num(0.0, 89.0),
+    "lateral_slack_m": Num(0.0, 0.3),
+    "turn_slack_deg": Num(0.0, 45.0),
+    "start_foot_x_m": Num(0.0, 10.0),
+    "start_foot_y_m": Num(-1.0, 1.0),
+}
+
+
 @dataclass(frozen=True)
 class CourseDistribution:
     """The course sampler's parameters (metres, degrees; uniform draws). Sources in the module docstring."""
@@ -74,6 +92,9 @@ class CourseDistribution:
     turn_slack_deg: float = 5.0  # modelling choice: a steppable course needs turns 5 deg short of the gait's limit
     start_foot_x_m: float = 1.95 + FOOT_CENTRE_AHEAD_M  # nominal foot centre of the last foothold on the slab
     start_foot_y_m: float = -0.06  # ... (the right foot, half the 0.12 m nominal step width to the right)
+
+    def __post_init__(self) -> None:
+        args.check_fields(self, STONES_RULES)
 
 
 @dataclass(frozen=True)
@@ -120,6 +141,16 @@ def sample_course(rng: np.random.Generator, dist: CourseDistribution, lateral_ra
     return Course(np.array(rows, dtype=float).reshape(-1, 2), np.array(heads, dtype=float))
 
 
+def check_steppable(dist: CourseDistribution, gait) -> None:
+    """Refuse a course distribution the gait (``GaitParams``) cannot step: the shortest spacing must exceed
+    the widest step width it allows (:func:`sample_course` takes ``asin(width / spacing)``)."""
+    w_hi = gait.step_width_m + gait.lateral_range_m[1] - dist.lateral_slack_m
+    if not dist.spacing_m[0] > w_hi:
+        raise ValueError(f"course_distribution.spacing_m must start above the widest step the gait allows "
+                         f"(gait_params.step_width_m + lateral_range_m[1] - course_distribution.lateral_slack_m "
+                         f"= {w_hi:g} m); got {dist.spacing_m!r}")
+
+
 def stone_block(k: int) -> Block:
     return Block(f"stone_{k}", 5, "-, m, 0/1",
                  f"slot {k}: course index of the stone ({k} after the first one not yet stepped on); perceived "
@@ -150,8 +181,7 @@ class SteppingStonesTask:
         self.gait = body.gait
         self.gait._ob_geom = {}  # no obstacle pool in this scene: the gait's trip checks see nothing
         self.dist = course_distribution
-        if not 1 <= self.dist.n_stones <= STONE_POOL:
-            raise ValueError(f"course_distribution.n_stones must be in [1, {STONE_POOL}], got {self.dist.n_stones}")
+        check_steppable(self.dist, self.gait.p)
         self.reward_weights = reward_weights
         self.geoms = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, n) for n in STONE_NAMES]
         self.mocap = [int(m.body_mocapid[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, n)]) for n in STONE_NAMES]

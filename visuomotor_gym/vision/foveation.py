@@ -44,8 +44,29 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from visuomotor_gym.core import args
+from visuomotor_gym.core.args import Flag, Num
+
 ARCMIN = math.pi / (180.0 * 60.0)
 DEG = math.pi / 180.0
+
+
+# What each VisionParams field accepts (visuomotor_gym.core.args.check_fields; a field not listed here
+# gets the check its default's type implies: a finite number, a real boolean). The upper bounds are
+# modelling choices far beyond any sourced value (10 deg of lateral std at the fovea; the noise scale
+# 1000 x the env's own 1000 x multiplier); position_slip_knee_deg_s = inf is the paper's static acuity.
+VISION_RULES = {
+    "retinal_position_std_arcmin": Num(0.0, 600.0),
+    "retinal_velocity_weber": Num(0.0, 10.0),
+    "retinal_velocity_floor_deg_s": Num(0.0, 100.0),
+    "depth_std_fraction": Num(0.0, 10.0),
+    "depth_rate_std_fraction": Num(0.0, 10.0),
+    "fovea_e2_deg": Num(0.0, 180.0, low_open=True),
+    "field_of_view_deg": Num(0.0, 180.0, low_open=True),
+    "position_slip_knee_deg_s": Num(0.0, 1000.0, low_open=True, inf_ok=True),
+    "noise_scale": Num(0.0, 1e6),
+    "foveated": Flag(),
+}
 
 
 @dataclass(frozen=True)
@@ -69,6 +90,7 @@ class VisionParams:
     foveated: bool = True  # False: foveal acuity everywhere, no field-of-view limit (FullView)
 
     def __post_init__(self) -> None:
+        args.check_fields(self, VISION_RULES)  # every field, those added later included
         for name in (
             "retinal_position_std_arcmin",
             "retinal_velocity_weber",
