@@ -112,53 +112,60 @@ def _groups(dirs, kinds=None, objects=None, params=CROWD):
     return periphery.crowding_groups(dirs, eccs, kinds or ["k"] * n, objects or [str(i) for i in range(n)], params)
 
 
+def _sep_deg(u, v) -> float:
+    return math.degrees(math.acos(max(-1.0, min(1.0, sum(a * b for a, b in zip(u, v))))))
+
+
 def test_crowding_pools_exactly_the_flankers_within_the_critical_spacing():
-    # target 10 deg left: critical spacing 5 deg; flankers 4.9 deg further left (in) and 5.1 deg up (out)
-    target = unit(10.0, 0.0)
-    inside = unit(14.9, 0.0)
-    outside_up = at_ecc(0.0, 0.0)  # placeholder, replaced below
-    # a point 5.1 deg from the target along the vertical through it: elevation 5.1 at azimuth 10 is not
-    # exactly 5.1 deg away; find it by hand with the spherical law of cosines instead
-    el = 5.1
-    outside_up = unit(10.0, el)
-    sep_in = math.degrees(math.acos(sum(a * b for a, b in zip(target, inside))))
-    sep_out = math.degrees(math.acos(sum(a * b for a, b in zip(target, outside_up))))
-    assert sep_in == pytest.approx(4.9, abs=1e-9) and 5.0 < sep_out < 5.2
-    g = _groups([target, inside, outside_up])
-    assert g[0] == [0, 1]  # the near flanker, not the far one
-    # the inside flanker (14.9 deg, spacing 7.45 deg) is crowded by the target, and the far one
-    # (5.1 deg up, eccentricity ~11.3 deg: spacing ~5.6) by the target too, not by the 14.9-deg flanker
-    sep_12 = math.degrees(math.acos(sum(a * b for a, b in zip(inside, outside_up))))
-    assert g[1] == ([0, 1, 2] if sep_12 < 0.5 * math.degrees(math.acos(inside[0])) else [0, 1])
-    assert g[2] == [0, 2]
+    # target 10 deg left: critical spacing 5 deg; a flanker 4.9 deg further left (in), one 5.1 deg above
+    # the target's direction (5.1 deg of elevation at azimuth 10: ~5.1 deg away, out)
+    target, inside, above = unit(10.0, 0.0), unit(14.9, 0.0), unit(10.0, 5.1)
+    assert _sep_deg(target, inside) == pytest.approx(4.9, abs=1e-9)
+    assert 5.0 < _sep_deg(target, above) < 5.2
+    g = _groups([target, inside, above])
+    assert g[0] == [[0], [1]]  # the near flanker, not the far one
+    # the 14.9-deg flanker (spacing 7.45) is crowded by the target; by the 'above' one if closer than 7.45
+    assert g[1] == ([[1], [0], [2]] if _sep_deg(inside, above) < 0.5 * 14.9 else [[1], [0]])
+    # 'above' (eccentricity ~11.2 deg, spacing ~5.6) is crowded by the target (5.1 deg) only
+    assert math.degrees(math.acos(above[0])) * 0.5 < _sep_deg(above, inside)
+    assert g[2] == [[2], [0]]
 
 
 def test_a_flanker_just_outside_the_critical_spacing_leaves_the_target_untouched():
     for sep, crowded in ((2.999, True), (3.001, False)):  # target at 6 deg: spacing 3 deg
         g = _groups([unit(6.0, 0.0), unit(6.0 + sep, 0.0)])
-        assert (g[0] == [0, 1]) is crowded
-        assert g[0] in ([0], [0, 1])
+        assert g[0] == ([[0], [1]] if crowded else [[0]])
 
 
 def test_crowding_is_asymmetric_and_spares_the_fovea_other_kinds_and_the_same_object():
     # the 4-deg target (spacing 2) is crowded by a flanker 1.5 deg nearer the fovea (2.5 deg: spacing 1.25),
     # which the target does not crowd
-    g = _groups([unit(4.0, 0.0), unit(2.5, 0.0)])
-    assert g == [[0, 1], [1]]
-    # within the 0.5-deg fovea nobody is crowded, even 0.2 deg from a flanker (b theta = 0.2 deg at 0.4 deg
-    # would be the limit); just outside it (0.6 deg: spacing 0.3) the same pair crowds
-    assert _groups([unit(0.4, 0.0), unit(0.6, 0.0)]) == [[0], [0, 1]]
+    assert _groups([unit(4.0, 0.0), unit(2.5, 0.0)]) == [[[0], [1]], [[1]]]
+    # within the 0.5-deg fovea nobody is crowded, even 0.2 deg from a flanker; just outside it (0.6 deg:
+    # spacing 0.3) the same pair crowds
+    assert _groups([unit(0.4, 0.0), unit(0.6, 0.0)]) == [[[0]], [[1], [0]]]
     # another kind, or another point of the same object, is no flanker
-    assert _groups([unit(10.0, 0.0), unit(11.0, 0.0)], kinds=["a", "b"]) == [[0], [1]]
-    assert _groups([unit(10.0, 0.0), unit(11.0, 0.0)], objects=["box", "box"]) == [[0], [1]]
+    assert _groups([unit(10.0, 0.0), unit(11.0, 0.0)], kinds=["a", "b"]) == [[[0]], [[1]]]
+    assert _groups([unit(10.0, 0.0), unit(11.0, 0.0)], objects=["box", "box"]) == [[[0]], [[1]]]
     # off: nobody is pooled
-    assert _groups([unit(10.0, 0.0), unit(11.0, 0.0)], params=VisionParams()) == [[0], [1]]
+    assert _groups([unit(10.0, 0.0), unit(11.0, 0.0)], params=VisionParams()) == [[[0]], [[1]]]
 
 
-def test_pooled_is_the_group_mean():
-    vecs = [[1.0, 2.0, 3.0], [3.0, 0.0, -1.0], [100.0, 100.0, 100.0]]
-    assert periphery.pooled(vecs, [0, 1]) == [2.0, 1.0, 1.0]
-    assert periphery.pooled(vecs, [2]) == [100.0, 100.0, 100.0]
+def test_a_flanking_object_counts_once_at_the_mean_of_its_flanking_points():
+    # target at 10 deg (spacing 5); object B has two points within it (12, 13 deg) and one outside (16)
+    dirs = [unit(10.0, 0.0), unit(12.0, 0.0), unit(13.0, 0.0), unit(16.0, 0.0)]
+    g = _groups(dirs, objects=["A", "B", "B", "B"])
+    assert g[0] == [[0], [1, 2]]
+    vecs = [[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [4.0, 0.0, 0.0], [100.0, 0.0, 0.0]]
+    # (target + mean(B's two flanking points)) / 2 = (0 + 3) / 2
+    assert periphery.pooled(vecs, g[0]) == [1.5, 0.0, 0.0]
+
+
+def test_pooled_is_the_mean_of_the_elements():
+    vecs = [[1.0, 2.0, 3.0], [3.0, 0.0, -1.0], [5.0, 2.0, 1.0], [100.0, 100.0, 100.0]]
+    assert periphery.pooled(vecs, [[0], [1]]) == [2.0, 1.0, 1.0]
+    assert periphery.pooled(vecs, [[0], [1, 2]]) == [2.5, 1.5, 1.5]  # (v0 + (v1 + v2) / 2) / 2
+    assert periphery.pooled(vecs, [[3]]) == [100.0, 100.0, 100.0]
 
 
 # --- 4. depth and the vergence distance ---------------------------------------------------------
@@ -238,18 +245,18 @@ def test_env_retina_pools_crowded_targets_and_draws_six_normals_each():
     env, u = _env_eye({"crowding": True, "noise_scale": 0.0})
     eye, data = u.eye, u.unwrapped.data
     a = _placed(unit(10.0, 0.0), eye, 2.0, "a")
-    b = _placed(unit(13.0, 0.0), eye, 2.0, "b")  # 3 deg from a (spacing 5): pooled; a is 3.9 from b's spacing 6.5
+    b = _placed(unit(13.0, 0.0), eye, 2.0, "b", group="b_obj")
     c = _placed(unit(-10.0, 0.0), eye, 2.0, "c")  # 20 deg away: alone
-    d = _placed(unit(14.0, 0.0), eye, 2.0, "d", group="b_obj")
-    b.group = "b_obj"  # b and d: one object, so they do not crowd one another
+    d = _placed(unit(14.0, 0.0), eye, 2.0, "d", group="b_obj")  # b and d: one object, no mutual crowding
     rng = np.random.default_rng(0)
     out = u.retina._see_all(data, [a, b, c, d], eye, rng)
-    pa, pb, pc, pd = (np.array(2.0 * np.array(v)) for v in (unit(10.0, 0.0), unit(13.0, 0.0), unit(-10.0, 0.0),
-                                                             unit(14.0, 0.0)))
+    pa, pb, pc, pd = (2.0 * np.array(v) for v in (unit(10.0, 0.0), unit(13.0, 0.0), unit(-10.0, 0.0),
+                                                  unit(14.0, 0.0)))
     assert all(o[2] for o in out)
-    np.testing.assert_allclose(out[0][0], (pa + pb + pd) / 3.0, atol=1e-9)  # b at 3, d at 4 deg (< 5)
+    # a (10 deg, spacing 5): b at 3 and d at 4 deg, both points of one object: (a + (b + d) / 2) / 2
+    np.testing.assert_allclose(out[0][0], (pa + (pb + pd) / 2.0) / 2.0, atol=1e-9)
     np.testing.assert_allclose(out[1][0], (pa + pb) / 2.0, atol=1e-9)  # b (13 deg, spacing 6.5): a only
-    np.testing.assert_allclose(out[2][0], pc, atol=1e-9)
+    np.testing.assert_allclose(out[2][0], pc, atol=1e-9)  # c: 20 deg from the others
     np.testing.assert_allclose(out[3][0], (pa + pd) / 2.0, atol=1e-9)  # d (14, spacing 7): a at 4, not b
     # one standard_normal(6) per seen target, as without crowding
     ref = np.random.default_rng(0)

@@ -182,9 +182,10 @@ class Retina:
 
     def _see_all_periphery(self, data, targets, eye, rng) -> list:
         """:meth:`_see_all` with the human periphery of :mod:`visuomotor_gym.vision.periphery`: the field
-        of view of ``params.field_shape``; crowding, each crowded target seen as the mean position and
-        velocity (eye frame) of its group, with the noise of a look at that mean (its distance and
-        eccentricity; the target's own retinal slip); the position law and the depth law (the eye's
+        of view of ``params.field_shape``; crowding, each crowded target seen at the mean position and
+        velocity (eye frame) of its group (:func:`~visuomotor_gym.vision.periphery.crowding_groups`: each
+        flanking object once), with the noise of a look at that mean (its distance and eccentricity; the
+        target's own retinal slip); the position law and the depth law (the eye's
         vergence distance ``eye.fixation``) inside :func:`~visuomotor_gym.vision.foveation.perceive`.
         One ``rng.standard_normal(6)`` per seen target, in target order, as without them."""
         vp = self.params

@@ -25,8 +25,8 @@ them on its pure-Python path.
 3. **Crowding** (``crowding``): Bouma's law (Bouma 1970, Nature 226:177): a target at eccentricity
    ``theta`` is crowded by any flanker closer to it (angle between the two lines of sight) than the
    critical spacing ``b * theta``, ``b = crowding_bouma`` = 0.5; crowded targets are seen as the average
-   of the group (compulsory averaging, Parkes et al. 2001, Nat Neurosci 4:739). See
-   :func:`crowding_groups` for the exact rule.
+   of the group, each flanking object counted once at the mean of its flanking points (compulsory
+   averaging, Parkes et al. 2001, Nat Neurosci 4:739). See :func:`crowding_groups` for the exact rule.
 4. **Depth precision and the vergence distance** (``depth_pedestal_arcmin``): depth from binocular
    disparity is finest at the fixation (vergence) distance and worsens with the disparity pedestal
    ``eta = I |1/d - 1/d_fix|`` (``I`` the interocular distance): stereo thresholds rise steeply with the
@@ -113,22 +113,25 @@ def angular_separation(u, v) -> float:
     return math.atan2(math.sqrt(cx * cx + cy * cy + cz * cz), u[0] * v[0] + u[1] * v[1] + u[2] * v[2])
 
 
-def crowding_groups(directions, eccentricities, kinds, objects, params) -> list[list[int]]:
+def crowding_groups(directions, eccentricities, kinds, objects, params) -> list[list[list[int]]]:
     """Who is pooled into whose percept (Bouma 1970; Parkes et al. 2001).
 
     ``directions``: the unit lines of sight (eye frame) of the targets seen this step (visible, inside
     the field); ``eccentricities`` (rad), ``kinds`` and ``objects`` the same targets' eccentricities,
-    kinds and objects. Returns, for each target ``i``, the sorted indices of its group: ``i`` and every
-    **neighbour** ``j``, that is every other seen target of the same kind, of another object (points of
-    one object -- the corners of one obstacle -- do not crowd one another), whose line of sight makes an
-    angle **strictly less** than the critical spacing ``crowding_bouma * theta_i`` with ``i``'s. A
-    target within ``crowding_fovea_deg`` of the fovea is never crowded (there the critical spacing
+    kinds and objects. A **neighbour** of target ``i`` is any other seen target of the same kind and of
+    another object (points of one object -- the corners of one obstacle -- do not crowd one another)
+    whose line of sight makes an angle **strictly less** than the critical spacing
+    ``crowding_bouma * theta_i`` with ``i``'s. Returns, for each target ``i``, its group as a list of
+    **elements**: ``[i]`` first, then, for each flanking object (in order of first appearance), the
+    sorted indices of its points that are neighbours of ``i``. Each element counts once in the average
+    (:func:`pooled`): an object seen as four points pulls no harder than one seen as one.
+    A target within ``crowding_fovea_deg`` of the fovea is never crowded (there the critical spacing
     ``b theta`` is below the few arcmin of foveal crowding, Levi, Klein & Aitsebaomo 1985 Exp. II).
-    The relation is not symmetric: a flanker nearer the fovea than its target may crowd it and not
-    be crowded by it. Without ``crowding`` (or foveation) every group is the target alone.
+    The relation is not symmetric: a flanker nearer the fovea than its target may crowd it and not be
+    crowded by it. Without ``crowding`` (or foveation) every group is ``[[i]]``.
     """
     n = len(directions)
-    groups = [[i] for i in range(n)]
+    groups = [[[i]] for i in range(n)]
     if not (params.crowding and params.foveated):
         return groups
     fovea = params.crowding_fovea_deg * DEG
@@ -137,17 +140,19 @@ def crowding_groups(directions, eccentricities, kinds, objects, params) -> list[
         if theta <= fovea:
             continue
         spacing = params.crowding_bouma * theta
+        flankers: dict = {}  # object -> its points that are neighbours of i, in index order
         for j in range(n):
             if j != i and kinds[j] == kinds[i] and objects[j] != objects[i] \
                     and angular_separation(directions[i], directions[j]) < spacing:
-                groups[i].append(j)
-        groups[i].sort()
+                flankers.setdefault(objects[j], []).append(j)
+        groups[i].extend(flankers.values())
     return groups
 
 
 def pooled(vectors, group) -> list[float]:
-    """The mean of ``vectors[k]`` (3-vectors) over the indices ``group`` (compulsory averaging)."""
-    n = len(group)
-    if n == 1:
-        return list(vectors[group[0]])
-    return [sum(vectors[k][c] for k in group) / n for c in range(3)]
+    """Compulsory averaging: the mean over the group's elements (:func:`crowding_groups`) of each
+    element's mean of ``vectors[k]`` (3-vectors); a lone target is itself."""
+    if len(group) == 1 and len(group[0]) == 1:
+        return list(vectors[group[0][0]])
+    means = [[sum(vectors[k][c] for k in element) / len(element) for c in range(3)] for element in group]
+    return [sum(m[c] for m in means) / len(means) for c in range(3)]
