@@ -8,8 +8,10 @@ interval. The model-based agents are given the exact ``VisionParams`` of the eye
 noise model then includes the position law; their depth model does not know the vergence law, and no
 agent knows about crowding).
 
-    nice -n 10 python benchmarks/periphery_sweep.py --episodes 30 \\
+    nice -n 10 python benchmarks/periphery_sweep.py --episodes 40 \\
         --out docs/reproductions/data/periphery/obstacle_walk_sweep.json
+    nice -n 10 python benchmarks/periphery_sweep.py --env SteppingStones-v0 --episodes 40 \\
+        --agents lookahead,gaze_blind:lookahead --out docs/reproductions/data/periphery/stepping_stones_sweep.json
 
 Writes a JSON (configurations, agents, per-seed outcomes, rates, run time) and a CSV beside it.
 """
@@ -44,6 +46,7 @@ CONFIGS = {
     "all four": {"field_shape": "human", "position_e2_deg": 0.7, "crowding": True, "depth_pedestal_arcmin": 10.0},
 }
 AGENTS = ("iwao", "gaze_blind:iwao")
+FAILURE_FLAGS = ("tripped", "off_path", "misstepped", "fell")
 
 
 def give_vision(policy, vision) -> None:
@@ -72,11 +75,9 @@ def play(agent_spec: str, env_id: str, fields: dict, seeds: list[int]) -> tuple[
     for s in seeds:
         trace = run_episode(env, policy, seed=s, env_id=env_id, agent=agent_spec)
         ok.append(bool(trace.success))
-        task = trace.task
-        reason = ("success" if trace.success else "tripped" if bool(task.get("tripped", False))
-                  else "off_path" if bool(task.get("off_path", False))
-                  else "misstep" if bool(task.get("misstepped", False)) else "other")
-        why.append(reason)
+        # the family's failure flags (walk: tripped, misstepped, off_path; stones: fell), else "other"
+        flags = [k for k in FAILURE_FLAGS if bool(trace.task.get(k, False))]
+        why.append("success" if trace.success else flags[0] if flags else "other")
     env.close()
     return ok, why
 
