@@ -17,7 +17,7 @@ import mujoco
 import numpy as np
 
 from visuomotor_gym import _native
-from visuomotor_gym.vision import foveation
+from visuomotor_gym.vision import foveation, periphery
 from visuomotor_gym.vision.foveation import VisionParams
 
 VISION_MODES = ("foveated", "full_view", "oracle")
@@ -31,10 +31,17 @@ def nothing() -> tuple[list, list, bool]:
 class VisualTarget:
     """Something the eye can see. Subclasses give its world position and velocity as arrays
     (:meth:`state`) and say when the scene hides it (``hidden``: behind its thrower, out of play, not
-    yet placed); the retina decides the rest (field of view, saccades, noise, delay)."""
+    yet placed); the retina decides the rest (field of view, saccades, noise, delay).
+
+    For crowding (``VisionParams.crowding``, :func:`visuomotor_gym.vision.periphery.crowding_groups`):
+    ``kind`` -- only targets of the same kind crowd one another; ``group`` -- the object the target is a
+    point of (None: the target is an object of its own, named ``name``); points of one object do not
+    crowd one another."""
 
     name: str = "target"
     hidden: bool = False
+    kind: str = "target"
+    group: str | None = None
 
     def state(self, data: mujoco.MjData) -> tuple[np.ndarray, np.ndarray]:
         raise NotImplementedError
@@ -60,8 +67,9 @@ class PointTarget(VisualTarget):
 
     _ZERO = np.zeros(3)
 
-    def __init__(self, name: str) -> None:
+    def __init__(self, name: str, group: str | None = None) -> None:
         self.name = name
+        self.group = group  # the object this is a point of (crowding); None: a point object of its own
         self.position = np.zeros(3)
         self.hidden = True
 
@@ -102,7 +110,8 @@ class Retina:
         self._cos_fov = math.cos(min(params.field_of_view_deg * foveation.DEG + 1e-9, math.pi))
         # The compiled _see_all (visuomotor_gym._native, _kernels.c: retina_see_all), when built; its
         # constants in the order of its VisionConsts struct.
-        self._native = _native.enabled()
+        # Issue 23's peripheral mechanisms (params.periphery_on) run on the pure-Python path only.
+        self._native = _native.enabled() and not params.periphery_on
         deg = foveation.DEG
         self._native_constants = np.array([
             1.0 if params.foveated else 0.0, self._cos_fov, params.field_of_view_deg * deg, params.noise_scale,
@@ -138,6 +147,8 @@ class Retina:
         """:meth:`_see` of every target (not the oracle, no saccade in flight), with the eye's pose read
         once: the same arithmetic in the same order, without a call and its look-ups per target (a
         walker's course hands the retina a dozen targets every step)."""
+        if self.params.periphery_on:
+            return self._see_all_periphery(data, targets, eye, rng)
         if self._native:  # this method, compiled
             return _native.kernels.retina_see_all(targets, data, eye.pos_list + eye.prev_pos + eye.prev_gaze
                                                   + eye.rot_flat, self.dt, self._native_constants, rng)
@@ -167,6 +178,57 @@ class Retina:
             vel_eye = [r0 * vx + r3 * vy + r6 * vz, r1 * vx + r4 * vy + r7 * vz, r2 * vx + r5 * vy + r8 * vz]
             retinal_speed = eye.retinal_speed(rx, ry, rz, vx, vy, vz, dt)
             out.append(perceive(pos_eye, vel_eye, retinal_speed, vp, rng))
+        return out
+
+    def _see_all_periphery(self, data, targets, eye, rng) -> list:
+        """:meth:`_see_all` with the human periphery of :mod:`visuomotor_gym.vision.periphery`: the field
+        of view of ``params.field_shape``; crowding, each crowded target seen at the mean position and
+        velocity (eye frame) of its group (:func:`~visuomotor_gym.vision.periphery.crowding_groups`: each
+        flanking object once), with the noise of a look at that mean (its distance and eccentricity; the
+        target's own retinal slip); the position law and the depth law (the eye's
+        vergence distance ``eye.fixation``) inside :func:`~visuomotor_gym.vision.foveation.perceive`.
+        One ``rng.standard_normal(6)`` per seen target, in target order, as without them."""
+        vp = self.params
+        ex, ey, ez = eye.pos_list
+        r0, r1, r2, r3, r4, r5, r6, r7, r8 = eye.rot_flat
+        dt = self.dt
+        seen = []  # (target index, position, velocity (eye frame), retinal speed, distance)
+        for i, target in enumerate(targets):
+            if target.hidden:
+                continue
+            pos, vel = target.state(data)
+            bx, by, bz = pos.tolist()
+            rx, ry, rz = bx - ex, by - ey, bz - ez
+            pos_eye = [r0 * rx + r3 * ry + r6 * rz, r1 * rx + r4 * ry + r7 * rz, r2 * rx + r5 * ry + r8 * rz]
+            if not periphery.in_field(*pos_eye, vp):
+                continue
+            vx, vy, vz = vel.tolist()
+            vel_eye = [r0 * vx + r3 * vy + r6 * vz, r1 * vx + r4 * vy + r7 * vz, r2 * vx + r5 * vy + r8 * vz]
+            d = math.sqrt(pos_eye[0] ** 2 + pos_eye[1] ** 2 + pos_eye[2] ** 2)
+            seen.append((i, pos_eye, vel_eye, eye.retinal_speed(rx, ry, rz, vx, vy, vz, dt), d))
+        if vp.crowding and len(seen) > 1:
+            dirs = [[c / d for c in p] if d > 0.0 else [1.0, 0.0, 0.0] for _, p, _, _, d in seen]
+            eccs = [math.acos(max(-1.0, min(1.0, u[0]))) for u in dirs]
+            kinds = [targets[i].kind for i, *_ in seen]
+            objects = [targets[i].name if targets[i].group is None else targets[i].group for i, *_ in seen]
+            groups = periphery.crowding_groups(dirs, eccs, kinds, objects, vp)
+            positions = [p for _, p, _, _, _ in seen]
+            velocities = [v for _, _, v, _, _ in seen]
+            seen = [(i, periphery.pooled(positions, g), periphery.pooled(velocities, g), slip, d)
+                    for (i, _, _, slip, d), g in zip(seen, groups)]
+        out = [nothing() for _ in targets]
+        draw = foveation._draw_at
+        fixation = eye.fixation
+        for i, (x, y, z), vel_eye, slip, _ in seen:
+            # A look at the (pooled) point, as foveation.perceive draws it once it is known to be seen
+            # (a pooled point may lie just outside the field that holds its target: still seen).
+            d = math.sqrt(x * x + y * y + z * z)
+            if d <= 0.0:
+                out[i] = ([x, y, z], list(vel_eye), True)
+                continue
+            ecc = math.acos(max(-1.0, min(1.0, x / d)))
+            p, v = draw(x, y, z, d, ecc, vel_eye, slip, vp, rng, fixation)
+            out[i] = (p, v, True)
         return out
 
     def _see(self, data, target: VisualTarget, eye, saccading: bool, rng) -> tuple[list, list, bool]:

@@ -166,7 +166,9 @@ class ObstacleWalkTask:
         self.reward_weights = reward_weights
         self.visual_delay_s = visual_delay_s
         n = len(self.pool)
-        self.all_targets = [PointTarget(f"obstacle_{i:02d}_{c}") for i in range(n) for c in TOP_POINTS]
+        # group: the four points of one obstacle do not crowd one another (VisionParams.crowding)
+        self.all_targets = [PointTarget(f"obstacle_{i:02d}_{c}", group=f"obstacle_{i:02d}") for i in range(n)
+                            for c in TOP_POINTS]
         self.targets = self.all_targets
         self._finish_body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, wn.WALKER_FINISH)
         self._finish_mocap = int(model.body_mocapid[self._finish_body])

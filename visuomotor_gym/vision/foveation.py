@@ -31,7 +31,10 @@ the paper; the defaults below follow the text):
 * everything is divided by the acuity factor ``alpha(theta) = E2 / (E2 + theta)`` (``theta`` the
   eccentricity from the line of sight, ``E2`` = 2 deg: acuity halves 2 deg from the fovea, the
   standard cortical-magnification form, e.g. Levi, Klein & Aitsebaomo 1985);
-* nothing is seen beyond the field of view (+-60 deg, Eom et al. 2019) or during a saccade.
+* nothing is seen beyond the field of view (+-60 deg, Eom et al. 2019) or during a saccade;
+* opt-in human peripheral vision (issue 23; all off by default): a human-shaped field of view, a
+  position law faster than the acuity law, crowding, and depth noise that grows away from the
+  vergence distance (:mod:`visuomotor_gym.vision.periphery`).
 
 One ``noise_scale`` multiplies every standard deviation (Eyecatch section 5 uses x10 for poor
 vision). All randomness comes from the ``numpy.random.Generator`` the caller passes in.
@@ -40,15 +43,18 @@ vision). All randomness comes from the ``numpy.random.Generator`` the caller pas
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, fields, replace
+from typing import ClassVar
 
 import numpy as np
 
 from visuomotor_gym.core import args
 from visuomotor_gym.core.args import Flag, Num
+from visuomotor_gym.vision import periphery
 
 ARCMIN = math.pi / (180.0 * 60.0)
 DEG = math.pi / 180.0
+_ANGLE_BOUNDS = {"bounds": (0.0, 180.0), "low_open": True}  # field metadata of the human field's extents
 
 
 # What each VisionParams field accepts (visuomotor_gym.core.args.check_fields; a field not listed here
@@ -88,6 +94,37 @@ class VisionParams:
     position_slip_knee_deg_s: float = 2.5
     noise_scale: float = 1.0  # multiplies every standard deviation (x10: Eyecatch "poor vision")
     foveated: bool = True  # False: foveal acuity everywhere, no field-of-view limit (FullView)
+    # --- Human peripheral vision (issue 23; vision/periphery.py), each off by default. Metadata
+    # "bounds": the allowed range [low, high] ("low_open": low itself excluded), "optional": None allowed
+    # (the mechanism off); "choices": the allowed strings.
+    # Field of view: "cone" (half-angle field_of_view_deg, all round) or "human": 60 deg up, 75 down,
+    # 100 to each side (Spector 1990, Clinical Methods ch. 116), elliptical between the meridians.
+    field_shape: str = field(default="cone", metadata={"choices": periphery.FIELD_SHAPES})
+    field_up_deg: float = field(default=60.0, metadata=_ANGLE_BOUNDS)  # Spector 1990
+    field_down_deg: float = field(default=75.0, metadata=_ANGLE_BOUNDS)  # Spector 1990
+    field_side_deg: float = field(default=100.0, metadata=_ANGLE_BOUNDS)  # Spector 1990
+    # Lateral position std x (1 + theta / E2_pos) instead of / alpha(theta): position judgements degrade
+    # faster with eccentricity than resolution (Levi, Klein & Aitsebaomo 1985); 0.6-0.8 deg often quoted,
+    # unconfirmed (modelling choice, to confirm). None: off (the acuity law, E2 = fovea_e2_deg).
+    position_e2_deg: float | None = field(
+        default=None, metadata={"bounds": (0.0, 90.0), "low_open": True, "optional": True})
+    # Crowding: flankers of the same kind (another object) within crowding_bouma x eccentricity pool
+    # with the target (Bouma 1970: b ~ 0.5; Parkes et al. 2001: compulsory averaging).
+    crowding: bool = False
+    crowding_bouma: float = field(default=0.5, metadata={"bounds": (0.0, 2.0), "low_open": True})  # Bouma
+    # Targets this close to the fovea are never crowded: the foveola's radius (1-1.2 deg across), where
+    # b * theta < 0.25 deg, near foveal crowding's few arcmin (Levi, Klein & Aitsebaomo 1985):
+    # modelling choice.
+    crowding_fovea_deg: float = field(default=0.5, metadata={"bounds": (0.0, 90.0)})
+    # Depth and depth-rate std x (1 + eta / eta_2), eta = interocular |1/d - 1/d_fix| the disparity
+    # pedestal from the vergence distance (Blakemore 1970: stereo thresholds rise with the pedestal);
+    # eta_2 (arcmin): modelling choice, to confirm. None: off (depth noise independent of vergence).
+    depth_pedestal_arcmin: float | None = field(
+        default=None, metadata={"bounds": (0.0, 600.0), "low_open": True, "optional": True})
+    # Interocular distance for the pedestal: mean adult interpupillary distance ~63 mm (Dodgson 2004).
+    interocular_m: float = field(default=0.063, metadata={"bounds": (0.0, 0.2), "low_open": True})
+    # Set by __post_init__: whether any of the mechanisms above acts (always False without foveation).
+    periphery_on: ClassVar[bool] = False
 
     def __post_init__(self) -> None:
         args.check_fields(self, VISION_RULES)  # every field, those added later included
@@ -112,6 +149,36 @@ class VisionParams:
             raise ValueError(
                 f"VisionParams.field_of_view_deg must be in (0, 180], got {self.field_of_view_deg!r}"
             )
+        self._check_periphery()
+        # Whether any peripheral mechanism acts (the retina then bypasses its compiled kernel).
+        object.__setattr__(self, "periphery_on", self.foveated and (
+            self.field_shape == "human" or self.position_e2_deg is not None or self.crowding
+            or self.depth_pedestal_arcmin is not None))
+
+    def _check_periphery(self) -> None:
+        """The peripheral-vision fields: each number finite and inside its metadata ``bounds`` (the low end
+        excluded where ``low_open``), None only where ``optional``."""
+        if self.field_shape not in periphery.FIELD_SHAPES:
+            raise ValueError(
+                f"VisionParams.field_shape must be one of {list(periphery.FIELD_SHAPES)}, "
+                f"got {self.field_shape!r}")
+        if not (isinstance(self.crowding, bool) or type(self.crowding).__name__ == "bool_"):
+            raise TypeError(f"VisionParams.crowding must be True or False, got {self.crowding!r}")
+        for f in fields(self):
+            bounds = f.metadata.get("bounds")
+            if bounds is None:
+                continue
+            value = getattr(self, f.name)
+            if value is None and f.metadata.get("optional"):
+                continue
+            low, high = bounds
+            closed = not f.metadata.get("low_open", False)
+            real = not isinstance(value, bool) and isinstance(value, (int, float)) and math.isfinite(value)
+            if not real or not ((value >= low) if closed else (value > low)) or value > high:
+                side = "[" if closed else "("
+                extra = " or None (off)" if f.metadata.get("optional") else ""
+                raise ValueError(f"VisionParams.{f.name} must be a finite number in {side}{low:g}, "
+                                 f"{high:g}]{extra}, got {value!r}")
 
     def scaled(self, factor: float) -> VisionParams:
         """A copy with ``noise_scale`` multiplied by ``factor``."""
@@ -165,38 +232,54 @@ def eccentricity(position_eye: np.ndarray) -> float:
 
 
 def is_in_field_of_view(position_eye: np.ndarray, params: VisionParams) -> bool:
-    """Whether a point (eye frame) lies inside the field of view (always, without foveation)."""
+    """Whether a point (eye frame) lies inside the field of view (always, without foveation): the cone
+    of half-angle ``field_of_view_deg`` or, with ``field_shape="human"``, the human field
+    (:func:`visuomotor_gym.vision.periphery.in_field`)."""
     if not params.foveated:
         return True
+    if params.field_shape == "human":
+        return periphery.in_field(*(float(c) for c in position_eye), params)
     return eccentricity(position_eye) <= params.field_of_view_deg * DEG
 
 
-def standard_deviations(distance: float, eccentricity_rad: float, retinal_speed: float, params: VisionParams):
+def standard_deviations(distance: float, eccentricity_rad: float, retinal_speed: float, params: VisionParams,
+                        fixation: float | None = None):
     """The diagonal of Sigma (Eyecatch Eq. 2) along the line of sight: (depth, lateral, lateral) x2.
 
     ``retinal_speed`` is the speed (rad/s) of the image on the retina: the line-of-sight angular
     velocity minus the eye's own angular velocity, so pursuit that stabilises the image sharpens the
-    velocity estimate.
+    velocity estimate. With the peripheral mechanisms of :mod:`visuomotor_gym.vision.periphery`: the
+    lateral position std follows the position law (``position_e2_deg``) and the depth stds grow with
+    the disparity pedestal from the vergence distance ``fixation`` (m; ``depth_pedestal_arcmin``).
     """
-    return np.array(_sigmas(distance, eccentricity_rad, retinal_speed, params))
+    return np.array(_sigmas(distance, eccentricity_rad, retinal_speed, params, fixation))
 
 
-def _sigmas(distance, eccentricity_rad, retinal_speed, params):
+def _sigmas(distance, eccentricity_rad, retinal_speed, params, fixation=None):
     """``standard_deviations`` as a tuple of floats (the per-step path)."""
     k = distance * params.noise_scale / acuity(eccentricity_rad, params)
     lateral = k * params.retinal_position_std_arcmin * ARCMIN * slip_factor(retinal_speed, params)
     lateral_rate = k * (
         params.retinal_velocity_weber * abs(retinal_speed) + params.retinal_velocity_floor_deg_s * DEG
     )
+    if params.periphery_on:  # issue 23's laws (off by default: the arithmetic above, unchanged)
+        if params.position_e2_deg is not None:
+            lateral = (distance * params.noise_scale * periphery.position_factor(eccentricity_rad, params)
+                       * params.retinal_position_std_arcmin * ARCMIN * slip_factor(retinal_speed, params))
+        g = periphery.depth_factor(distance, fixation, params)
+        return (k * params.depth_std_fraction * g, lateral, lateral, k * params.depth_rate_std_fraction * g,
+                lateral_rate, lateral_rate)
     return (k * params.depth_std_fraction, lateral, lateral, k * params.depth_rate_std_fraction, lateral_rate,
             lateral_rate)
 
 
-def covariance(position_eye: np.ndarray, retinal_speed: float, params: VisionParams) -> np.ndarray:
-    """The 6x6 observation covariance A Sigma^2 A^T in the eye frame (Eyecatch Eq. 1-3)."""
+def covariance(position_eye: np.ndarray, retinal_speed: float, params: VisionParams,
+               fixation: float | None = None) -> np.ndarray:
+    """The 6x6 observation covariance A Sigma^2 A^T in the eye frame (Eyecatch Eq. 1-3); ``fixation``
+    (m): the vergence distance, for the depth law of ``depth_pedestal_arcmin``."""
     position_eye = np.asarray(position_eye, dtype=float)
     d = math.sqrt(float(position_eye @ position_eye))
-    sig = standard_deviations(d, eccentricity(position_eye), retinal_speed, params)
+    sig = standard_deviations(d, eccentricity(position_eye), retinal_speed, params, fixation)
     rot = line_of_sight_rotation(position_eye / d) if d > 0 else np.eye(3)
     a = np.zeros((6, 6))
     a[:3, :3] = rot
@@ -204,27 +287,30 @@ def covariance(position_eye: np.ndarray, retinal_speed: float, params: VisionPar
     return a @ np.diag(sig**2) @ a.T
 
 
-def perceive(position_eye, velocity_eye, retinal_speed: float, params: VisionParams, rng: np.random.Generator):
+def perceive(position_eye, velocity_eye, retinal_speed: float, params: VisionParams, rng: np.random.Generator,
+             fixation: float | None = None):
     """One look at a point: ``(position, velocity, visible)`` in the eye frame, as float lists.
 
     Outside the field of view nothing is drawn and zeros are returned with ``visible=False``
-    (saccadic suppression is the caller's business: it knows when the eye moved).
+    (saccadic suppression is the caller's business: it knows when the eye moved). ``fixation`` (m):
+    the eye's vergence distance, for the depth law of ``depth_pedestal_arcmin``.
     """
     x, y, z = position_eye
     d = math.sqrt(x * x + y * y + z * z)
     if d <= 0.0:
         return list(position_eye), list(velocity_eye), True
     ecc = math.acos(max(-1.0, min(1.0, x / d)))
-    if params.foveated and ecc > params.field_of_view_deg * DEG:
+    if params.foveated and (ecc > periphery.human_field_limit(y / d, z / d, params)
+                            if params.field_shape == "human" else ecc > params.field_of_view_deg * DEG):
         return [0.0, 0.0, 0.0], [0.0, 0.0, 0.0], False
-    pos, vel = _draw_at(x, y, z, d, ecc, velocity_eye, retinal_speed, params, rng)
+    pos, vel = _draw_at(x, y, z, d, ecc, velocity_eye, retinal_speed, params, rng, fixation)
     return pos, vel, True
 
 
-def _draw_at(x, y, z, d, ecc, velocity_eye, retinal_speed, params, rng):
+def _draw_at(x, y, z, d, ecc, velocity_eye, retinal_speed, params, rng, fixation=None):
     """True state + A Sigma eps with eps ~ N(0, I6) (Eyecatch Eq. 1-3) for a point at distance ``d`` > 0
     and eccentricity ``ecc`` (rad); float lists in and out."""
-    s0, s1, s2, s3, s4, s5 = _sigmas(d, ecc, retinal_speed, params)
+    s0, s1, s2, s3, s4, s5 = _sigmas(d, ecc, retinal_speed, params, fixation)
     e0, e1, e2, e3, e4, e5 = rng.standard_normal(6).tolist()
     n0, n1, n2, n3, n4, n5 = s0 * e0, s1 * e1, s2 * e2, s3 * e3, s4 * e4, s5 * e5
     (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = _los_rows(x / d, y / d, z / d)
