@@ -226,7 +226,7 @@ TWIN_PREFIX = "gaze-blind-"
 def team(name: str) -> str:
     """The agent an entry name belongs to: without the gaze-blind twin's prefix and the version suffix
     (``gaze-blind-ppo-gated-v2`` -> ``ppo-gated``)."""
-    return family(name.removeprefix(TWIN_PREFIX))
+    return family(name.removeprefix(TWIN_PREFIX).removeprefix("static-gaze-"))
 
 
 def agent_spec_problems(entry: Entry, where: str) -> list[Problem]:

@@ -207,12 +207,14 @@ def _series(rows: list[Row]) -> list[str]:
 
 
 TWIN_PREFIX = "gaze-blind-"
+STATIC_PREFIX = "static-gaze-"  # entry names of the best static twins
+TWIN_PREFIXES = (TWIN_PREFIX, STATIC_PREFIX)
 
 
 def _base_agent(name: str) -> str:
     """The agent an entry name belongs to, for its colour: without the gaze-blind twin's prefix and the
     version suffix (``gaze-blind-eyecatch-v2`` and ``eyecatch-v4`` are both ``eyecatch``)."""
-    base = name.removeprefix(TWIN_PREFIX)
+    base = name.removeprefix(TWIN_PREFIX).removeprefix(STATIC_PREFIX)
     head, sep, tail = base.rpartition("-v")
     return head if sep and tail.isdigit() else base
 
@@ -504,7 +506,7 @@ def svg_catch_rate(rows: list[Row], ladder: list[str]) -> str:
 
     def marker(cx, cy, name):  # filled: the agent; hollow: its gaze-blind twin
         color = colours[name]
-        fill = "#ffffff" if name.startswith(TWIN_PREFIX) else color
+        fill = "#ffffff" if name.startswith(TWIN_PREFIXES) else color
         return f'<circle class="point" cx="{cx:.1f}" cy="{cy:.1f}" r="5" fill="{fill}" stroke="{color}" stroke-width="2"/>'
 
     for k, name in enumerate(names):
@@ -517,7 +519,7 @@ def svg_catch_rate(rows: list[Row], ladder: list[str]) -> str:
                 runs[-1].append(r)
             else:
                 runs.append([r])
-        dash = ' stroke-dasharray="4 3"' if name.startswith(TWIN_PREFIX) else ""
+        dash = ' stroke-dasharray="4 3"' if name.startswith(TWIN_PREFIXES) else ""
         for run in runs:
             if len(run) > 1:
                 pts = " ".join(f"{x(r.env_id, k):.1f},{y(r.rate):.1f}" for r in run)
