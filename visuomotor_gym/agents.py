@@ -285,12 +285,17 @@ class GazeBlind:
         if hasattr(self.base, "reset"):
             self.base.reset()
 
-    def predict(self, observation, state=None, episode_start=None, deterministic=True):
+    def base_action(self, observation, state=None, episode_start=None, deterministic=True):
+        """The base agent's action (a float32 copy of the checked shape) and its state."""
         action, state = self.base.predict(observation, state=state, episode_start=episode_start,
                                           deterministic=deterministic)
         action = np.array(action, dtype=np.float32, copy=True)
         if action.shape[-1] != self.action_dim:
             raise ValueError(f"base agent gave an action of shape {action.shape}, expected (..., {self.action_dim})")
+        return action, state
+
+    def predict(self, observation, state=None, episode_start=None, deterministic=True):
+        action, state = self.base_action(observation, state, episode_start, deterministic)
         action[..., self.held] = 0.0
         return action, state
 

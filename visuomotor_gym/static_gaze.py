@@ -299,11 +299,7 @@ class StaticGaze(GazeBlind):
         return np.asarray(observation, dtype=float)[..., self._rot]
 
     def predict(self, observation, state=None, episode_start=None, deterministic=True):
-        action, state = self.base.predict(observation, state=state, episode_start=episode_start,
-                                          deterministic=deterministic)
-        action = np.array(action, dtype=np.float32, copy=True)
-        if action.shape[-1] != self.action_dim:
-            raise ValueError(f"base agent gave an action of shape {action.shape}, expected (..., {self.action_dim})")
+        action, state = self.base_action(observation, state, episode_start, deterministic)
         rots = self._eye_rots(observation)
         b = self._blocks
         if rots.ndim == 1:
