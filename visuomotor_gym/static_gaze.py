@@ -472,6 +472,7 @@ def search(env_id: str, agent: str, *, design_seed: int = DESIGN_SEED, coarse_ep
     if not 1 <= coarse_episodes <= final_episodes:
         raise ValueError(f"need 1 <= coarse_episodes <= final_episodes, got {coarse_episodes}, {final_episodes}")
     geometry = env_geometry(env_id)
+    origin = provenance(command)  # the code that runs (taken before, not after, a long search)
     started = time.perf_counter()
     scorer = _Scorer(env_id, agent, design_seed, log=log)
     stages = []
@@ -563,7 +564,7 @@ def search(env_id: str, agent: str, *, design_seed: int = DESIGN_SEED, coarse_ep
                      for p, r in scorer.results.items()],
         "episodes_played": scorer.episodes_played,
         "wall_time_s": round(wall, 1),
-        "provenance": provenance(command),
+        "provenance": origin,
     }
 
 
