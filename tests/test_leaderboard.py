@@ -865,3 +865,33 @@ def test_belief_mpc_params_reject_a_malformed_tuple():
         obj["params"]["speeds"] = bad
         with pytest.raises(ValueError, match="params.speeds"):
             fmt.load(json.dumps(obj).encode(), "ObstacleDodge-v0")
+
+
+def test_the_page_gain_is_success_minus_the_better_twin_entry():
+    """The committed page's gaze gain of every baseline, recomputed here from the twins' own results files:
+    success minus the better of the held twin (gaze_blind:<agent>) and the best static twin
+    (static_gaze:<posture>:<agent>); every foveated id's baselines have both twins entered."""
+    from visuomotor_gym.bench.evaluate import static_twin_base
+    from visuomotor_gym.leaderboard.pages import _rows, twin_agents
+
+    rows, _ = _rows(load_leaderboard(COMMITTED))
+    with_static = 0
+    for r in rows:
+        if r.agent.startswith(("gaze_blind:", "static_gaze:")) or r.agent == "fixed_gaze":
+            continue
+        same = [t for t in rows if t.env_id == r.env_id and t.seeds == r.seeds]
+        held = [t.entry.results["success_rate"] for t in same if t.agent in twin_agents(r.agent)]
+        static = [t.entry.results["success_rate"] for t in same if static_twin_base(t.agent) == r.agent]
+        assert (r.held_gain is None) == (not held)
+        if held:
+            assert r.held_gain == pytest.approx(r.entry.results["success_rate"] - held[0])
+        if static:
+            with_static += 1
+            expected = r.entry.results["success_rate"] - max(static[0], held[0] if held else 0.0)
+            assert r.gain == pytest.approx(expected), r.key
+        else:
+            assert r.gain is None, f"{r.key}: a gain without a static twin entry"
+    foveated = ("EyeCatch-v0", "ShelfReach-v0", "ObstacleWalk-v0", "SteppingStones-v0", "ObstacleDodge-v0")
+    assert with_static >= len(foveated)
+    for env_id in foveated:
+        assert any(r.env_id == env_id and r.gain is not None for r in rows), f"no static twin on {env_id}"
