@@ -31,7 +31,7 @@ from visuomotor_gym.metrics.stats import wilson_interval
 
 REPO = Path(__file__).resolve().parents[1]
 COMMITTED = REPO / "leaderboard"
-KEY = "eyecatch-v3__EyeCatch-v0"  # current (not superseded) entries
+KEY = "eyecatch-v5__EyeCatch-v0"  # current (not superseded) entries
 POOR = "eyecatch-v3__EyeCatchPoorVision-v0"
 
 
