@@ -672,11 +672,11 @@ def test_page_renders_in_a_headless_browser(tmp_path):
 
     # A screenshot of the unmodified page: the right size, and the plots' colours are on it.
     # tall enough to reach the realism heat map below the entry table
-    png = browser.screenshot(COMMITTED / "index.html", tmp_path / "page.png", width=1200, height=3600)
+    png = browser.screenshot(COMMITTED / "index.html", tmp_path / "page.png", width=1200, height=8000)
     Image = pytest.importorskip("PIL.Image")
 
     image = Image.open(png).convert("RGB")
-    assert image.size == (1200, 3600)
+    assert image.size == (1200, 8000)
     colors = image.getcolors(maxcolors=1 << 20)
     count = {c: k for k, c in colors}
 
