@@ -43,7 +43,7 @@ vision). All randomness comes from the ``numpy.random.Generator`` the caller pas
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import dataclass, field, replace
 from typing import ClassVar
 
 import numpy as np
@@ -127,58 +127,13 @@ class VisionParams:
     periphery_on: ClassVar[bool] = False
 
     def __post_init__(self) -> None:
-        args.check_fields(self, VISION_RULES)  # every field, those added later included
-        for name in (
-            "retinal_position_std_arcmin",
-            "retinal_velocity_weber",
-            "retinal_velocity_floor_deg_s",
-            "depth_std_fraction",
-            "depth_rate_std_fraction",
-            "noise_scale",
-        ):
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value >= 0.0):
-                raise ValueError(f"VisionParams.{name} must be finite and >= 0, got {value!r}")
-        if not (math.isfinite(self.fovea_e2_deg) and self.fovea_e2_deg > 0.0):
-            raise ValueError(f"VisionParams.fovea_e2_deg must be > 0, got {self.fovea_e2_deg!r}")
-        if not (self.position_slip_knee_deg_s > 0.0):  # inf allowed: no slip effect
-            raise ValueError(
-                f"VisionParams.position_slip_knee_deg_s must be > 0, got {self.position_slip_knee_deg_s!r}"
-            )
-        if not (0.0 < self.field_of_view_deg <= 180.0):
-            raise ValueError(
-                f"VisionParams.field_of_view_deg must be in (0, 180], got {self.field_of_view_deg!r}"
-            )
-        self._check_periphery()
+        # Every field, those added later included: VISION_RULES, else the field's metadata (bounds,
+        # optional, choices), else the check its default's type implies (visuomotor_gym.core.args).
+        args.check_fields(self, VISION_RULES)
         # Whether any peripheral mechanism acts (the retina then bypasses its compiled kernel).
         object.__setattr__(self, "periphery_on", self.foveated and (
             self.field_shape == "human" or self.position_e2_deg is not None or self.crowding
             or self.depth_pedestal_arcmin is not None))
-
-    def _check_periphery(self) -> None:
-        """The peripheral-vision fields: each number finite and inside its metadata ``bounds`` (the low end
-        excluded where ``low_open``), None only where ``optional``."""
-        if self.field_shape not in periphery.FIELD_SHAPES:
-            raise ValueError(
-                f"VisionParams.field_shape must be one of {list(periphery.FIELD_SHAPES)}, "
-                f"got {self.field_shape!r}")
-        if not (isinstance(self.crowding, bool) or type(self.crowding).__name__ == "bool_"):
-            raise TypeError(f"VisionParams.crowding must be True or False, got {self.crowding!r}")
-        for f in fields(self):
-            bounds = f.metadata.get("bounds")
-            if bounds is None:
-                continue
-            value = getattr(self, f.name)
-            if value is None and f.metadata.get("optional"):
-                continue
-            low, high = bounds
-            closed = not f.metadata.get("low_open", False)
-            real = not isinstance(value, bool) and isinstance(value, (int, float)) and math.isfinite(value)
-            if not real or not ((value >= low) if closed else (value > low)) or value > high:
-                side = "[" if closed else "("
-                extra = " or None (off)" if f.metadata.get("optional") else ""
-                raise ValueError(f"VisionParams.{f.name} must be a finite number in {side}{low:g}, "
-                                 f"{high:g}]{extra}, got {value!r}")
 
     def scaled(self, factor: float) -> VisionParams:
         """A copy with ``noise_scale`` multiplied by ``factor``."""
