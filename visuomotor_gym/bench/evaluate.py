@@ -255,11 +255,14 @@ def static_twin_spec(agent: str, env_id: str) -> str:
 
 def static_twin_base(spec: str) -> str | None:
     """The agent whose static twin ``spec`` is (``static_gaze:[posture:]<agent>`` -> ``<agent>``), else None."""
-    name, _, rest = spec.partition(":")
-    if name != "static_gaze" or not rest:
+    from visuomotor_gym.agents import parse_agent_spec
+
+    if not spec.startswith("static_gaze:"):
         return None
-    head, colon, tail = rest.partition(":")
-    return tail if colon and "=" in head else rest
+    try:
+        return parse_agent_spec(spec)[1]["base"]
+    except ValueError:  # not a spec this version parses (an old entry's unknown agent)
+        return None
 
 
 def _run_on_ray(agent, env_id, chunks, seeds, address, progress) -> list[list[EpisodeTrace]]:

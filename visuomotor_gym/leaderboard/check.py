@@ -220,13 +220,15 @@ MAX_SPEC_LENGTH = 256
 # A path argument (``ppo:<path>``): relative, each component starting with a letter or digit (no '..',
 # no hidden files, no absolute path, no '~').
 PATH_RE = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]*(/[A-Za-z0-9][A-Za-z0-9._-]*)*")
-TWIN_PREFIX = "gaze-blind-"
+TWIN_PREFIX = "gaze-blind-"  # entry names of the held twins
+STATIC_PREFIX = "static-gaze-"  # entry names of the best static twins
+TWIN_PREFIXES = (TWIN_PREFIX, STATIC_PREFIX)
 
 
 def team(name: str) -> str:
-    """The agent an entry name belongs to: without the gaze-blind twin's prefix and the version suffix
-    (``gaze-blind-ppo-gated-v2`` -> ``ppo-gated``)."""
-    return family(name.removeprefix(TWIN_PREFIX).removeprefix("static-gaze-"))
+    """The agent an entry name belongs to: without a twin's prefix and the version suffix
+    (``gaze-blind-ppo-gated-v2`` and ``static-gaze-ppo-gated`` -> ``ppo-gated``)."""
+    return family(name.removeprefix(TWIN_PREFIX).removeprefix(STATIC_PREFIX))
 
 
 def agent_spec_problems(entry: Entry, where: str) -> list[Problem]:

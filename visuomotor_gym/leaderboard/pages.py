@@ -24,6 +24,7 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
+from visuomotor_gym.leaderboard.check import STATIC_PREFIX, TWIN_PREFIX, TWIN_PREFIXES
 from visuomotor_gym.leaderboard.entries import Entry, Leaderboard
 from visuomotor_gym.leaderboard.problems import Problem
 
@@ -206,9 +207,6 @@ def _series(rows: list[Row]) -> list[str]:
     return names
 
 
-TWIN_PREFIX = "gaze-blind-"
-STATIC_PREFIX = "static-gaze-"  # entry names of the best static twins
-TWIN_PREFIXES = (TWIN_PREFIX, STATIC_PREFIX)
 
 
 def _base_agent(name: str) -> str:
