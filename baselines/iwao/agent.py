@@ -75,16 +75,17 @@ class IwaoAgent:
     """See the module docstring. ``predict(obs) -> (action, state)`` on flat ObstacleWalk observations."""
 
     def __init__(self, params: IwaoParams | None = None, gaze: IwaoGazeParams | None = None,
-                 planner: PlannerParams | None = None, gait: GaitParams | None = None) -> None:
+                 planner: PlannerParams | None = None, gait: GaitParams | None = None,
+                 vision: VisionParams | None = None) -> None:
         self.params = p = params or IwaoParams()
         self.gaze_params = gaze or IwaoGazeParams()
         self.gait = gait or GaitParams()
         self.planner = FootstepPlanner(self.gait, planner)
-        self.vision = VisionParams(noise_scale=p.vision_noise_scale, foveated=p.foveated,
-                                   position_slip_knee_deg_s=p.position_slip_knee_deg_s)
+        self.memory = ObstacleMemory(vision or VisionParams(noise_scale=p.vision_noise_scale, foveated=p.foveated,
+                                                           position_slip_knee_deg_s=p.position_slip_knee_deg_s),
+                                     self.planner.p.walkway_half_width_m)
         self.delay_steps = round(p.visual_delay_s / p.control_dt)
         self.gaze_range = p.gaze_action_range_deg * DEG
-        self.memory = ObstacleMemory(self.vision, self.planner.p.walkway_half_width_m)
         self.period_steps = round(self.gait.step_s / p.control_dt)
         self.lead_steps = min(round(p.pursuit_lead_s / p.control_dt), self.period_steps)
         self.reset()
@@ -98,7 +99,25 @@ class IwaoAgent:
         unknown = sorted(set(overrides) - known)
         if unknown:
             raise TypeError(f"unknown iwao parameter(s) {unknown}; known: {sorted(known)}")
-        return cls(replace(base, **overrides))
+        # The eye's every constant (env_vision_params: the walk family's, with the human periphery's
+        # fields when the id is registered with them), so the obstacle memory weights each sample as
+        # this eye makes it; the noise scale, foveation and slip knee given as overrides win.
+        params = replace(base, **overrides)
+        vision = env_vision_params(env_id)
+        mine = {"vision_noise_scale": "noise_scale", "foveated": "foveated",
+                "position_slip_knee_deg_s": "position_slip_knee_deg_s"}
+        vision = replace(vision, **{mine[k]: getattr(params, k) for k in overrides if k in mine})
+        return cls(params, vision=vision)
+
+    @property
+    def vision(self) -> VisionParams:
+        """The vision model the agent weights its samples with: its obstacle memory's (one object, so
+        ``agents.match_vision`` setting it reaches the memory too)."""
+        return self.memory.vision
+
+    @vision.setter
+    def vision(self, value: VisionParams) -> None:
+        self.memory.vision = value
 
     def reset(self) -> None:
         self.memory.reset()

@@ -78,10 +78,9 @@ class LookaheadAgent:
                  vision: VisionParams | None = None) -> None:
         self.params = p = params or LookaheadParams()
         self.gait = gait or GaitParams()
-        self.vision = vision or VisionParams(noise_scale=p.vision_noise_scale, foveated=p.foveated)
+        self.memory = StoneMemory(vision or VisionParams(noise_scale=p.vision_noise_scale, foveated=p.foveated))
         self.delay_steps = round(p.visual_delay_s / p.control_dt)
         self.gaze_range = p.gaze_action_range_deg * DEG
-        self.memory = StoneMemory(self.vision)
         self.reset()
 
     @classmethod
@@ -93,6 +92,16 @@ class LookaheadAgent:
         if unknown:
             raise TypeError(f"unknown lookahead parameter(s) {unknown}; known: {sorted(known)}")
         return cls(replace(base, **overrides), vision=env_vision_params(env_id))
+
+    @property
+    def vision(self) -> VisionParams:
+        """The vision model the agent weights its samples with: its stone memory's (one object, so
+        ``agents.match_vision`` setting it reaches the memory too)."""
+        return self.memory.vision
+
+    @vision.setter
+    def vision(self, value: VisionParams) -> None:
+        self.memory.vision = value
 
     def reset(self) -> None:
         self.memory.reset()
