@@ -65,10 +65,10 @@ CONDITIONS = {
 }
 # The modelling choices' sweep (--extra): the all-on condition with the other value of each.
 EXTRA = {
-    "f' all on, E2 0.35 deg": {**HUMAN_FIELD, "position_e2_deg": 0.35, **CROWDING, **DEPTH},
-    "f' all on, E2 1.4 deg": {**HUMAN_FIELD, "position_e2_deg": 1.4, **CROWDING, **DEPTH},
-    "f' all on, depth 60 arcmin": {**HUMAN_FIELD, **POSITION_E2, **CROWDING, "depth_pedestal_arcmin": 60.0},
-    "f' all on, no depth law": {**HUMAN_FIELD, **POSITION_E2, **CROWDING},
+    "f' all on: E2 0.35 deg": {**HUMAN_FIELD, "position_e2_deg": 0.35, **CROWDING, **DEPTH},
+    "f' all on: E2 1.4 deg": {**HUMAN_FIELD, "position_e2_deg": 1.4, **CROWDING, **DEPTH},
+    "f' all on: depth 60 arcmin": {**HUMAN_FIELD, **POSITION_E2, **CROWDING, "depth_pedestal_arcmin": 60.0},
+    "f' all on: no depth law": {**HUMAN_FIELD, **POSITION_E2, **CROWDING},
 }
 ROLES = ("baseline", "held", "static")
 
@@ -150,7 +150,7 @@ def table(record: dict) -> str:
 
 
 def search_posture(target: str, condition: str, out: Path, coarse_step: float, coarse_episodes: int,
-                   final_episodes: int) -> None:
+                   final_episodes: int, refine_steps: tuple = (10.0,)) -> None:
     """The static posture search under ``condition`` for ``ENV:AGENT`` (design seeds)."""
     from visuomotor_gym.static_gaze import search
 
@@ -159,7 +159,7 @@ def search_posture(target: str, condition: str, out: Path, coarse_step: float, c
     set_vision(env_id, fields)
     try:
         record = search(env_id, agent, coarse_step=coarse_step, coarse_episodes=coarse_episodes,
-                        final_episodes=final_episodes, command=" ".join(sys.argv),
+                        final_episodes=final_episodes, refine_steps=refine_steps, command=" ".join(sys.argv),
                         log=lambda line: print(line, flush=True))
     finally:
         set_vision(env_id, {})
@@ -187,6 +187,7 @@ def main(argv=None) -> int:
     ap.add_argument("--coarse-step", type=float, default=30.0)
     ap.add_argument("--coarse-episodes", type=int, default=12)
     ap.add_argument("--final-episodes", type=int, default=20)
+    ap.add_argument("--refine-steps", default="10", help="comma-separated refinement steps (deg)")
     args = ap.parse_args(argv)
     out = Path(args.out)
     if args.table:
@@ -195,7 +196,7 @@ def main(argv=None) -> int:
     _setup()
     if args.search:
         search_posture(args.search, args.search_condition, out, args.coarse_step, args.coarse_episodes,
-                       args.final_episodes)
+                       args.final_episodes, tuple(float(x) for x in args.refine_steps.split(",")))
         return 0
     families = args.families.split(",")
     for f in families:
