@@ -116,3 +116,29 @@ def test_dodge_planner_models_the_env_vision():
         assert policy.noise is not before
     finally:
         env.close()
+
+
+def test_iwao_verges_on_its_gaze_target_only_under_the_depth_law():
+    """Without the depth law the fixation action stays 0 (iwao v0); with it, it asks for a vergence
+    distance on the ground ahead (the fixated point: 1.8-8 m for the walkway's eye 1.6 m up), never the
+    action 0's 1.4 m."""
+    from visuomotor_gym.baselines.iwao.agent import _LOG_FIX
+
+    lo, hi = _LOG_FIX
+    for fields, check in (({}, lambda a: a == 0.0),
+                          ({"depth_pedestal_arcmin": 10.0},
+                           lambda a: 1.8 <= math.exp(lo + (a + 1.0) * 0.5 * (hi - lo)) <= 8.0)):
+        env = gym.make("ObstacleWalk-v0", vision_params=fields) if fields else gym.make("ObstacleWalk-v0")
+        try:
+            policy = make_agent("iwao", "ObstacleWalk-v0", int(env.action_space.shape[0]))
+            match_vision(policy, env.unwrapped.vision_params)
+            fix = env.unwrapped.action_structure  # the fixation action's index in the flat action
+            index = sum(n for name, n in list(fix.items())[:list(fix).index("fixation")])
+            obs, _ = env.reset(seed=0)
+            for _ in range(40):
+                action, _ = policy.predict(obs)
+                assert check(float(action[index])), (fields, float(action[index]))
+                obs, _, terminated, truncated, _ = env.step(action)
+                assert not (terminated or truncated)
+        finally:
+            env.close()
