@@ -23,6 +23,7 @@ from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
+from visuomotor_gym.baselines.crowding import crowded
 from visuomotor_gym.body.walker import GaitParams
 from visuomotor_gym.body.walker_body import WalkerBody
 from visuomotor_gym.envs.walk import WALK_LAYOUT
@@ -177,6 +178,15 @@ class IwaoAgent:
         prev, self.prev_seen_eye = self.prev_seen_eye, seen_eye
         motion = None if prev is None else eye_motion(prev, seen_eye, self.params.control_dt)
         f = 1 + 3 * N_POINTS  # the seen flags follow the id and the points
+        if self.vision.crowding:
+            # with crowding in the vision model, a point that may be pooled with another obstacle's is fused
+            # with the spread of its crowding zone (baselines.crowding); one obstacle's points do not crowd
+            seen = [(round(ol[b]), which, ol[b + 1 + 3 * which:b + 4 + 3 * which]) for b in _SLOTS
+                    for which in range(N_POINTS) if ol[b + f + which] > 0.0]
+            drop = crowded([p for _, _, p in seen], [index for index, _, _ in seen], self.vision)
+            for n, (index, which, p_eye) in enumerate(seen):
+                self.memory.add(index, which, p_eye, eye_pos, rot_rows, odo, motion, vergence, crowded=n in drop)
+            return
         for b in _SLOTS:
             flags = ol[b + f:b + f + N_POINTS]
             if 1.0 not in flags:
