@@ -213,7 +213,9 @@ def main(argv=None) -> int:
     record = {"description": __doc__.splitlines()[0], "episodes": args.episodes, "seed": args.seed,
               "command": " ".join(sys.argv), "conditions": {**CONDITIONS, **EXTRA}, "cells": []}
     if args.resume and out.exists():
-        record["cells"] = json.loads(out.read_text())["cells"]
+        before = json.loads(out.read_text())
+        record["cells"] = before["cells"]
+        record.update({k: v for k, v in before.items() if k not in record})  # notes, superseded cells
     done = {(c["family"], c["condition"], c["role"]) for c in record["cells"]}
     seeds = list(range(args.seed, args.seed + args.episodes))
     for fam in families:
