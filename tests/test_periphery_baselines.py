@@ -142,3 +142,21 @@ def test_iwao_verges_on_its_gaze_target_only_under_the_depth_law():
                 assert not (terminated or truncated)
         finally:
             env.close()
+
+
+def test_crowded_flags_only_targets_within_the_critical_spacing():
+    """Target at 10 deg: a flanker of another object 4.9 deg away crowds it (b theta = 5 deg), one at
+    5.1 deg does not, a point of the same object never does; a target inside the 0.5 deg fovea is never
+    crowded; without crowding in the vision model nothing is flagged."""
+    from visuomotor_gym.baselines.crowding import crowd_std, crowded
+
+    def at(az_deg):
+        return (math.cos(az_deg * DEG), math.sin(az_deg * DEG), 0.0)
+
+    v = VisionParams(crowding=True)
+    assert crowded([at(10.0), at(14.9)], [1, 2], v) == {0, 1}  # 4.9 < 0.5 x 14.9 too
+    assert 0 not in crowded([at(10.0), at(15.1)], [1, 2], v)
+    assert crowded([at(10.0), at(14.9)], [1, 1], v) == set()
+    assert 0 not in crowded([at(0.3), at(0.35)], [1, 2], v)
+    assert crowded([at(10.0), at(14.9)], [1, 2], VisionParams()) == set()
+    assert crowd_std(2.0, 10.0 * DEG, v) == pytest.approx(0.5 * 0.5 * 10.0 * DEG * 2.0)
