@@ -28,6 +28,7 @@ from visuomotor_gym.body import walker_names as wn
 from visuomotor_gym.body.walker import DEG, GaitParams, TurningGait, WalkerGait
 from visuomotor_gym.core.frames import RootFrame
 from visuomotor_gym.core.observation import Block
+from visuomotor_gym.core.parts import Body
 
 N_FOOTHOLDS_OBSERVED = 3  # the last three latched footholds (modelling choice: the landed one and the two planned)
 
@@ -45,7 +46,7 @@ WALKER_BLOCKS = (
 )
 
 
-class WalkerBody:
+class WalkerBody(Body):
     """Footstep actions, proprioception and events of the walker (``envs_assets/walker.xml``)."""
 
     observation_blocks = WALKER_BLOCKS

@@ -42,6 +42,7 @@ from visuomotor_gym.body import walker_names as wn
 from visuomotor_gym.core import args
 from visuomotor_gym.core.args import Num, Pair, Weights
 from visuomotor_gym.core.observation import Block
+from visuomotor_gym.core.parts import Task
 from visuomotor_gym.core.retina import PointTarget
 
 K_SLOTS = 4
@@ -146,7 +147,7 @@ TRAILING_BLOCKS = (
 )
 
 
-class ObstacleWalkTask:
+class ObstacleWalkTask(Task):
     """Course, visual targets, events, rewards and info of ObstacleWalk. ``body`` is a
     :class:`~visuomotor_gym.body.walker_body.WalkerBody`."""
 
@@ -214,9 +215,6 @@ class ObstacleWalkTask:
         """Gaze starts level, straight ahead along the path (at the finish line, at eye height)."""
         return np.array([self.course.length, 0.0, 1.6]), (0.0, 0.0)
 
-    def initial_fixation(self, distance: float) -> float:
-        return distance
-
     def reset_info(self) -> dict:
         """The course (true state, scoring only). Fixed shapes whatever the seed, so that Gymnasium's vector
         envs can stack it: ``obstacles`` is (pool size, 6), its first ``n_obstacles`` rows the course's
@@ -236,9 +234,6 @@ class ObstacleWalkTask:
                 "off_path": bool(info["off_path"]), "finished": bool(info["finished"])}
 
     # --- physics ------------------------------------------------------------------------------
-    def before_physics(self, data: mujoco.MjData) -> None:
-        return None
-
     def needs_substep_checks(self, data: mujoco.MjData) -> bool:
         """Contact checks every substep only while an obstacle is within reach of a leg: then the
         substeps are *watched* (:meth:`WalkerGait.watch_substeps`) and still run as one ``mj_step``
