@@ -245,8 +245,8 @@ def _clearance_over(steps, clearance):
 
 
 def test_low_clearance_over_a_bar_trips(model):
-    w, data = walk(model, 4.0, command=_clearance_over((5, 6), 0.08),
-                   setup=lambda g, d: _bar_at_mid_step(g, d, 0.20))
+    w, _ = walk(model, 4.0, command=_clearance_over((5, 6), 0.08),
+                setup=lambda g, d: _bar_at_mid_step(g, d, 0.20))
     assert w.contacts.tripped and w.contacts.events[0].kind == "trip"
     first = w.contacts.events[0]
     assert first.side == 1 and first.part == "foot"  # the right foot swinging to foothold 5 strikes it

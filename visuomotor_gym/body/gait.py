@@ -63,7 +63,7 @@ feet, the gait puts the stance soles at z = 0 (see ``envs_assets/README.md``).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from math import acos, atan2, cos, sin, sqrt
 
 import mujoco
