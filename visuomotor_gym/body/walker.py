@@ -17,8 +17,6 @@ from visuomotor_gym.body.gait import (
     GaitParams,
     TurningGait,
     WalkerGait,
-    _smooth,
 )
 
-__all__ = ["DEG", "GAIT_ORDER", "GAIT_RULES", "LEFT", "RIGHT", "FootPlan", "GaitParams", "TurningGait", "WalkerGait",
-           "_smooth"]
+__all__ = ["DEG", "GAIT_ORDER", "GAIT_RULES", "LEFT", "RIGHT", "FootPlan", "GaitParams", "TurningGait", "WalkerGait"]
