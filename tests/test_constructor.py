@@ -49,7 +49,7 @@ def _table_rows(cls) -> dict[str, str]:
 def test_signature_lists_own_then_shared_arguments_with_the_shared_defaults(cls):
     kwargs = _kwargs(cls)
     assert not [p for p in kwargs.values() if p.kind is inspect.Parameter.VAR_KEYWORD], "no **shared left visible"
-    assert list(kwargs)[0] == "render_mode"
+    assert next(iter(kwargs)) == "render_mode"
     assert all(p.kind is inspect.Parameter.KEYWORD_ONLY for n, p in kwargs.items() if n != "render_mode")
     base = inspect.signature(VisuomotorEnv.__init__).parameters
     for name in SHARED:

@@ -49,11 +49,11 @@ class Body(abc.ABC):
     n_action: int
     trace_step_fields: tuple[str, ...] = ()
 
-    def reset_pose(self, data: mujoco.MjData) -> None:  # noqa: B027  (a documented no-op hook)
+    def reset_pose(self, data: mujoco.MjData) -> None:
         """At reset, after ``mj_resetData`` and before ``mj_forward``: write the start posture into
         ``data`` (qpos, act, ...). Default: nothing (the model's reference pose)."""
 
-    def start(self, data: mujoco.MjData) -> None:  # noqa: B027
+    def start(self, data: mujoco.MjData) -> None:
         """At reset, after ``mj_forward`` and the eye's start: set controller memories from the
         computed kinematics. May change the body's own state only. Default: nothing."""
 
@@ -95,7 +95,7 @@ class Task(abc.ABC):
     trace_flag_fields: tuple[str, ...] = ()
 
     # --- episode ------------------------------------------------------------------------------
-    def reset_state(self) -> None:  # noqa: B027
+    def reset_state(self) -> None:
         """At construction (the task calls it) and at every reset, before any physics: clear the
         per-episode flags and memories (``success`` included). Must not touch ``data``. Default:
         nothing."""
@@ -122,7 +122,7 @@ class Task(abc.ABC):
         return self.trace_episode_fields()
 
     # --- physics ------------------------------------------------------------------------------
-    def before_physics(self, data: mujoco.MjData) -> None:  # noqa: B027
+    def before_physics(self, data: mujoco.MjData) -> None:
         """Every step, after the body's command and before the substeps: move scripted scene
         objects, remember pre-step state. May write ``data``. Default: nothing."""
 
@@ -139,17 +139,17 @@ class Task(abc.ABC):
         return False
 
     # --- observation --------------------------------------------------------------------------
-    def before_observe(self, data: mujoco.MjData) -> None:  # noqa: B027
+    def before_observe(self, data: mujoco.MjData) -> None:
         """Every observation, after the body frame's update and before the retina samples
         ``targets``: per-step bookkeeping (which objects fill the observation's slots; ``targets``
         may be changed here). Default: nothing."""
 
-    def observe_leading(self, values: list, samples: list) -> None:  # noqa: B027
+    def observe_leading(self, values: list, samples: list) -> None:
         """Every observation, first: append exactly the values of ``leading_blocks`` to
         ``values``, from the retina's ``samples`` ((position, velocity, visible) per target).
         Default: nothing (for no leading blocks)."""
 
-    def observe_trailing(self, values: list, samples: list, data: mujoco.MjData) -> None:  # noqa: B027
+    def observe_trailing(self, values: list, samples: list, data: mujoco.MjData) -> None:
         """Every observation, last: append exactly the values of ``trailing_blocks``. Default:
         nothing (for no trailing blocks)."""
 
