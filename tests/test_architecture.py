@@ -11,6 +11,7 @@ and the records give back exactly the ids, kwargs and limits registered before t
 from __future__ import annotations
 
 import ast
+import functools
 import math
 import subprocess
 import sys
@@ -65,10 +66,20 @@ def modules():
         yield ".".join(parts), path
 
 
+@functools.cache
+def _known() -> frozenset[str]:
+    return frozenset(m for m, _ in modules())
+
+
+@functools.cache
+def _tree(path: Path) -> ast.Module:
+    return ast.parse(path.read_text())
+
+
 def imports(path: Path, module: str, top_level_only: bool):
     """Dotted names imported by ``path`` (``from pkg import mod`` gives ``pkg.mod`` when mod is a module)."""
-    known = {m for m, _ in modules()}
-    tree = ast.parse(path.read_text())
+    known = _known()
+    tree = _tree(path)
     nodes = tree.body if top_level_only else list(ast.walk(tree))
     package = module if path.name == "__init__.py" else module.rsplit(".", 1)[0]
     for node in nodes:
