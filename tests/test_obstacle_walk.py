@@ -98,7 +98,7 @@ def _move_obstacles(env):
     task = env.task
     for i, (x, y, depth, width, height, kind) in enumerate(task.course.obstacles.tolist()):
         x, height = x + 0.7, min(height + 0.1, 0.4)
-        env.gait.pool.place(env.model, env.data, i, x, y, depth, width, height)
+        task.pool.place(env.model, env.data, i, x, y, depth, width, height)
         for t, point in zip(task.targets[N_POINTS * i: N_POINTS * (i + 1)], top_points(x, y, depth, width, height)):
             t.place(*point)
         task.course.obstacles[i, [0, 4]] = (x, height)

@@ -121,7 +121,7 @@ class WalkerBody:
             dx, dy = x - ox, y - oy
             values += (c * dx + s * dy, -s * dx + c * dy, z - oz)
         n = (g.next_latch_tick - g.T_mid) // T + 2  # g.next_footstep_index
-        gu, gv, (gx, gy), gc, gs = g.u, g.v, g.origin, g._c, g._s
+        gu, gv, (gx, gy), gc, gs = g.u, g.v, g.origin, g.path_cos, g.path_sin
         for j in range(n - N_FOOTHOLDS_OBSERVED, n):
             u, v = gu[j], gv[j]
             dx, dy = gx + gc * u - gs * v - ox, gy + gs * u + gc * v - oy
@@ -161,7 +161,7 @@ class TurningWalkerBody(WalkerBody):
     def __init__(self, model: mujoco.MjModel, params: GaitParams | None = None) -> None:
         super().__init__(model, params)
         self._turn = self.p.max_turn_deg * DEG
-        self._yaw_qpos = self.gait._qpos_idx[3]
+        self._yaw_qpos = self.gait.qpos_index[3]
 
     @staticmethod
     def action_from_turn(turn: float, p: GaitParams | None = None) -> float:

@@ -179,7 +179,6 @@ class SteppingStonesTask:
         m = self.model = model
         self.body = body
         self.gait = body.gait
-        self.gait._ob_geom = {}  # no obstacle pool in this scene: the gait's trip checks see nothing
         self.dist = course_distribution
         check_steppable(self.dist, self.gait.p)
         self.reward_weights = reward_weights
