@@ -354,7 +354,7 @@ def test_importing_the_records_builds_no_mujoco_model():
         "from visuomotor_gym.families import families\n"
         "print(len(families()))\n"
     )
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, check=False)
     assert out.returncode == 0, out.stderr[-2000:] + out.stdout[-2000:]
     assert out.stdout.strip() == str(len(FAMILY_MODULES))
 

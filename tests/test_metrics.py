@@ -661,8 +661,8 @@ def test_catch_hand_path_reference_is_sourced_and_leaves_gaze_realism_alone():
 
 
 def test_catch_hand_path_in_the_results_of_a_simulated_run():
-    from visuomotor_gym.bench.evaluate import evaluate
     from visuomotor_gym.bench.commands import summary_rows
+    from visuomotor_gym.bench.evaluate import evaluate
     from visuomotor_gym.bench.results import ResultsError, build_results, validate_results
 
     res = evaluate("eyecatch", "EyeCatch-v0", episodes=2, seed=0)

@@ -10,6 +10,22 @@ from dataclasses import asdict
 
 import gymnasium as gym
 
+# The per-family constants of earlier versions, importable as before (each family's env module declares them).
+from visuomotor_gym.envs.catch import (  # noqa: F401 (re-exported)
+    CATCH_MAX_EPISODE_STEPS,
+    PAPER_POOR_VISION_SCALE,
+    PAPER_VISION,
+    TWO_BALLS_MAX_EPISODE_STEPS,
+)
+from visuomotor_gym.envs.catch import FAMILY as _CATCH
+from visuomotor_gym.envs.dodge import DODGE_MAX_EPISODE_STEPS  # noqa: F401 (re-exported)
+from visuomotor_gym.envs.dodge import FAMILY as _DODGE
+from visuomotor_gym.envs.reach import FAMILY as _REACH
+from visuomotor_gym.envs.reach import REACH_MAX_EPISODE_STEPS  # noqa: F401 (re-exported)
+from visuomotor_gym.envs.stones import FAMILY as _STONES
+from visuomotor_gym.envs.stones import STONES_MAX_EPISODE_STEPS  # noqa: F401 (re-exported)
+from visuomotor_gym.envs.walk import FAMILY as _WALK
+from visuomotor_gym.envs.walk import WALK_MAX_EPISODE_STEPS  # noqa: F401 (re-exported)
 from visuomotor_gym.families import families, family_for
 from visuomotor_gym.family import (  # noqa: F401 (re-exported)
     POOR_VISION_SCALE,
@@ -18,23 +34,6 @@ from visuomotor_gym.family import (  # noqa: F401 (re-exported)
     ExtraEnv,
     vision_rungs,
 )
-
-# The per-family constants of earlier versions, importable as before (each family's env module declares them).
-from visuomotor_gym.envs.catch import (
-    CATCH_MAX_EPISODE_STEPS,
-    PAPER_POOR_VISION_SCALE,
-    PAPER_VISION,
-    TWO_BALLS_MAX_EPISODE_STEPS,
-)
-from visuomotor_gym.envs.catch import FAMILY as _CATCH
-from visuomotor_gym.envs.dodge import DODGE_MAX_EPISODE_STEPS
-from visuomotor_gym.envs.dodge import FAMILY as _DODGE
-from visuomotor_gym.envs.reach import FAMILY as _REACH
-from visuomotor_gym.envs.reach import REACH_MAX_EPISODE_STEPS
-from visuomotor_gym.envs.stones import FAMILY as _STONES
-from visuomotor_gym.envs.stones import STONES_MAX_EPISODE_STEPS
-from visuomotor_gym.envs.walk import FAMILY as _WALK
-from visuomotor_gym.envs.walk import WALK_MAX_EPISODE_STEPS
 
 CATCH_ENTRY_POINT = _CATCH.entry_point
 WALK_ENTRY_POINT = _WALK.entry_point

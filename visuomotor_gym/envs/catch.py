@@ -264,7 +264,7 @@ RENDER_CAMERAS = tuple(EyeCatchEnv.render_cameras)
 
 
 # ---------------------------------------------------------------- the family record (visuomotor_gym.family)
-from visuomotor_gym.family import BeliefMPC, ExtraEnv, Family  # noqa: E402
+from visuomotor_gym.family import BeliefMPC, ExtraEnv, Family
 
 CATCH_MAX_EPISODE_STEPS = 125  # 2.5 s at 50 Hz: the longest flight is 1.4 s
 TWO_BALLS_MAX_EPISODE_STEPS = 150  # 3 s: the second ball arrives at most 2.2 s after the first release

@@ -192,7 +192,7 @@ if ObstacleDodgeEnv.__doc__:
 
 
 # ---------------------------------------------------------------- the family record (visuomotor_gym.family)
-from visuomotor_gym.family import BeliefMPC, Family  # noqa: E402
+from visuomotor_gym.family import BeliefMPC, Family
 
 DODGE_MAX_EPISODE_STEPS = 2000  # 40 s at 50 Hz: about three times the nominal walk (1.3 m/s) to the farthest (20 m) goal
 

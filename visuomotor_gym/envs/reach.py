@@ -242,7 +242,7 @@ if ShelfReachEnv.__doc__:
 
 
 # ---------------------------------------------------------------- the family record (visuomotor_gym.family)
-from visuomotor_gym.family import Family  # noqa: E402
+from visuomotor_gym.family import Family
 
 REACH_MAX_EPISODE_STEPS = 150  # 3 s at 50 Hz: first saccade (~0.2 s), fixation, a ~0.6-1 s reach, slack (modelling choice)
 

@@ -212,7 +212,7 @@ if SteppingStonesEnv.__doc__:
 
 
 # ---------------------------------------------------------------- the family record (visuomotor_gym.family)
-from visuomotor_gym.family import BeliefMPC, Family  # noqa: E402
+from visuomotor_gym.family import BeliefMPC, Family
 
 STONES_MAX_EPISODE_STEPS = 1000  # 20 s at 50 Hz: twice the nominal crossing (~18 steps of 0.5 s) (modelling choice)
 

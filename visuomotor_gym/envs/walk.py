@@ -216,7 +216,7 @@ if ObstacleWalkEnv.__doc__:
 
 
 # ---------------------------------------------------------------- the family record (visuomotor_gym.family)
-from visuomotor_gym.family import Family  # noqa: E402
+from visuomotor_gym.family import Family
 
 WALK_MAX_EPISODE_STEPS = 2000  # 40 s at 50 Hz: three times the nominal walk (1.3 m/s) of the longest (20 m) course
 
