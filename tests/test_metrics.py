@@ -678,6 +678,16 @@ def test_catch_hand_path_in_the_results_of_a_simulated_run():
     bad["hand_path"]["verdict"] = "great"
     with pytest.raises(ResultsError, match="hand_path"):
         validate_results(bad)
+    # The family-neutral count: written, checked, and optional (results written before it lack it).
+    assert obj["success"] == obj["caught"] == round(obj["success_rate"] * obj["episodes"])
+    assert rows["catch rate"].endswith(f"({obj['success']}/2)")
+    wrong = json.loads(json.dumps(obj))
+    wrong["success"] = obj["success"] + 1
+    with pytest.raises(ResultsError, match=r"\$.success: success = .* is not success_rate x episodes"):
+        validate_results(wrong)
+    older = json.loads(json.dumps(obj))
+    del older["success"]
+    validate_results(older)
 
 
 # --- the family dispatch (metrics.summary reads each family's record; metrics.common is the scaffolding) ----
@@ -741,4 +751,5 @@ def test_every_summary_has_the_same_keys(reach_traces):
     reach = M.summarize(reach_traces)
     catch.pop("hand_path", None)
     assert list(catch) == list(reach)
-    assert reach["caught"] == 1 and reach["catch_rate"] == reach["success_rate"] == 0.5
+    assert reach["success"] == reach["caught"] == 1 and reach["catch_rate"] == reach["success_rate"] == 0.5
+    assert catch["success"] == catch["caught"] == 1

@@ -98,12 +98,14 @@ def summary_rows(results: dict) -> list[tuple[str, str]]:
     """(metric, value) rows of the summary table, labelled in the env family's terms."""
     family = _family_of(results["env_id"])
     rate_label, time_label, miss_label = family.outcome_labels  # the results keep the catch key names
-    lo, hi = results["catch_rate_ci95"]
+    # The family-neutral keys; results written before them carry only catch_rate (the same number there).
+    rate = results.get("success_rate", results["catch_rate"])
+    lo, hi = results.get("success_rate_ci95", results["catch_rate_ci95"])
+    successes = results.get("success", results["caught"])
     gaze = results["gaze_realism"]
     lat = results["latency_ms"]
     rows = [
-        (rate_label, f"{results['catch_rate']:.3f}  95% CI [{lo:.3f}, {hi:.3f}]  "
-                     f"({results['caught']}/{results['episodes']})"),
+        (rate_label, f"{rate:.3f}  95% CI [{lo:.3f}, {hi:.3f}]  ({successes}/{results['episodes']})"),
         ("gaze realism", _fmt(gaze["score"])),
     ]
     gain = results.get("gaze_gain")

@@ -34,6 +34,7 @@ def catch_summary(traces: Sequence) -> dict:
         "caught": caught,
         "catch_rate": caught / n if n else float("nan"),
         "catch_rate_ci95": [low, high],
+        "success": succeeded,
         "success_rate": succeeded / n if n else float("nan"),
         "success_rate_ci95": [s_low, s_high],
         "diverged": diverged,

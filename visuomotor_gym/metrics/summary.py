@@ -34,11 +34,13 @@ def summarize(traces: Sequence) -> dict:
 
     Keys (every family):
 
-    * ``episodes``, ``caught`` (count of successes), ``catch_rate``, ``catch_rate_ci95`` ([low, high],
-      Wilson 95 %), ``diverged`` (count; physics divergences count as failures);
-    * ``success_rate``, ``success_rate_ci95``: the family-neutral rate of episodes that met the task's
-      goal (:func:`episode_success`; for catching it is the catch rate) with its Wilson 95 % interval,
-      so a leaderboard can rank tasks that do not catch anything;
+    * ``episodes``, ``diverged`` (count; physics divergences count as failures);
+    * ``success`` (count), ``success_rate``, ``success_rate_ci95``: the family-neutral count and rate
+      of episodes that met the task's goal (:func:`episode_success`; for catching, every ball caught)
+      with its Wilson 95 % interval, so a leaderboard can rank tasks that do not catch anything;
+    * ``caught`` (count), ``catch_rate``, ``catch_rate_ci95`` ([low, high], Wilson 95 %): the catches;
+      on every other family the same successes again -- deprecated aliases of ``success`` and
+      ``success_rate``, kept so older results files and their readers still work;
     * ``gaze_realism``: ``{"score", "components": {name: {"value", "score", "episodes"}}}`` against the
       family's human reference table;
     * ``latency_ms``: ``{"p50", "p95", "max"}`` policy compute time per step;
