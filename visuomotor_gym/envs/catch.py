@@ -238,3 +238,46 @@ if EyeCatchEnv.__doc__:
     )
 
 RENDER_CAMERAS = tuple(EyeCatchEnv.render_cameras)
+
+
+# ---------------------------------------------------------------- the family record (visuomotor_gym.family)
+from visuomotor_gym.family import BeliefMPC, ExtraEnv, Family
+
+CATCH_MAX_EPISODE_STEPS = 125  # 2.5 s at 50 Hz: the longest flight is 1.4 s
+TWO_BALLS_MAX_EPISODE_STEPS = 150  # 3 s: the second ball arrives at most 2.2 s after the first release
+PAPER_POOR_VISION_SCALE = 10.0  # Eyecatch (Yeo et al. 2012, section 5): every vision noise x10 (81.2 % caught)
+# The Eyecatch paper's vision model (Yeo et al. 2012, section 3.1): lateral position noise is static 20/20 acuity
+# whatever the image's speed on the retina. The default degrades it with retinal slip
+# (VisionParams.position_slip_knee_deg_s; docs/reproductions/gaze_default.md).
+PAPER_VISION = {"position_slip_knee_deg_s": math.inf}
+
+FAMILY = Family(
+    name="catch",
+    prefix="EyeCatch",
+    entry_point="visuomotor_gym.envs.catch:EyeCatchEnv",
+    max_episode_steps=CATCH_MAX_EPISODE_STEPS,
+    oracle_sees="ball",
+    body="seated",
+    summariser="visuomotor_gym.metrics.catch_summary:catch_summary",
+    miss_distance="visuomotor_gym.metrics.outcome:miss_distance",
+    outcome_labels=("catch rate", "time to catch (s)", "miss distance (m)"),
+    reaction_from_t0=True,  # the throw starts at t = 0
+    extra_envs=(
+        ExtraEnv("EyeCatchBounce-v0", {"bounce_wall": True},
+                 "foveated; the ball bounces off an invisible wall mid-flight (Eyecatch 5)"),
+        ExtraEnv("EyeCatchTwoBalls-v0", {"n_balls": 2},
+                 "foveated; two staggered balls from both sides, catch both (Eom 7)", TWO_BALLS_MAX_EPISODE_STEPS),
+        # The two vision conditions of the Eyecatch paper (section 5: 98 % normal, 81.2 % with the noise
+        # x10), for its reproduction page: the paper's static 20/20 acuity at any retinal speed, no slip term.
+        ExtraEnv("EyeCatchPaper-v0", {"vision_params": dict(PAPER_VISION)},
+                 "Eyecatch paper's vision: foveated, static acuity at any retinal speed"),
+        ExtraEnv("EyeCatchPaperPoorVision-v0",
+                 {"vision_params": dict(PAPER_VISION), "vision_noise_scale": PAPER_POOR_VISION_SCALE},
+                 "Eyecatch paper's vision with all noise x10 (Eyecatch 5: 81.2 %)"),
+    ),
+    agents=("eyecatch", "fixed_gaze", "oracle", "belief_intercept", "belief_mpc"),
+    golden_agent="eyecatch",
+    golden_extra=(("oracle", "EyeCatchOracle-v0"),),
+    belief_mpc=BeliefMPC("visuomotor_gym.baselines.belief_mpc:BeliefMPCAgent",
+                         "visuomotor_gym.baselines.belief_mpc.agent:BeliefMPCParams", env_vision=True),
+)

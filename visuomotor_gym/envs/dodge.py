@@ -151,3 +151,28 @@ if ObstacleDodgeEnv.__doc__:
     ObstacleDodgeEnv.__doc__ = ObstacleDodgeEnv.__doc__.replace(
         "OBSERVATION_TABLE", "\n    ".join(DODGE_LAYOUT.markdown_table().splitlines())
     ).replace("(N,)", f"({DODGE_LAYOUT.size},)").replace("(N in the table)", "")
+
+
+# ---------------------------------------------------------------- the family record (visuomotor_gym.family)
+from visuomotor_gym.family import BeliefMPC, Family
+
+DODGE_MAX_EPISODE_STEPS = 2000  # 40 s at 50 Hz: about three times the nominal walk (1.3 m/s) to the farthest (20 m) goal
+
+FAMILY = Family(
+    name="dodge",
+    prefix="ObstacleDodge",
+    entry_point="visuomotor_gym.envs.dodge:ObstacleDodgeEnv",
+    max_episode_steps=DODGE_MAX_EPISODE_STEPS,
+    oracle_sees="pedestrian",
+    body="walker",
+    vision_defaults=WALK_VISION,  # the walk family's 20 deg recognition field
+    summariser="visuomotor_gym.metrics.dodge_realism:dodge_summary",
+    miss_distance="visuomotor_gym.metrics.dodge_realism:distance_left",
+    outcome_labels=("success rate", "time to goal (s)", "distance left, failed walks (m)"),
+    agents=("belief_mpc", "fajen_warren"),
+    golden_agent="fajen_warren",
+    # experimental: Eom's uncertainty term on fajen_warren's locomotion
+    belief_mpc=BeliefMPC("visuomotor_gym.baselines.belief_mpc.dodge:DodgeBeliefMPCAgent",
+                         "visuomotor_gym.baselines.belief_mpc.dodge:DodgeBeliefMPCParams",
+                         vision_note="env_vision_params"),
+)

@@ -214,3 +214,24 @@ if ShelfReachEnv.__doc__:
                              .replace("OBSERVATION_TABLE", "\n    ".join(_layout.markdown_table().splitlines()))
                              .replace("ACTION_TABLE", _action_table())
                              .replace("OBS_SIZE", str(_layout.size)))
+
+
+# ---------------------------------------------------------------- the family record (visuomotor_gym.family)
+from visuomotor_gym.family import Family
+
+REACH_MAX_EPISODE_STEPS = 150  # 3 s at 50 Hz: first saccade (~0.2 s), fixation, a ~0.6-1 s reach, slack (modelling choice)
+
+FAMILY = Family(
+    name="reach",
+    prefix="ShelfReach",
+    entry_point="visuomotor_gym.envs.reach:ShelfReachEnv",
+    max_episode_steps=REACH_MAX_EPISODE_STEPS,
+    oracle_sees="object",
+    body="seated",
+    summariser="visuomotor_gym.metrics.reach_realism:reach_summary",
+    miss_distance="visuomotor_gym.metrics.reach_realism:closest_distance",
+    outcome_labels=("success rate", "time to success (s)", "closest distance, failed reaches (m)"),
+    reaction_from_t0=True,  # the object appears at t = 0
+    agents=("faraway",),
+    golden_agent="faraway",
+)

@@ -211,3 +211,24 @@ if ObstacleWalkEnv.__doc__:
     ObstacleWalkEnv.__doc__ = ObstacleWalkEnv.__doc__.replace(
         "OBSERVATION_TABLE", "\n    ".join(WALK_LAYOUT.markdown_table().splitlines())
     ).replace("(N,)", f"({WALK_LAYOUT.size},)").replace("(N in the table)", "")
+
+
+# ---------------------------------------------------------------- the family record (visuomotor_gym.family)
+from visuomotor_gym.family import Family
+
+WALK_MAX_EPISODE_STEPS = 2000  # 40 s at 50 Hz: three times the nominal walk (1.3 m/s) of the longest (20 m) course
+
+FAMILY = Family(
+    name="walk",
+    prefix="ObstacleWalk",
+    entry_point="visuomotor_gym.envs.walk:ObstacleWalkEnv",
+    max_episode_steps=WALK_MAX_EPISODE_STEPS,
+    oracle_sees="obstacle",
+    body="walker",
+    vision_defaults=WALK_VISION,  # Iwao's 20 deg recognition field
+    summariser="visuomotor_gym.metrics.walk_realism:walk_summary",
+    miss_distance="visuomotor_gym.metrics.walk_realism:distance_left",
+    outcome_labels=("success rate", "time to finish (s)", "distance left, failed walks (m)"),
+    agents=("iwao",),
+    golden_agent="iwao",
+)
