@@ -18,7 +18,7 @@ from visuomotor_gym.core import args
 from visuomotor_gym.core.eye import EYE_BLOCKS
 from visuomotor_gym.core.head import HEAD_BLOCKS
 from visuomotor_gym.core.observation import ObservationLayout
-from visuomotor_gym.envs.walk import WalkerEnv
+from visuomotor_gym.envs.walk import WALK_VISION, WalkerEnv
 from visuomotor_gym.tasks.obstacle_dodge import (
     DEFAULT_REWARD_WEIGHTS,
     PERCEPT_BLOCKS,
