@@ -59,8 +59,8 @@ DOCUMENTED_CONSTANTS: tuple[tuple[str, str, tuple[str, ...] | None, str], ...] =
      "seen flags: every top-face point of a present obstacle is seen without a field-of-view limit"),
     ("stones", r"stone_\d+\[4\]", ("oracle", "full_view"), "seen flag: every stone is seen without a field limit"),
     ("stones", r"stone_\d+\[0\]|stones_left\[0\]", None,
-     "course index / stones left change only once a stone is stepped on; random footsteps fall first "
-     "(tests/test_stepping_stones.py steps on stones)"),
+     ("course index / stones left change only once a stone is stepped on; random footsteps fall first "
+      "(tests/test_stepping_stones.py steps on stones)")),
     ("catch", r"balls_caught\[[01]\]|holding\[0\]", None,
      "touch blocks change only on a catch, which random actions do not make (tests/test_two_balls.py)"),
 )
@@ -335,6 +335,9 @@ def test_bad_actions_raise_and_leave_the_env_usable(env_id):
         with pytest.raises(ValueError, match=r"shape") as excinfo:
             env.step(bad)
         assert f"({n},)" in str(excinfo.value), "the message should say which shape is expected"
+    for bad in (np.array(["a"] * n), [None] * n):
+        with pytest.raises(ValueError, match=r"(?i)numeric"):
+            env.step(bad)
     np.testing.assert_array_equal(env.data.qpos, before)  # a refused action does not advance the physics
     with pytest.raises(ValueError, match="options"):
         env.reset(seed=0, options={"anything": 1})
@@ -361,6 +364,7 @@ BAD_ARGUMENTS = [
 ]
 
 
+@pytest.mark.filterwarnings("ignore:.*render_mode='ascii'")  # Gymnasium's own warning before the env refuses it
 @pytest.mark.parametrize("env_id", ENV_IDS)
 def test_bad_constructor_arguments_raise_naming_the_argument(env_id):
     for kwargs, exc, name in BAD_ARGUMENTS:
