@@ -392,7 +392,8 @@ def test_reward_is_the_sum_of_the_named_terms(env_id, weights):
             terms = info["reward_terms"]
             assert set(terms) == weighted, f"terms {sorted(terms)} vs weighted {sorted(weighted)}"
             assert isinstance(reward, float) and math.isfinite(reward)
-            assert reward == pytest.approx(math.fsum(terms.values()), rel=0, abs=1e-12)
+            assert reward == pytest.approx(math.fsum(terms.values()), rel=0, abs=1e-12), (
+                f"reward {reward!r} is not the sum of its terms {terms}")
             if terminated or truncated:
                 break
 
@@ -490,3 +491,24 @@ def test_no_observation_element_is_constant_over_random_episodes(env_id):
     for i, label in enumerate(labels):
         if re.fullmatch(r"(ball|object)_age\[0\]", label):
             assert np.all(table[:, i] == np.float32(env_vision(env_id)["visual_delay_s"])), label
+
+
+def test_constructor_parameters_follow_forwarded_keyword_arguments():
+    """The Arguments check reads arguments a subclass forwards with ``**kwargs`` to its base (the
+    ``AntEnv`` -> ``MujocoEnv`` pattern), stops at an ``__init__`` without ``**``, and ignores gym.Env's."""
+
+    class Base(gym.Env):
+        def __init__(self, render_mode=None, *, vision="foveated", **unknown):
+            pass
+
+    class Family(Base):
+        def __init__(self, *, course=None, **shared):
+            super().__init__(**shared)
+
+    class Closed(Base):
+        def __init__(self, *, course=None):
+            pass
+
+    assert {n: p.default for n, p in constructor_parameters(Family).items()} == {
+        "course": None, "render_mode": None, "vision": "foveated"}
+    assert list(constructor_parameters(Closed)) == ["course"]
