@@ -37,17 +37,14 @@ import numpy as np  # noqa: E402
 GOLDEN_FILE = Path(__file__).with_name("digests.json")
 STEPS_FILE = Path(__file__).with_name("steps.json.gz")
 SEEDS = (0, 1, 2)
-# Families whose episodes are pinned (a family joins once its env and baseline are settled: a digest of
-# a behaviour still being tuned proves nothing).
-GOLDEN_FAMILIES = ("catch", "reach", "walk", "stones", "dodge")
 MAX_STEPS = 150
 # steps.json.gz keeps STEP_HEX hex digits per step of a hash over all the step's keys (a changed step
 # keeps it by chance once in 65536: the first differing step) and one hex digit per key and step (a
 # changed key keeps it once in 16: the key named). Modelling choice: ~0.3 MB for 276 cases.
 STEP_HEX = 4
-# Each family's own baseline on each of its ids (catch: the Eyecatch agent, walk: iwao, reach: faraway).
-FAMILY_AGENT = {"catch": "eyecatch", "walk": "iwao", "reach": "faraway", "stones": "lookahead",
-                "dodge": "fajen_warren"}
+# Each family's pinned baseline (its Family record's golden_agent) runs on each of its ids; a family
+# with no golden agent is not pinned yet (a family joins once its env and baseline are settled: a digest
+# of a behaviour still being tuned proves nothing). Extra (agent, id) cases come from golden_extra.
 VARIANTS = {
     "joint": ("EyeCatch-v0", {"control": "joint"}),
     "shaped": ("EyeCatch-v0", {"reward": "shaped"}),
@@ -161,10 +158,11 @@ def case_table() -> dict[str, tuple[str, dict, str | None, int]]:
     """Every golden case by name: ``(env_id, make kwargs, agent or None for random actions, seed)``,
     in the order the digests are computed."""
     import visuomotor_gym  # noqa: F401  (registers the ids)
-    from visuomotor_gym.registration import ENV_SPECS, family_of
+    from visuomotor_gym.families import families, family_for
+    from visuomotor_gym.registration import ENV_SPECS
 
     out: dict[str, tuple[str, dict, str | None, int]] = {}
-    ids = [spec.id for spec in ENV_SPECS if family_of(spec.id) in GOLDEN_FAMILIES]
+    ids = [spec.id for spec in ENV_SPECS if family_for(spec.id).golden_agent is not None]
     for env_id in ids:
         for obs_mode in ("flat", "dict"):
             for seed in SEEDS:
@@ -173,7 +171,8 @@ def case_table() -> dict[str, tuple[str, dict, str | None, int]]:
         for seed in SEEDS:
             out[f"{env_id}/{name}/random/{seed}"] = (env_id, dict(kwargs), None, seed)
     # Scripted agents: catches, the weld (the held ball moves with the hand), the two-ball release.
-    agent_cases = [("oracle", "EyeCatchOracle-v0")] + [(FAMILY_AGENT[family_of(i)], i) for i in ids]
+    agent_cases = [case for f in families() for case in f.golden_extra]
+    agent_cases += [(family_for(i).golden_agent, i) for i in ids]
     for agent, env_id in agent_cases:
         for seed in SEEDS:
             out[f"{env_id}/agent:{agent}/{seed}"] = (env_id, {}, agent, seed)
