@@ -38,6 +38,7 @@ from visuomotor_gym.baselines.crowding import crowded
 from visuomotor_gym.body.walker import GaitParams
 from visuomotor_gym.body.walker_body import TurningWalkerBody as WalkerBody
 from visuomotor_gym.envs.stones import STONES_LAYOUT
+from visuomotor_gym.oculomotor.plant import OculomotorParams
 from visuomotor_gym.registration import env_vision, env_vision_params
 from visuomotor_gym.tasks.stepping_stones import FOOT_CENTRE_AHEAD_M, K_SLOTS
 from visuomotor_gym.vision.foveation import VisionParams
@@ -48,6 +49,14 @@ _S = STONES_LAYOUT.slices
 DEG = math.pi / 180.0
 NECK_PITCH_DOWN_DEG = 50.0  # the head action's -1 (envs_assets/common/head_eye.xml: neck_pitch -50 .. 40)
 NECK_YAW_DEG = 80.0  # the head action's +-1 (neck_yaw -80 .. 80)
+# The plant's fixation range, onto which the fixation action is log-mapped (core.eye.Eye.command).
+_LOG_FIX = tuple(math.log(x) for x in OculomotorParams().fixation_range_m)
+
+
+def fixation_action(distance: float) -> float:
+    """The fixation action that asks for vergence at ``distance`` m (the log map of ``Eye.command``)."""
+    lo, hi = _LOG_FIX
+    return min(max(2.0 * (math.log(distance) - lo) / (hi - lo) - 1.0, -1.0), 1.0)
 
 
 @dataclass(frozen=True)
@@ -70,6 +79,31 @@ class LookaheadParams:
     turn_margin_deg: float = 0.5
     # Nominal spacing used to extrapolate a stone not seen yet (the middle of ALLSTEPS' 0.65-0.85 m).
     spacing_m: float = 0.75
+    # Where gaze goes once a footstep is latched: True, to the first stone no foothold is planned for yet
+    # (as soon as the foothold onto the stone before it is committed: ~0.5 s of fixation before its own
+    # footstep is read, fixations 2-3 steps ahead as on rough terrain, Matthis, Yates & Hayhoe 2018);
+    # False, to the stone after the one the swinging foot is headed for (the switch comes as that foot's
+    # swing starts, Eom et al. 2019 section 7; ~0.2 s before the read). None: True when the agent's vision
+    # model crowds (VisionParams.crowding: before the eye gets there, a stone is seen pooled with its
+    # neighbours, so the footstep needs the fixation's own samples), else False (the original agent).
+    look_past_plan: bool | None = None
+    # Which samples the stone memory fuses with the crowding zone's spread (baselines.crowding.crowd_std)
+    # instead of the vision model's own: True, every sample farther than VisionParams.crowding_fovea_deg
+    # from the line of sight (a flanker the observation does not report -- a hazard beside the stone, a
+    # stone outside the slots -- may have pooled it: only the fixation's own samples are trusted); False,
+    # only those with another slot's stone within the critical spacing (baselines.crowding.crowded).
+    # None: True when the agent's vision model crowds (modelling choice), else False.
+    distrust_periphery: bool | None = None
+
+
+def beyond_fovea(directions, fovea_rad: float) -> set[int]:
+    """Indices of the eye-frame vectors (x along the line of sight) farther than ``fovea_rad`` from it."""
+    out = set()
+    for i, (x, y, z) in enumerate(directions):
+        n = math.sqrt(x * x + y * y + z * z)
+        if n > 0.0 and math.acos(max(-1.0, min(1.0, x / n))) > fovea_rad:
+            out.add(i)
+    return out
 
 
 class LookaheadAgent:
@@ -144,8 +178,13 @@ class LookaheadAgent:
         seen = [_S[f"stone_{k}"].start for k in range(K_SLOTS) if ol[_S[f"stone_{k}"].start + 4] > 0.0]
         # with crowding in the vision model, a sample that may be pooled with a neighbour's is fused with the
         # spread of its crowding zone (baselines.crowding)
-        drop = crowded([ol[b + 1:b + 4] for b in seen], [round(ol[b]) for b in seen], self.vision) \
-            if self.vision.crowding else ()
+        crowding = bool(getattr(self.vision, "crowding", False))
+        distrust = self.params.distrust_periphery if self.params.distrust_periphery is not None else crowding
+        if distrust and self.vision.foveated:
+            drop = beyond_fovea([ol[b + 1:b + 4] for b in seen], self.vision.crowding_fovea_deg * DEG)
+        else:
+            drop = crowded([ol[b + 1:b + 4] for b in seen], [round(ol[b]) for b in seen], self.vision) \
+                if crowding else ()
         for n, b in enumerate(seen):
             self.memory.add(round(ol[b]), ol[b + 1:b + 4], seen_pose[0], seen_pose[1], seen_pose[2], prev,
                             self.params.control_dt, crowded=n in drop)
@@ -218,7 +257,9 @@ class LookaheadAgent:
     # --- gaze ---------------------------------------------------------------------------------
     def _look(self, obs: np.ndarray, pose) -> list:
         p = self.params
-        target = min(self.next_stone + 1, self.planned_stone + 1)
+        past = p.look_past_plan if p.look_past_plan is not None else bool(getattr(self.vision, "crowding", False))
+        target = self.planned_stone + 1 if past and self.planned_stone >= 0 else min(self.next_stone + 1,
+                                                                                      self.planned_stone + 1)
         xy = self.stone_xy(target)
         eye_pos, rot, odo = pose
         c, s = math.cos(odo[2]), math.sin(odo[2])
@@ -237,6 +278,11 @@ class LookaheadAgent:
         pitch = math.atan2(-dz, math.hypot(wx, wy))  # below the horizontal, positive
         yaw = math.atan2(wy, wx)
         r = self.gaze_range
-        return [min(max(d_az / r, -1.0), 1.0), min(max(d_el / r, -1.0), 1.0), 0.0,
+        # Vergence: without the depth law in the agent's vision model the action's midpoint, 1.4 m (the
+        # original agent); with it (depth precise only near the vergence distance, Blakemore 1970) on the
+        # gaze target, as humans verge on the fixated point (modelling choice; the iwao agent does the same).
+        verge = 0.0 if self.vision.depth_pedestal_arcmin is None else \
+            fixation_action(min(max(math.sqrt(dx * dx + dy * dy + dz * dz), 0.3), 20.0))
+        return [min(max(d_az / r, -1.0), 1.0), min(max(d_el / r, -1.0), 1.0), verge,
                 min(max(p.head_share * yaw / (NECK_YAW_DEG * DEG), -1.0), 1.0),
                 min(max(-p.head_share * pitch / (NECK_PITCH_DOWN_DEG * DEG), -1.0), 0.0)]

@@ -27,6 +27,9 @@ EyePose = tuple  # (eye position (3), eye axes as rows of a 3x3, columns = axes)
 STONE_PLANE_Z = STONE_TOP_Z
 MIN_STD_M = 1e-4  # a floor for the noiseless oracle rung (its information would be infinite)
 MIN_DEPRESSION = 0.02  # rad: a direction this close to the horizon says little about where on the plane
+# With the depth law (VisionParams.depth_pedestal_arcmin), a sample perceived nearer than this share of
+# the distance to the plane along its direction is dropped (modelling choice; see StoneMemory.add).
+NEAR_GATE = 0.5
 
 
 class _Stone:
@@ -103,6 +106,11 @@ class StoneMemory:
         c, s = math.cos(yaw), math.sin(yaw)
         eye_h = pz + eye_pos[2] - STONE_PLANE_Z  # the eye's height over the plane
         t = eye_h / dep  # distance along the line of sight to the plane
+        if self.vision.depth_pedestal_arcmin is not None and d < NEAR_GATE * t:
+            # With the depth law the depth noise can bring a point far nearer the eye than the plane, and
+            # the lateral noise then bends its direction by degrees: its eccentricity, and the std the
+            # model gives it, are not to be trusted (modelling choice: such samples are dropped).
+            return
         hx, hy = (c * lx - s * ly) / d, (s * lx + c * ly) / d  # horizontal part of the unit line of sight
         exw, eyw = ox + c * eye_pos[0] - s * eye_pos[1], oy + s * eye_pos[0] + c * eye_pos[1]
         px, py = exw + t * hx, eyw + t * hy
@@ -110,7 +118,15 @@ class StoneMemory:
         # d it is an angle s_lat / d, which is t s_lat / d across the line of sight on the plane.
         est = self.estimate(index)
         qx, qy = est[0] if est is not None else (px, py)
-        slip = self.retinal_slip(qx, qy, self.eye_pose(eye_pos, rot_rows, odo), prev, dt)
+        pose = self.eye_pose(eye_pos, rot_rows, odo)
+        slip = self.retinal_slip(qx, qy, pose, prev, dt)
+        if self.vision.periphery_on and est is not None:
+            # With the human periphery a far-peripheral sample can be bent by many degrees (the position
+            # law, slip, a near depth), landing near the line of sight: its noise is then modelled at the
+            # larger of its perceived eccentricity and that of the stone's current estimate (modelling
+            # choice; without it one such sample, taken for a foveal one, can move the estimate by metres).
+            u = self._in_eye(pose, qx, qy, STONE_PLANE_Z)
+            ecc = max(ecc, math.acos(max(-1.0, min(1.0, u[0]))))
         s_lat = max(_sigmas(t, ecc, slip, self.vision)[1] * t / d, MIN_STD_M)
         if crowded:
             s_lat = max(s_lat, crowd_std(t, ecc, self.vision))

@@ -29,6 +29,7 @@ from visuomotor_gym.tasks.stepping_stones import (
     TRAILING_BLOCKS,
     CourseDistribution,
     SteppingStonesTask,
+    course_preset,
 )
 
 __all__ = ["STONES_LAYOUT", "SteppingStonesEnv"]
@@ -140,7 +141,8 @@ class SteppingStonesEnv(WalkerEnv):
     reward_terms = REWARD_TERMS
     body_class = TurningWalkerBody
     argument_meanings = {  # noqa: RUF012  (read only: the generated Arguments table)
-        "course_distribution": "``CourseDistribution`` or dict",
+        "course_distribution": ('``CourseDistribution``, dict, or a preset name: ``"rough"`` (small stones among '
+                                'hazards; ``COURSE_PRESETS`` in ``visuomotor_gym.tasks.stepping_stones``)'),
         "vision": ('``"foveated"``, ``"full_view"`` (foveal noise everywhere, no field-of-view limit, no saccadic '
                    'blindness) or ``"oracle"`` (true stone centres)'),
         "render_camera": '``"both"`` (side view beside the eye view), ``"side"``, ``"follow"``, ``"scene"``, ``"eye"``',
@@ -151,10 +153,13 @@ class SteppingStonesEnv(WalkerEnv):
         self,
         render_mode: str | None = None,
         *,
-        course_distribution: CourseDistribution | dict | None = None,
+        course_distribution: CourseDistribution | dict | str | None = None,
         **shared: Any,
     ):
+        if isinstance(course_distribution, str):  # a named preset ("rough")
+            course_distribution = course_preset(course_distribution)
         self.course_distribution = args.coerce(CourseDistribution, course_distribution, "course_distribution")
+        self.scene = self.course_distribution.scene  # stones_rough.xml when the course has hazards
         super().__init__(render_mode, **shared)
 
     def _build_task(self, body: TurningWalkerBody) -> SteppingStonesTask:

@@ -34,21 +34,26 @@ read) the slots reach two stones beyond it, as the walker must see >= 2 steps ah
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import mujoco
 import numpy as np
 
 from visuomotor_gym.body import walker_names as wn
 from visuomotor_gym.core import args
-from visuomotor_gym.core.args import Int, Num, Pair
+from visuomotor_gym.core.args import Int, Num, Optional, Pair
 from visuomotor_gym.core.observation import Block
 from visuomotor_gym.core.parts import Task
 from visuomotor_gym.core.retina import PointTarget
 
 STONES_SCENE = "stones.xml"
+ROUGH_SCENE = "stones_rough.xml"  # stones.xml plus HAZARD_POOL hazards (the "rough" preset)
 STONE_POOL = 16  # stone bodies in stones.xml (>= n_stones)
 STONE_NAMES = tuple(f"stone_{i:02d}" for i in range(STONE_POOL))  # mocap bodies and their cylinder geoms
+HAZARD_POOL = 32  # hazard bodies in stones_rough.xml (>= n_stones * hazards_per_stone)
+HAZARD_NAMES = tuple(f"hazard_{i:02d}" for i in range(HAZARD_POOL))
+# Tries to place one hazard clear of every stone and hazard before it is left out (modelling choice).
+HAZARD_TRIES = 50
 SLAB = "start_slab"
 STONES_SCENE_CAMERA = "stones_scene"
 STONE_TOP_Z = -0.005  # stones.xml: tops 5 mm below the soles' planned height (sensing, not pushing)
@@ -57,6 +62,9 @@ K_SLOTS = 4
 # course steppable only through a sliver of headings would ask the agent for sub-degree precision).
 MIN_HEADING_FREEDOM = math.radians(1.0)
 FOOT_CENTRE_AHEAD_M = 0.07  # walker_body.xml: the foot box's centre is 7 cm ahead of the ankle (the foothold)
+STONE_RADIUS_M = 0.25  # stones.xml's stones (ALLSTEPS, Xie et al. 2020); the task reads it from the model
+SLAB_FAR_EDGE_M = 2.3  # stones.xml: the slab's far edge (x), 2.3 m ahead of the first heel strike
+HAZARD_RGBA = (0.42, 0.30, 0.24, 1.0)
 REWARD_TERMS = ("finish", "fall", "stone", "progress")
 DEFAULT_REWARD_WEIGHTS = {"finish": 1.0, "fall": -1.0, "stone": 0.0, "progress": 0.0}
 LAST_STONE_RGBA = (0.20, 0.65, 0.30, 1.0)
@@ -76,6 +84,11 @@ STONES_RULES = {
     "turn_slack_deg": Num(0.0, 45.0),
     "start_foot_x_m": Num(0.0, 10.0),
     "start_foot_y_m": Num(-1.0, 1.0),
+    "stone_radius_m": Optional(Num(0.08, 0.25)),
+    "hazards_per_stone": Int(0, 4),
+    "hazard_radius_m": Num(0.05, 0.25),
+    "hazard_distance_m": Pair(Num(0.1, 1.5)),
+    "hazard_clearance_m": Num(0.0, 0.5),
 }
 
 
@@ -93,15 +106,59 @@ class CourseDistribution:
     turn_slack_deg: float = 5.0  # modelling choice: a steppable course needs turns 5 deg short of the gait's limit
     start_foot_x_m: float = 1.95 + FOOT_CENTRE_AHEAD_M  # nominal foot centre of the last foothold on the slab
     start_foot_y_m: float = -0.06  # ... (the right foot, half the 0.12 m nominal step width to the right)
+    # --- the "rough" terrain (issue 23; off by default: the fields below leave the course as above) ---
+    # Radius of every stone (m); None: the scene's 0.25 m (ALLSTEPS).
+    stone_radius_m: float | None = None
+    # Hazards (loose rocks that do not hold a foot: a foot landing on one falls) drawn beside each stone;
+    # 0: none, and the plain scene (stones.xml) without them.
+    hazards_per_stone: int = 0
+    hazard_radius_m: float = 0.12  # radius of a hazard (used only with hazards)
+    hazard_distance_m: tuple[float, float] = (0.3, 0.45)  # centre of a hazard from its stone's centre
+    hazard_clearance_m: float = 0.05  # the least gap between a hazard's rim and any stone's or hazard's rim
 
     def __post_init__(self) -> None:
         args.check_fields(self, STONES_RULES)
+        if self.n_stones * self.hazards_per_stone > HAZARD_POOL:
+            raise ValueError(f"course_distribution.hazards_per_stone * n_stones must be <= {HAZARD_POOL} (the "
+                             f"hazards of {ROUGH_SCENE}); got {self.hazards_per_stone} * {self.n_stones}")
+
+    @property
+    def scene(self) -> str:
+        """The scene file this distribution needs: ``stones_rough.xml`` with hazards, else ``stones.xml``."""
+        return ROUGH_SCENE if self.hazards_per_stone else STONES_SCENE
+
+
+# The opt-in course presets (``SteppingStonesEnv(course_distribution="rough")``). "rough" (issue 23; its
+# measurements in docs/reproductions/data/terrain/stepping_stones.md): footholds that must be located
+# precisely and early, among clutter where crowding acts. Stones of radius 0.15 m (modelling choice: a
+# 30 cm stone, the midfoot must land within 15 cm of its centre, where ALLSTEPS' 0.25 m stones leave 25 cm),
+# the path as ALLSTEPS draws it (spacing 0.65-0.85 m, turns up to +-30 deg per step), and beside each stone
+# two hazards (loose rocks, radius 0.12 m, 0.3-0.45 m from the stone's centre, at least 5 cm rim to rim
+# from any other rock: modelling choices). A hazard is a flanker of the stone's own kind: seen more than
+# about twice its angular distance from the line of sight (Bouma's critical spacing, b = 0.5), the stone
+# is pooled with it (crowding, VisionParams.crowding) and its perceived centre moves toward the hazard by
+# about a third to a half of their distance, 10-22 cm, beyond what the stone's radius forgives.
+COURSE_PRESETS = {
+    "rough": {"stone_radius_m": 0.15, "hazards_per_stone": 2, "hazard_radius_m": 0.12,
+              "hazard_distance_m": (0.3, 0.45), "hazard_clearance_m": 0.05},
+}
+
+
+def course_preset(name: str) -> CourseDistribution:
+    """The :class:`CourseDistribution` of a named preset (:data:`COURSE_PRESETS`)."""
+    if name not in COURSE_PRESETS:
+        raise ValueError(f"course_distribution={name!r} is not a preset; allowed: {sorted(COURSE_PRESETS)} "
+                         "(or a CourseDistribution, a dict of its fields, or None)")
+    return CourseDistribution(**COURSE_PRESETS[name])
 
 
 @dataclass(frozen=True)
 class Course:
     stones: np.ndarray  # (N, 2): centre x, y of each stone's top (world, the walker starts at the origin)
     headings: np.ndarray  # (N,): direction (rad) from the previous stone (stone 0: from the last slab foot)
+    # (M, 2): centre x, y of each hazard ("rough" terrain; none by default) and (M,): the stone it flanks
+    hazards: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    hazard_of: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
 
 
 def sample_course(rng: np.random.Generator, dist: CourseDistribution, lateral_range: tuple[float, float],
@@ -139,7 +196,41 @@ def sample_course(rng: np.random.Generator, dist: CourseDistribution, lateral_ra
         rows.append((nx, ny))
         heads.append(new_psi)
         x, y, psi = nx, ny, new_psi
-    return Course(np.array(rows, dtype=float).reshape(-1, 2), np.array(heads, dtype=float))
+    stones = np.array(rows, dtype=float).reshape(-1, 2)
+    if not dist.hazards_per_stone:  # the default course: no further draw
+        return Course(stones, np.array(heads, dtype=float))
+    hazards, owner = sample_hazards(rng, dist, stones)
+    return Course(stones, np.array(heads, dtype=float), hazards, owner)
+
+
+def sample_hazards(rng: np.random.Generator, dist: CourseDistribution, stones: np.ndarray,
+                   stone_radius: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """``dist.hazards_per_stone`` hazards beside each stone, in stone order: a direction uniform round the
+    stone and a centre distance uniform in ``hazard_distance_m``, redrawn (up to :data:`HAZARD_TRIES`
+    times, else left out) until its rim clears every stone's and every earlier hazard's rim by
+    ``hazard_clearance_m`` and it lies beyond the slab's far edge (x > 2.3 m, so no foot on the slab
+    stands beside one). Returns the (M, 2) centres and the (M,) index of the stone each flanks."""
+    r_s = dist.stone_radius_m if stone_radius is None else stone_radius
+    r_s = STONE_RADIUS_M if r_s is None else r_s
+    r_h, gap = dist.hazard_radius_m, dist.hazard_clearance_m
+    placed: list[tuple[float, float]] = []
+    owner: list[int] = []
+    for i, (cx, cy) in enumerate(stones.tolist()):
+        for _ in range(dist.hazards_per_stone):
+            for _ in range(HAZARD_TRIES):
+                a = float(rng.uniform(-math.pi, math.pi))
+                r = float(rng.uniform(*dist.hazard_distance_m))
+                hx, hy = cx + r * math.cos(a), cy + r * math.sin(a)
+                if hx - r_h <= SLAB_FAR_EDGE_M:
+                    continue
+                if any((hx - sx) ** 2 + (hy - sy) ** 2 < (r_s + r_h + gap) ** 2 for sx, sy in stones.tolist()):
+                    continue
+                if any((hx - px) ** 2 + (hy - py) ** 2 < (2.0 * r_h + gap) ** 2 for px, py in placed):
+                    continue
+                placed.append((hx, hy))
+                owner.append(i)
+                break
+    return np.array(placed, dtype=float).reshape(-1, 2), np.array(owner, dtype=int)
 
 
 def check_steppable(dist: CourseDistribution, gait) -> None:
@@ -191,7 +282,23 @@ class SteppingStonesTask(Task):
         self.slab = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, SLAB)
         if min(self.geoms + [self.slab]) < 0:
             raise ValueError(f"the model lacks stones or the slab: is it envs_assets/{STONES_SCENE}?")
+        if self.dist.stone_radius_m is not None:  # the course's own stones (the "rough" preset)
+            for g in self.geoms:
+                m.geom_size[g, 0] = self.dist.stone_radius_m
         self.radius = float(m.geom_size[self.geoms[0], 0])  # one source: the XML (0.25 m, ALLSTEPS)
+        # The hazards ("rough" terrain): in stones_rough.xml only.
+        self.hazard_geoms, self.hazard_mocap, self._hazard_park = [], [], []
+        if self.dist.hazards_per_stone:
+            for n in HAZARD_NAMES:
+                g = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, n)
+                if g < 0:
+                    raise ValueError(f"the model lacks hazards: course_distribution.hazards_per_stone needs "
+                                     f"envs_assets/{ROUGH_SCENE}")
+                b = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, n)
+                m.geom_size[g, 0] = self.dist.hazard_radius_m
+                self.hazard_geoms.append(g)
+                self.hazard_mocap.append(int(m.body_mocapid[b]))
+                self._hazard_park.append(m.body_pos[b].copy())
         half_height = float(m.geom_size[self.geoms[0], 1])
         self._stone_z = STONE_TOP_Z - half_height
         sx, sy = m.geom_pos[self.slab, :2]
@@ -201,6 +308,8 @@ class SteppingStonesTask(Task):
         self.support_of_geom[self.slab] = -1
         self.feet = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, wn.WALKER_LEG_GEOMS[s][2]) for s in (0, 1)]
         self.all_targets = [PointTarget(n) for n in STONE_NAMES]
+        # Hazards are seen as the stones are (the centre of the top; the same kind, so they crowd them).
+        self.hazard_targets = [PointTarget(n) for n in HAZARD_NAMES[:len(self.hazard_geoms)]]
         self.targets = self.all_targets
         self.course = Course(np.zeros((0, 2)), np.zeros(0))
         self.reset_state()
@@ -229,6 +338,15 @@ class SteppingStonesTask(Task):
             d.mocap_pos[self.mocap[i]] = (x, y, self._stone_z)
             m.geom_rgba[self.geoms[i]] = LAST_STONE_RGBA if i == n - 1 else STONE_RGBA
             self.targets[i].place(x, y, STONE_TOP_Z)
+        if self.hazard_geoms:  # after the stones in the target list: the observation's slots index the stones
+            for k, t in enumerate(self.hazard_targets):
+                t.hidden = True
+                d.mocap_pos[self.hazard_mocap[k]] = self._hazard_park[k]
+            for k, (x, y) in enumerate(course.hazards.tolist()):
+                d.mocap_pos[self.hazard_mocap[k]] = (x, y, self._stone_z)
+                m.geom_rgba[self.hazard_geoms[k]] = HAZARD_RGBA
+                self.hazard_targets[k].place(x, y, STONE_TOP_Z)
+            self.targets = self.targets + self.hazard_targets[:len(course.hazards)]
         self._prev_x = float(d.qpos[0])
 
     def initial_gaze(self) -> tuple[np.ndarray, tuple[float, float]]:
@@ -237,7 +355,11 @@ class SteppingStonesTask(Task):
 
     # --- what the evaluator records ----------------------------------------------------------
     def trace_episode_fields(self) -> dict:
-        return {"stones": self.course.stones.copy(), "stone_radius": self.radius}
+        fields = {"stones": self.course.stones.copy(), "stone_radius": self.radius}
+        if self.hazard_geoms:
+            fields.update(hazards=self.course.hazards.copy(), hazard_of=self.course.hazard_of.copy(),
+                          hazard_radius=self.dist.hazard_radius_m)
+        return fields
 
     @staticmethod
     def trace_final_fields(info: dict) -> dict:
@@ -290,12 +412,17 @@ class SteppingStonesTask(Task):
         """Sample only the slots' stones (the others cannot reach the observation)."""
         if self._slots_for != self.next_stone:
             n = self.next_stone
-            for i, t in enumerate(self.targets):
+            n_stones = len(self.course.stones)
+            for i, t in enumerate(self.targets[:n_stones]):
+                t.hidden = not (n <= i < n + K_SLOTS)
+            # a hazard is sampled while the stone it flanks is in a slot (modelling choice: the clutter
+            # around the footholds the observation reports; farther rocks could only add crowding)
+            for t, i in zip(self.targets[n_stones:], self.course.hazard_of.tolist()):
                 t.hidden = not (n <= i < n + K_SLOTS)
             self._slots_for = n
 
     def observe_leading(self, values: list, samples: list) -> None:
-        n_targets = len(samples)
+        n_targets = len(self.course.stones)  # the stones come first in the target list (hazards after them)
         for k in range(K_SLOTS):
             i = self.next_stone + k
             values.append(float(i))
@@ -337,4 +464,5 @@ class SteppingStonesTask(Task):
         }
 
 
-__all__ = ["K_SLOTS", "STONES_SCENE", "Course", "CourseDistribution", "SteppingStonesTask", "sample_course"]
+__all__ = ["COURSE_PRESETS", "K_SLOTS", "ROUGH_SCENE", "STONES_SCENE", "Course", "CourseDistribution", "SteppingStonesTask",
+           "course_preset", "sample_course", "sample_hazards"]

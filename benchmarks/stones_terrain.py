@@ -1,0 +1,116 @@
+"""SteppingStones terrain sweep (issue 23): an agent, its held twin and static twins on a course preset
+under the human periphery, with success, failure causes and the stones realism score.
+
+Each condition is a set of ``SteppingStonesEnv`` keyword arguments (``course_distribution`` preset,
+``vision_params`` fields over the walk family's); every agent plays the same seeds (episode ``i``
+resets with ``seed + i``, as ``vmgym bench``) and is given the env's exact ``VisionParams``
+(``agents.match_vision``: its stone memory weights samples, and flags crowded ones, with the eye's own
+model). Agent specs are those of ``make_agent`` (``lookahead``, ``gaze_blind:lookahead``,
+``static_gaze:az=0,el=-35,neck_yaw=0,neck_pitch=-15:lookahead``...).
+
+    OPENBLAS_CORETYPE=Haswell nice -n 10 .venv/bin/python benchmarks/stones_terrain.py --episodes 40 \\
+        --conditions "rough + all four" --agents lookahead,gaze_blind:lookahead \\
+        --out docs/reproductions/data/terrain/stepping_stones_sweep.json
+
+Writes a JSON (conditions, rows: agent, per-seed outcomes, rate with its 95 % Wilson interval, failure
+causes, realism score and components, wall time). ``--resume`` keeps the rows of the file already there.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+ENV_ID = "SteppingStones-v0"
+# The four mechanisms of visuomotor_gym.vision.periphery with the values of the periphery sweep
+# (benchmarks/periphery_sweep.py: E2_pos 0.7 deg unconfirmed, Bouma b = 0.5, 10 arcmin pedestal, the
+# human field of Spector 1990).
+ALL_FOUR = {"field_shape": "human", "position_e2_deg": 0.7, "crowding": True, "depth_pedestal_arcmin": 10.0}
+CONDITIONS = {
+    "default": {},
+    "default + all four": {"vision_params": ALL_FOUR},
+    "rough": {"course_distribution": "rough"},
+    "rough + human field": {"course_distribution": "rough", "vision_params": {"field_shape": "human"}},
+    "rough + human field + crowding": {"course_distribution": "rough",
+                                       "vision_params": {"field_shape": "human", "crowding": True}},
+    "rough + human field + crowding + position E2": {
+        "course_distribution": "rough", "vision_params": {"field_shape": "human", "crowding": True, "position_e2_deg": 0.7}},
+    "rough + human field + crowding + depth": {
+        "course_distribution": "rough", "vision_params": {"field_shape": "human", "crowding": True,
+                                                          "depth_pedestal_arcmin": 10.0}},
+    "rough + all four": {"course_distribution": "rough", "vision_params": ALL_FOUR},
+}
+
+
+def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
+    if n == 0:
+        return 0.0, 1.0
+    p = k / n
+    c = p + z * z / (2 * n)
+    s = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n))
+    return (c - s) / (1 + z * z / n), (c + s) / (1 + z * z / n)
+
+
+def play(agent: str, kwargs: dict, seeds: list[int]) -> tuple[list, dict]:
+    import gymnasium as gym
+
+    from visuomotor_gym.agents import make_agent, match_vision
+    from visuomotor_gym.bench.trace import run_episode
+    from visuomotor_gym.metrics.stones_realism import stones_gaze_realism
+
+    env = gym.make(ENV_ID, **kwargs)
+    policy = make_agent(agent, ENV_ID, int(env.action_space.shape[0]), seed=seeds[0])
+    match_vision(policy, env.unwrapped.vision_params)
+    traces = [run_episode(env, policy, seed=s, env_id=ENV_ID, agent=agent) for s in seeds]
+    env.close()
+    return traces, stones_gaze_realism(traces)
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--episodes", type=int, default=40)
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--agents", default="lookahead,gaze_blind:lookahead")
+    ap.add_argument("--conditions", default="rough + all four", help="comma-separated condition names")
+    ap.add_argument("--out", required=True)
+    ap.add_argument("--resume", action="store_true")
+    args = ap.parse_args(argv)
+    sys.path.insert(0, str(ROOT))
+    import visuomotor_gym  # noqa: F401  (registers the ids)
+
+    out = Path(args.out)
+    rows = json.loads(out.read_text())["rows"] if args.resume and out.exists() else []
+    seeds = list(range(args.seed, args.seed + args.episodes))
+    for name in args.conditions.split(","):
+        kwargs = CONDITIONS[name]
+        for agent in args.agents.split(";") if ";" in args.agents else args.agents.split(","):
+            t0 = time.time()
+            traces, realism = play(agent, kwargs, seeds)
+            ok = [bool(tr.success) for tr in traces]
+            why = ["success" if tr.success else "fell" if tr.task.get("fell") else "other" for tr in traces]
+            k, n = sum(ok), len(ok)
+            lo, hi = wilson(k, n)
+            rows = [r for r in rows if not (r["condition"] == name and r["agent"] == agent and r["seed"] == args.seed)]
+            rows.append({"condition": name, "kwargs": kwargs, "agent": agent, "seed": args.seed, "episodes": n,
+                         "success": k, "rate": k / n, "wilson95": [round(lo, 4), round(hi, 4)],
+                         "outcomes": {r: why.count(r) for r in sorted(set(why))},
+                         "realism": round(float(realism["score"]), 4),
+                         "realism_components": {c: {kk: (round(v, 4) if isinstance(v, float) else v)
+                                                    for kk, v in d.items()}
+                                                for c, d in realism["components"].items()},
+                         "seconds": round(time.time() - t0, 1), "per_seed": [int(o) for o in ok]})
+            print(f"{name:32s} {agent:40s} {100 * k / n:5.1f} % [{100 * lo:4.1f}, {100 * hi:4.1f}] "
+                  f"realism {realism['score']:.3f} {rows[-1]['outcomes']} ({rows[-1]['seconds']} s)", flush=True)
+            out.parent.mkdir(parents=True, exist_ok=True)
+            out.write_text(json.dumps({"env": ENV_ID, "command": " ".join(sys.argv), "conditions": CONDITIONS,
+                                       "rows": rows}, indent=1) + "\n")
+    print(f"wrote {out}")
+
+
+if __name__ == "__main__":
+    main()
