@@ -371,11 +371,12 @@ class _Scorer:
     episode succeeds (``bar``: the k-th best complete score so far, so the pruning never changes which
     postures make the top k; ties continue, as the tie rule might favour the newcomer)."""
 
-    def __init__(self, env_id: str, agent: str, design_seed: int, log=None):
+    def __init__(self, env_id: str, agent: str, design_seed: int, log=None, env_kwargs: dict | None = None):
         from visuomotor_gym.bench.evaluate import make_env
 
         self.env_id, self.agent, self.design_seed = env_id, agent, design_seed
-        self.env = make_env(env_id)
+        self.env_kwargs = dict(env_kwargs or {})
+        self.env = make_env(env_id) if not self.env_kwargs else _make_env_with(env_id, self.env_kwargs)
         self.results: dict[Posture, list[bool]] = {}
         self.stage_of: dict[Posture, str] = {}
         self.log = log or (lambda *_: None)
@@ -402,7 +403,9 @@ class _Scorer:
                 break
             if len(have) >= RACE_MIN_EPISODES and wilson_upper(sum(have), len(have)) < race:
                 break
-            have.extend(tr.success for tr in run_chunk(spec, self.env_id, chunk_seeds, env=self.env))
+            traces = run_chunk(spec, self.env_id, chunk_seeds, env=self.env) if not self.env_kwargs \
+                else run_chunk_with(spec, self.env_id, chunk_seeds, self.env)
+            have.extend(tr.success for tr in traces)
             self.episodes_played += len(chunk_seeds)
         complete = len(have) >= episodes
         if len(have) > before or not complete:
@@ -434,10 +437,33 @@ class _Scorer:
         self.env.close()
 
 
+def _make_env_with(env_id: str, env_kwargs: dict):
+    """``gymnasium.make(env_id, **env_kwargs)``, refusing anything but a dict of keyword arguments."""
+    import gymnasium as gym
+
+    import visuomotor_gym  # noqa: F401
+
+    if not isinstance(env_kwargs, dict) or not all(isinstance(k, str) for k in env_kwargs):
+        raise TypeError(f"env_kwargs must be a dict of the env's keyword arguments, got {env_kwargs!r}")
+    return gym.make(env_id, **env_kwargs)
+
+
+def run_chunk_with(spec: str, env_id: str, seeds: list[int], env) -> list:
+    """:func:`visuomotor_gym.bench.evaluate.run_chunk` on an env made with keyword arguments: the agent
+    (built for ``env_id``, seeded with ``seeds[0]``) is given the env's own ``VisionParams``
+    (``agents.match_vision``), as its registered id would give them."""
+    from visuomotor_gym.agents import make_agent, match_vision
+    from visuomotor_gym.bench.trace import run_episode
+
+    policy = make_agent(spec, env_id, action_dim=int(env.action_space.shape[0]), seed=int(seeds[0]))
+    match_vision(policy, env.unwrapped.vision_params)
+    return [run_episode(env, policy, seed=int(s), env_id=env_id, agent=spec) for s in seeds]
+
+
 def search(env_id: str, agent: str, *, design_seed: int = DESIGN_SEED, coarse_episodes: int = COARSE_EPISODES,
            final_episodes: int = FINAL_EPISODES, coarse_step: float = 20.0, refine_steps=(10.0, 5.0),
            refine_top: int = 3, finalists: int = 5, neck_step: float = 20.0, postures=None,
-           command: str | None = None, log=None) -> dict:
+           command: str | None = None, log=None, env_kwargs: dict | None = None) -> dict:
     """Search the best static posture of ``agent`` on ``env_id``; returns the results record.
 
     Every posture is played with :func:`visuomotor_gym.bench.evaluate.run_chunk` in ``evaluate()``'s
@@ -453,6 +479,10 @@ def search(env_id: str, agent: str, *, design_seed: int = DESIGN_SEED, coarse_ep
     4. ``neck``: at the best final line of sight, the neck at +-``neck_step`` (yaw, pitch, both) around
        the along-the-line-of-sight neck (the postures the eye can hold; none when ``neck_step`` is 0),
        on ``final_episodes`` seeds.
+
+    ``env_kwargs``: keyword arguments of the env (a course preset, ``vision_params``...; recorded in the
+    results); every posture then plays on ``gymnasium.make(env_id, **env_kwargs)`` with the agent given
+    that env's ``VisionParams`` (:func:`run_chunk_with`). Without them, the registered env as it is.
 
     A posture stops early once it cannot reach the score that selection needs (stages 1-2: the
     ``max(refine_top, finalists)``-th best on ``coarse_episodes`` seeds; 3-4: the best on
@@ -474,7 +504,9 @@ def search(env_id: str, agent: str, *, design_seed: int = DESIGN_SEED, coarse_ep
     geometry = env_geometry(env_id)
     origin = provenance(command)  # the code that runs (taken before, not after, a long search)
     started = time.perf_counter()
-    scorer = _Scorer(env_id, agent, design_seed, log=log)
+    if env_kwargs:  # refused before the search starts, not after its first posture
+        _make_env_with(env_id, env_kwargs).close()
+    scorer = _Scorer(env_id, agent, design_seed, log=log, env_kwargs=env_kwargs)
     stages = []
     keep = max(refine_top, finalists)
     try:
@@ -540,7 +572,7 @@ def search(env_id: str, agent: str, *, design_seed: int = DESIGN_SEED, coarse_ep
         scorer.close()
     wall = time.perf_counter() - started
     k = sum(scorer.results[chosen][:final_episodes])
-    return {
+    record = {
         "env_id": env_id,
         "agent": agent,
         "chosen": {**asdict(chosen), "spec": static_gaze_spec(chosen, agent), "successes": k,
@@ -566,6 +598,9 @@ def search(env_id: str, agent: str, *, design_seed: int = DESIGN_SEED, coarse_ep
         "wall_time_s": round(wall, 1),
         "provenance": origin,
     }
+    if env_kwargs:
+        record["env_kwargs"] = dict(env_kwargs)
+    return record
 
 
 def evaluate_pinned(record: dict, episodes: int = 200, seed: int = 0, workers: int = 1) -> dict:
@@ -573,10 +608,19 @@ def evaluate_pinned(record: dict, episodes: int = 200, seed: int = 0, workers: i
     from visuomotor_gym.bench.evaluate import evaluate
 
     spec = record["chosen"]["spec"]
-    result = evaluate(spec, record["env_id"], episodes, seed, workers=workers, keep_traces=True)
-    k = sum(tr.success for tr in result.traces)
+    if record.get("env_kwargs"):  # an env made with keyword arguments: played here, in one process
+        env = _make_env_with(record["env_id"], record["env_kwargs"])
+        started = time.perf_counter()
+        try:
+            traces = run_chunk_with(spec, record["env_id"], list(range(seed, seed + episodes)), env)
+        finally:
+            env.close()
+        k, wall = sum(tr.success for tr in traces), time.perf_counter() - started
+    else:
+        result = evaluate(spec, record["env_id"], episodes, seed, workers=workers, keep_traces=True)
+        k, wall = sum(tr.success for tr in result.traces), result.wall_time_s
     record["pinned"] = {"spec": spec, "seed": seed, "episodes": episodes, "successes": k,
-                        "success": k / episodes, "wall_time_s": round(result.wall_time_s, 1)}
+                        "success": k / episodes, "wall_time_s": round(wall, 1)}
     return record
 
 
@@ -662,6 +706,8 @@ def main(argv=None) -> int:
     s.add_argument("--workers", type=int, default=1, help="worker processes of the pinned evaluation")
     s.add_argument("--update-postures", action="store_true",
                    help="write the chosen posture into the package's static_postures.json")
+    s.add_argument("--env-kwargs", type=str, default=None, metavar="JSON",
+                   help='keyword arguments of the env as a JSON object, e.g. \'{"course_distribution": "rough"}\'')
     s.add_argument("--quiet", action="store_true")
     p = sub.add_parser("pinned", help="add the pinned-seed evaluation to an existing results JSON")
     p.add_argument("results")
@@ -698,11 +744,19 @@ def main(argv=None) -> int:
                 raise SystemExit(f"--postures: {item!r} is not az,el[,neck_yaw,neck_pitch]")
             postures.append(Posture(*values))
     log = None if args.quiet else (lambda line: print(line, flush=True))
+    env_kwargs = None
+    if args.env_kwargs:
+        try:
+            env_kwargs = json.loads(args.env_kwargs)
+        except json.JSONDecodeError as exc:
+            raise SystemExit(f"--env-kwargs: not JSON ({exc}): {args.env_kwargs!r}") from None
+        if not isinstance(env_kwargs, dict):
+            raise SystemExit(f"--env-kwargs must be a JSON object of the env's keyword arguments, got {args.env_kwargs!r}")
     record = search(args.env, args.agent, design_seed=args.design_seed, coarse_episodes=args.coarse_episodes,
                     final_episodes=args.final_episodes, coarse_step=args.coarse_step,
                     refine_steps=tuple(float(x) for x in args.refine_steps.split(",") if x),
                     refine_top=args.refine_top, finalists=args.finalists, neck_step=args.neck_step,
-                    postures=postures, command=command, log=log)
+                    postures=postures, command=command, log=log, env_kwargs=env_kwargs)
     if args.pinned:
         evaluate_pinned(record, episodes=args.pinned, workers=args.workers)
     out = Path(args.out)

@@ -113,7 +113,7 @@ class CourseDistribution:
     # 0: none, and the plain scene (stones.xml) without them.
     hazards_per_stone: int = 0
     hazard_radius_m: float = 0.12  # radius of a hazard (used only with hazards)
-    hazard_distance_m: tuple[float, float] = (0.3, 0.45)  # centre of a hazard from its stone's centre
+    hazard_distance_m: tuple[float, float] = (0.32, 0.45)  # centre of a hazard from its stone's centre (modelling choice)
     hazard_clearance_m: float = 0.05  # the least gap between a hazard's rim and any stone's or hazard's rim
 
     def __post_init__(self) -> None:
@@ -133,14 +133,14 @@ class CourseDistribution:
 # precisely and early, among clutter where crowding acts. Stones of radius 0.15 m (modelling choice: a
 # 30 cm stone, the midfoot must land within 15 cm of its centre, where ALLSTEPS' 0.25 m stones leave 25 cm),
 # the path as ALLSTEPS draws it (spacing 0.65-0.85 m, turns up to +-30 deg per step), and beside each stone
-# two hazards (loose rocks, radius 0.12 m, 0.3-0.45 m from the stone's centre, at least 5 cm rim to rim
+# two hazards (loose rocks, radius 0.12 m, 0.32-0.45 m from the stone's centre, at least 5 cm rim to rim
 # from any other rock: modelling choices). A hazard is a flanker of the stone's own kind: seen more than
 # about twice its angular distance from the line of sight (Bouma's critical spacing, b = 0.5), the stone
 # is pooled with it (crowding, VisionParams.crowding) and its perceived centre moves toward the hazard by
 # about a third to a half of their distance, 10-22 cm, beyond what the stone's radius forgives.
 COURSE_PRESETS = {
     "rough": {"stone_radius_m": 0.15, "hazards_per_stone": 2, "hazard_radius_m": 0.12,
-              "hazard_distance_m": (0.3, 0.45), "hazard_clearance_m": 0.05},
+              "hazard_distance_m": (0.32, 0.45), "hazard_clearance_m": 0.05},
 }
 
 
