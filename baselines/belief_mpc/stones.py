@@ -90,7 +90,7 @@ class StonesBeliefMPCParams(LookaheadParams):
     def __post_init__(self) -> None:
         for f in fields(self):
             v = getattr(self, f.name)
-            if isinstance(v, bool):
+            if isinstance(v, bool) or v is None:  # None: a LookaheadParams switch left to the vision model
                 continue
             if not math.isfinite(v) or v < 0:
                 raise ValueError(f"StonesBeliefMPCParams.{f.name} must be finite and >= 0, got {v!r}")

@@ -23,6 +23,16 @@ foothold's heading; length and width follow in that frame. An unseen stone is ex
 before it; beyond the longest step (still on the slab) the distance is split into equal nominal steps
 along the current heading.
 
+**Under the human periphery** (issue 23; each change only when the agent's vision model has the
+mechanism, so with the default vision the agent is the original one): with crowding it looks at the
+first stone no foothold is planned for yet as soon as the previous footstep is latched
+(``look_past_plan``: ~0.5 s of fixation before the read, 2-3 steps ahead as on rough terrain, Matthis,
+Yates & Hayhoe 2018) and trusts only its foveal fixes (``distrust_periphery``: every sample beyond the
+crowding-free fovea is fused with the spread of its crowding zone, since a flanker the observation does
+not report may have pooled it); with the depth law it verges on its gaze target and drops samples whose
+depth noise brought them near the eye; with any mechanism its memory models a sample's noise at the larger
+of its perceived eccentricity and that of the stone's estimate (:mod:`.perception`).
+
 ``gaze_blind=True`` holds gaze and head (gaze action 0: gaze stays level along the slab where the
 episode put it; head straight): the gaze-blind twin of DESIGN section 2, the same belief and planner.
 """

@@ -29,6 +29,16 @@ holds the percepts of the ``K_SLOTS`` = 4 next stones (slot ``k`` = stone ``n + 
 stone no foot has landed on yet): when the footstep onto stone ``n + 1`` is chosen (its mid-stance
 read) the slots reach two stones beyond it, as the walker must see >= 2 steps ahead (Matthis & Fajen
 2014) and ALLSTEPS' policy sees the next 2 targets. A stone not seen this step reads as zeros.
+
+**Rough terrain (opt-in, issue 23)**: ``course_distribution="rough"`` (:data:`COURSE_PRESETS`) keeps the
+path of the default course for the same seed (its draws come first) and adds what makes footholds hard
+to localise without looking at them: smaller stones (``stone_radius_m``) and, beside each stone,
+``hazards_per_stone`` *hazards* (loose rocks: :func:`sample_hazards`; the scene ``stones_rough.xml``) that
+never hold a foot (a foot on one stands over the gap and falls). Hazards are seen as the stones are (the
+centre of the top, :class:`~visuomotor_gym.core.retina.PointTarget` of the same kind, so with
+``VisionParams.crowding`` a stone seen in the periphery is pooled with them) while the stone they flank
+is in a slot; they never appear in the observation's slots, which hold the stones only. Every default
+field leaves the course, the scene and the draws as they were.
 """
 
 from __future__ import annotations
