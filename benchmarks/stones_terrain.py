@@ -34,6 +34,7 @@ ALL_FOUR = {"field_shape": "human", "position_e2_deg": 0.7, "crowding": True, "d
 CONDITIONS = {
     "default": {},
     "default + all four": {"vision_params": ALL_FOUR},
+    "default + human field + crowding": {"vision_params": {"field_shape": "human", "crowding": True}},
     "rough": {"course_distribution": "rough"},
     "rough + human field": {"course_distribution": "rough", "vision_params": {"field_shape": "human"}},
     "rough + human field + crowding": {"course_distribution": "rough",
@@ -45,6 +46,11 @@ CONDITIONS = {
                                                           "depth_pedestal_arcmin": 10.0}},
     "rough + all four": {"course_distribution": "rough", "vision_params": ALL_FOUR},
 }
+
+# The conditions with a static-gaze search (python -m visuomotor_gym.static_gaze search ... --env-kwargs),
+# its results in <folder>/stepping_stones_static_<slug>.json.
+STATIC_SEARCHES = {"rough + all four": "rough_all_four", "rough + human field + crowding": "rough_field_crowding",
+                   "default + all four": "default_all_four", "default + human field + crowding": "default_field_crowding"}
 
 
 def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
@@ -71,6 +77,39 @@ def play(agent: str, kwargs: dict, seeds: list[int]) -> tuple[list, dict]:
     return traces, stones_gaze_realism(traces)
 
 
+def table(sweep: Path, statics: dict[str, Path]) -> str:
+    """Markdown: condition x (baseline, held twin, best static twin, gain, realism) from the sweep JSON and,
+    per condition, a static-gaze search JSON whose chosen posture was replayed in the sweep (its row's
+    agent is the chosen spec)."""
+    rows = json.loads(sweep.read_text())["rows"]
+    by = {(r["condition"], r["agent"]): r for r in rows}
+    out = ["| condition | lookahead | held twin | best static twin (posture; design seeds) | gain | "
+           "realism (lookahead / static) |", "|---|---|---|---|---|---|"]
+    for name in CONDITIONS:
+        base, held = by.get((name, "lookahead")), by.get((name, "gaze_blind:lookahead"))
+        if base is None:
+            continue
+        static_text, static_rate, static_real = "not searched", None, "-"
+        if name in statics and statics[name].exists():
+            rec = json.loads(statics[name].read_text())
+            c = rec["chosen"]
+            row = by.get((name, c["spec"]))
+            pinned = rec.get("pinned")
+            if row is not None:
+                static_rate, static_real = row["rate"], f"{row['realism']:.3f}"
+            elif pinned is not None:
+                static_rate = pinned["success"]
+            posture = f"az {c['az']:g}, el {c['el']:g}, neck {c['neck_yaw']:g}/{c['neck_pitch']:g}"
+            static_text = (f"{100 * static_rate:.1f} % ({posture}; {c['successes']}/{c['episodes']})"
+                           if static_rate is not None else f"not replayed ({posture})")
+        best_twin = max(held["rate"] if held else 0.0, static_rate if static_rate is not None else 0.0)
+        gain = f"{100 * (base['rate'] - best_twin):+.1f}" if static_rate is not None else \
+            f"({100 * (base['rate'] - best_twin):+.1f} vs held)"
+        out.append(f"| {name} | {100 * base['rate']:.1f} % | {100 * held['rate']:.1f} % | {static_text} | {gain} | "
+                   f"{base['realism']:.3f} / {static_real} |")
+    return "\n".join(out) + "\n"
+
+
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--episodes", type=int, default=40)
@@ -79,7 +118,14 @@ def main(argv=None) -> None:
     ap.add_argument("--conditions", default="rough + all four", help="comma-separated condition names")
     ap.add_argument("--out", required=True)
     ap.add_argument("--resume", action="store_true")
+    ap.add_argument("--table", action="store_true",
+                    help="print the markdown table of --out and the static searches in its folder, play nothing")
     args = ap.parse_args(argv)
+    if args.table:
+        folder = Path(args.out).parent
+        print(table(Path(args.out), {name: folder / f"stepping_stones_static_{slug}.json"
+                                     for name, slug in STATIC_SEARCHES.items()}), end="")
+        return
     sys.path.insert(0, str(ROOT))
     import visuomotor_gym  # noqa: F401  (registers the ids)
 
@@ -88,7 +134,9 @@ def main(argv=None) -> None:
     seeds = list(range(args.seed, args.seed + args.episodes))
     for name in args.conditions.split(","):
         kwargs = CONDITIONS[name]
-        for agent in args.agents.split(";") if ";" in args.agents else args.agents.split(","):
+        # agents: comma-separated, or semicolon-separated when a spec holds commas (static_gaze postures)
+        for agent in args.agents.split(";") if ";" in args.agents or "static_gaze" in args.agents \
+                else args.agents.split(","):
             t0 = time.time()
             traces, realism = play(agent, kwargs, seeds)
             ok = [bool(tr.success) for tr in traces]
