@@ -28,7 +28,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
-from gaze_gain_sweep import _use_checkout_baselines, wilson
+from gaze_gain_sweep import _use_checkout_baselines, wilson  # noqa: E402 (after the sys.path line)
 
 # name -> VisionParams fields over the env's defaults. Values: E2_pos 0.7 deg (middle of the 0.6-0.8 deg
 # often quoted for position tasks, unconfirmed), Bouma b = 0.5, a 10-arcmin disparity pedestal doubling

@@ -32,8 +32,8 @@ Further names register with :func:`register_agent`.
 from __future__ import annotations
 
 import functools
-
-from typing import Any, Callable, Protocol, runtime_checkable
+from collections.abc import Callable
+from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
@@ -159,7 +159,7 @@ def _agent_families() -> dict[str, tuple[str, ...]]:
     out: dict[str, tuple[str, ...]] = {}
     for record in families():
         for agent in record.agents:
-            out[agent] = out.get(agent, ()) + (record.name,)
+            out[agent] = (*out.get(agent, ()), record.name)
     return out
 
 
@@ -306,7 +306,7 @@ class GazeBlind:
         return getattr(self.base, name)
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _registered_action_structure(env_id: str) -> tuple[tuple[str, int], ...]:
     import gymnasium as gym
 

@@ -39,7 +39,7 @@ NOMINAL_SPEED_M_S = 1.3  # the gait's nominal 0.65 m step per 0.5 s: the action'
 class DodgeBody(WalkerBody):
     """:class:`WalkerBody` with the ``locomotion`` (heading, speed) action block."""
 
-    action_structure = {"locomotion": 2}
+    action_structure = {"locomotion": 2}  # noqa: RUF012 (a body replaces it, never mutates it)
     n_action = 2
 
     def footstep_from_locomotion(self, a0: float, a1: float) -> tuple[float, float, float]:

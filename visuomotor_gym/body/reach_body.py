@@ -92,7 +92,7 @@ class ReachSeatedBody(SeatedBody):
             self.action_structure = {"hand_target": 3, "bezier_y1": 3, "bezier_y2": 3, "reach_duration": 1,
                                      "reach_start": 1, "grasp": 1}
             self.n_action = sum(self.action_structure.values())
-            self.observation_blocks = tuple(self.observation_blocks) + (REACH_PROGRESS_BLOCK,)
+            self.observation_blocks = (*self.observation_blocks, REACH_PROGRESS_BLOCK)
         self._reset_reach()
 
     def _reset_reach(self) -> None:

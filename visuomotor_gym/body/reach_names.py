@@ -30,7 +30,7 @@ TOP_CAMERA = "top_camera"
 CAMERAS = (SCENE_CAMERA, OVER_SHOULDER_CAMERA, TOP_CAMERA)
 
 ALL_NAMES = {
-    "body": TOWERS + (OBJECT,),
+    "body": (*TOWERS, OBJECT),
     "geom": BOARDS + PANELS + (OBJECT_GEOM,),
     "camera": CAMERAS,
 }

@@ -9,7 +9,7 @@ documentation.
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, ClassVar
 
 from visuomotor_gym.body import names
 from visuomotor_gym.body.seated import CONTROL_MODES, HAND_WORKSPACE, SEAT_ORIGIN, SeatedBody
@@ -17,11 +17,11 @@ from visuomotor_gym.control.hand import HandControlParams
 from visuomotor_gym.core import args
 from visuomotor_gym.core.env import VisuomotorEnv
 from visuomotor_gym.envs.observation import SECOND_BALL_OBSERVATION, ObservationLayout, catch_observation
-from visuomotor_gym.tasks.catch_rewards import REWARD_TERMS, SHAPED_WEIGHTS, SPARSE_WEIGHTS
 from visuomotor_gym.scenarios.throws import ThrowDistribution
 from visuomotor_gym.tasks.catch import CatchTask, catch_scene
+from visuomotor_gym.tasks.catch_rewards import REWARD_TERMS, SHAPED_WEIGHTS, SPARSE_WEIGHTS
 
-__all__ = ["EyeCatchEnv", "HAND_WORKSPACE", "SEAT_ORIGIN"]
+__all__ = ["HAND_WORKSPACE", "SEAT_ORIGIN", "EyeCatchEnv"]
 
 REWARD_MODES = ("sparse", "shaped")
 
@@ -140,7 +140,7 @@ class EyeCatchEnv(VisuomotorEnv):
       The leaderboard entries made before are superseded.
     """
 
-    render_cameras = {
+    render_cameras: ClassVar[dict[str, tuple[str, ...]]] = {
         "both": (names.SCENE_CAMERA, names.EYE_CAMERA),
         "scene": (names.SCENE_CAMERA,),
         "eye": (names.EYE_CAMERA,),

@@ -8,7 +8,7 @@ heading-and-speed action (:mod:`visuomotor_gym.body.dodge_body` over the scripte
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, ClassVar
 
 from visuomotor_gym.body import names
 from visuomotor_gym.body import walker_names as wn
@@ -108,7 +108,7 @@ class ObstacleDodgeEnv(WalkerEnv):
     * v0: initial release (issue 13).
     """
 
-    render_cameras = {
+    render_cameras: ClassVar[dict[str, tuple[str, ...]]] = {
         "both": (DODGE_TOP_CAMERA, names.EYE_CAMERA),
         "side": (wn.WALKER_SIDE_CAMERA,),
         "follow": (wn.WALKER_FOLLOW_CAMERA,),

@@ -8,7 +8,7 @@ documentation.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, ClassVar
 
 from visuomotor_gym.body import names, reach_names
 from visuomotor_gym.body.reach_body import (
@@ -117,7 +117,7 @@ class ShelfReachEnv(VisuomotorEnv):
     * v0: initial release.
     """
 
-    render_cameras = {
+    render_cameras: ClassVar[dict[str, tuple[str, ...]]] = {
         "both": (reach_names.SCENE_CAMERA, names.EYE_CAMERA),
         "scene": (reach_names.SCENE_CAMERA,),
         "eye": (names.EYE_CAMERA,),

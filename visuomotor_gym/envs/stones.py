@@ -9,7 +9,7 @@ per footstep) on ``envs_assets/stones.xml`` and the stepping-stones task
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, ClassVar
 
 from visuomotor_gym.body import names
 from visuomotor_gym.body import walker_names as wn
@@ -127,7 +127,7 @@ class SteppingStonesEnv(WalkerEnv):
       the first definition's walker kept its heading and the path stayed within +-20 deg (8 actions).
     """
 
-    render_cameras = {
+    render_cameras: ClassVar[dict[str, tuple[str, ...]]] = {
         "both": (wn.WALKER_SIDE_CAMERA, names.EYE_CAMERA),
         "side": (wn.WALKER_SIDE_CAMERA,),
         "follow": (wn.WALKER_FOLLOW_CAMERA,),
@@ -168,7 +168,7 @@ class SteppingStonesEnv(WalkerEnv):
 
 
 assert STONES_LAYOUT.structure == {b.name: b.size for b in STONES_LAYOUT.blocks}
-assert K_SLOTS == len(PERCEPT_BLOCKS)
+assert len(PERCEPT_BLOCKS) == K_SLOTS
 if SteppingStonesEnv.__doc__:
     SteppingStonesEnv.__doc__ = SteppingStonesEnv.__doc__.replace(
         "OBSERVATION_TABLE", "\n    ".join(STONES_LAYOUT.markdown_table().splitlines())

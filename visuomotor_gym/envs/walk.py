@@ -8,7 +8,7 @@ and the obstacle-walk task (:mod:`visuomotor_gym.tasks.obstacle_walk`).
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, ClassVar
 
 from visuomotor_gym.body import names
 from visuomotor_gym.body import walker_names as wn
@@ -163,7 +163,7 @@ class ObstacleWalkEnv(WalkerEnv):
       episode), bars across it, four seen points per obstacle.
     """
 
-    render_cameras = {
+    render_cameras: ClassVar[dict[str, tuple[str, ...]]] = {
         "both": (wn.WALKER_SIDE_CAMERA, names.EYE_CAMERA),
         "side": (wn.WALKER_SIDE_CAMERA,),
         "follow": (wn.WALKER_FOLLOW_CAMERA,),
@@ -206,7 +206,7 @@ class ObstacleWalkEnv(WalkerEnv):
 
 
 assert WALK_LAYOUT.structure == {b.name: b.size for b in WALK_LAYOUT.blocks}
-assert K_SLOTS == len(PERCEPT_BLOCKS)
+assert len(PERCEPT_BLOCKS) == K_SLOTS
 if ObstacleWalkEnv.__doc__:
     ObstacleWalkEnv.__doc__ = ObstacleWalkEnv.__doc__.replace(
         "OBSERVATION_TABLE", "\n    ".join(WALK_LAYOUT.markdown_table().splitlines())

@@ -173,10 +173,7 @@ def catch_reach_segment(trace) -> tuple[int, int, int] | None:
     if moving.size == 0:
         return None
     onset = int(moving[0])
-    if bool(trace.success):
-        end = hand.shape[0] - 1
-    else:
-        end = int(np.argmin(np.linalg.norm(ball - hand, axis=1)))
+    end = hand.shape[0] - 1 if bool(trace.success) else int(np.argmin(np.linalg.norm(ball - hand, axis=1)))
     if end <= onset:
         return None
     away = np.flatnonzero(np.linalg.norm(hand[onset : end + 1] - hand[end], axis=1) > ARRIVAL_RADIUS_M)
