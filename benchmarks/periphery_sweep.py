@@ -1,5 +1,5 @@
-"""Periphery sweep: what each opt-in mechanism of human peripheral vision (issue 23;
-``visuomotor_gym.vision.periphery``) does to an agent and its gaze-blind twin.
+"""Periphery sweep: what each opt-in mechanism of human peripheral vision
+(``visuomotor_gym.vision.periphery``) does to an agent and its gaze-blind twin.
 
 Each configuration is a set of ``VisionParams`` fields laid over the env's own (for ObstacleWalk-v0:
 the 20 deg field of the walk family); every agent plays the same pinned courses (episode ``i`` resets

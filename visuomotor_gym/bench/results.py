@@ -190,7 +190,7 @@ def _semantic_problems(obj: dict) -> list[tuple[str, str]]:
 
     out = []
     env_id = obj.get("env_id")
-    if isinstance(env_id, str) and env_id not in ENV_IDS:  # any family (issue 10), not only catch
+    if isinstance(env_id, str) and env_id not in ENV_IDS:  # any family, not only catch
         out.append(("$.env_id", f"{env_id!r} is not a registered environment id "
                                  f"(known: {', '.join(ENV_IDS)})"))
 

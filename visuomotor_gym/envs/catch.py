@@ -131,7 +131,7 @@ class EyeCatchEnv(VisuomotorEnv):
 
     ## Version History
 
-    * v0: initial release. Before the first release (issue 11) the default vision gained the retinal-slip
+    * v0: initial release. Before the first release the default vision gained the retinal-slip
       term of moving-target localisation (``VisionParams.position_slip_knee_deg_s`` = 2.5), so that where
       the eye looks decides the catch; the Eyecatch paper's static acuity is ``EyeCatchPaper-v0`` and
       ``EyeCatchPaperPoorVision-v0`` (x10). The oculomotor plant pursues like a human (150 ms latency,

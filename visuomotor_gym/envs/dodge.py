@@ -1,5 +1,5 @@
 """ObstacleDodge: walk to a goal while pedestrians cross the path, seen only through a foveated, saccading
-eye (issue 13; Eom et al. section 7, seed 001).
+eye (Eom, Han, Shin & Noh 2019, Sec. 7, "Moving obstacle avoidance").
 
 ``ObstacleDodgeEnv`` composes the embodiment core (:mod:`visuomotor_gym.core`), the walker with a
 heading-and-speed action (:mod:`visuomotor_gym.body.dodge_body` over the scripted gait of
@@ -105,7 +105,7 @@ class ObstacleDodgeEnv(WalkerEnv):
 
     ## Version History
 
-    * v0: initial release (issue 13).
+    * v0: initial release.
     """
 
     render_cameras: ClassVar[dict[str, tuple[str, ...]]] = {

@@ -53,7 +53,7 @@ class ShelfReachEnv(VisuomotorEnv):
     The seated upper body of the catch family (3-DOF torso, 7-DOF right arm, 2-DOF neck, cyclopean
     eye) must reach, with its right hand, an object standing on one of **30 shelf targets: three
     towers (in front, 45 deg to the right, 90 deg to the right) x five heights x two depths**, the
-    layout of Faraway, Reed & Wang (2007, seed 002), whose Bézier model of human hand paths is the
+    layout of Faraway, Reed & Wang (2007), whose Bézier model of human hand paths is the
     realism reference of this family (``visuomotor_gym.handpath``). The object is seen **only through
     the eye**: its position reaches the agent as samples of the foveated noise model (Eyecatch Eq. 1-3;
     depth noise 5 % of the distance at the fovea, growing with eccentricity), nothing outside the
@@ -93,7 +93,7 @@ class ShelfReachEnv(VisuomotorEnv):
     ## Starting State
 
     The body sits upright with the hand at its home posture, in front of the belly near the midline
-    (~(0.32, -0.05, 0.74) m: the seated analogue of seed 002's home shelf). The target is drawn
+    (~(0.32, -0.05, 0.74) m: the seated analogue of Faraway et al.'s home shelf). The target is drawn
     uniformly from the 30, with a +-1 cm jitter on its board; the gaze starts on the front tower's middle
     level between its two depths, with a 2 deg Gaussian jitter. The same seed gives the same target on
     every rung of the ladder. ``info`` at reset: ``target_index`` (0-29: tower-major, then level, then
@@ -197,7 +197,7 @@ def _action_table() -> str:
         "|---|---|---|---|",
         f"| 0-2 | - | 0-2 | hand target (catch-site centre; with bezier: the reach's end point), seat frame, mapped from [-1, 1] to x in [{x0}, {x1}], y in [{y0}, {y1}], z in [{z0}, {z1}] m |",
         "| - | 0-9 | - | torso (3) and arm (7) joint setpoints, mapped onto each joint's range |",
-        f"| - | - | 3-5, 6-8 | interior control-point offsets Y1, Y2 per metre of reach, body frame (lateral right, forward, up), [-1, 1] onto [-{BEZIER_OFFSET_RANGE}, {BEZIER_OFFSET_RANGE}] (seed 002's axis parameterisation; 0 = straight) |",
+        f"| - | - | 3-5, 6-8 | interior control-point offsets Y1, Y2 per metre of reach, body frame (lateral right, forward, up), [-1, 1] onto [-{BEZIER_OFFSET_RANGE}, {BEZIER_OFFSET_RANGE}] (Faraway et al.'s axis parameterisation; 0 = straight) |",
         f"| - | - | 9 | reach duration, [-1, 1] onto [{lo}, {hi}] s |",
         "| - | - | 10 | reach start: > 0 starts a reach from the hand reference when none is in progress |",
         "| 3 | 10 | 11 | grasp: -1 open ... 1 closed |",

@@ -1,5 +1,5 @@
-"""SteppingStones: cross a gap on stones seen only through a foveated, saccading eye (issue 13; Eom et
-al. 2019 section 7, seed 001).
+"""SteppingStones: cross a gap on stones seen only through a foveated, saccading eye (Eom, Han, Shin &
+Noh 2019, Sec. 7, "Walking on stepping stones").
 
 ``SteppingStonesEnv`` composes the embodiment core (:mod:`visuomotor_gym.core`), the turning walker
 (:class:`~visuomotor_gym.body.walker_body.TurningWalkerBody`: ObstacleWalk's body and gait with a turn
@@ -47,7 +47,7 @@ class SteppingStonesEnv(WalkerEnv):
     benchmark, Xie et al. 2020), **seeing the stones only through a human-like eye**: the same
     oculomotor plant, foveated noise (Eyecatch Eq. 1-3), saccadic suppression and vestibulo-ocular
     reflex as the catch family, and the walk family's field: a stone is seen only within **20 deg of the
-    line of sight** (Iwao et al.'s view angle while walking, seed 003 section 4.2.3). The stone two steps
+    line of sight** (Iwao et al.'s view angle while walking, Sec. 4.2.3). The stone two steps
     ahead lies ~45 deg below a level gaze: to place its feet the walker has to look down at the stones,
     as humans fixate stepping targets about two steps ahead (Patla & Vickers 2003) and shift gaze to the
     next stone as the foot starts its swing (Eom et al. 2019 section 7).
@@ -122,7 +122,7 @@ class SteppingStonesEnv(WalkerEnv):
 
     ## Version History
 
-    * v0: initial release (issue 13). Redefined in place (issue 13, ALLSTEPS' turns): the walker turns
+    * v0: initial release. Redefined in place (ALLSTEPS' turns): the walker turns
       (a fourth footstep value, the ``foothold_headings`` block) and the path may drift to +-60 deg, where
       the first definition's walker kept its heading and the path stayed within +-20 deg (8 actions).
     """

@@ -1,4 +1,4 @@
-"""The stepping-stones task (issue 13; Eom et al. 2019 section 7, seed 001): cross a gap on a path of
+"""The stepping-stones task (Eom, Han, Shin & Noh 2019, Sec. 7, "Walking on stepping stones"): cross a gap on a path of
 stones seen only through the foveated eye; a foot that lands off every support ends the episode.
 
 **Course** (:func:`sample_course`, drawn first from the env's ``np_random`` so every rung of the ladder
