@@ -289,7 +289,7 @@ def test_the_records_register_exactly_the_ids_of_before():
     got = tuple((s.id, s.entry_point.removeprefix("visuomotor_gym.envs."), s.kwargs, s.max_episode_steps, s.family)
                 for s in registration.ENV_SPECS)
     assert got == REGISTERED_BEFORE_THE_RECORDS
-    assert registration.ENV_IDS == tuple(row[0] for row in REGISTERED_BEFORE_THE_RECORDS)
+    assert tuple(row[0] for row in REGISTERED_BEFORE_THE_RECORDS) == registration.ENV_IDS
     for env_id, entry_point, kwargs, steps, _ in REGISTERED_BEFORE_THE_RECORDS:
         spec = gym.spec(env_id)
         assert (spec.entry_point, spec.kwargs, spec.max_episode_steps) == (
@@ -310,7 +310,7 @@ def test_the_old_public_names_are_derived_from_the_records():
     with pytest.raises(ValueError, match="unknown family 'swim'; known families: catch, walk"):
         family("swim")
     assert registration.POOR_VISION_SCALE == 2.0 and registration.VISUAL_DELAY_S == 0.1
-    assert registration.PAPER_VISION == {"position_slip_knee_deg_s": math.inf}
+    assert {"position_slip_knee_deg_s": math.inf} == registration.PAPER_VISION
 
 
 def test_each_record_is_declared_at_the_end_of_its_env_module():

@@ -7,9 +7,6 @@ import math
 import numpy as np
 import pytest
 import scipy.linalg
-
-import visuomotor_gym  # noqa: F401
-from visuomotor_gym.agents import make_agent
 from visuomotor_gym.baselines.belief_mpc import BeliefMPCAgent, BeliefMPCParams, ilqr
 from visuomotor_gym.baselines.belief_mpc.belief import (
     ObservationNoise,
@@ -22,6 +19,9 @@ from visuomotor_gym.baselines.belief_mpc.belief import (
 from visuomotor_gym.baselines.belief_mpc.model import GazeBeliefProblem, HandProblem, Limits
 from visuomotor_gym.baselines.belief_mpc.sequential import SequentialEyecatch
 from visuomotor_gym.baselines.eyecatch import EyecatchAgent
+
+import visuomotor_gym  # noqa: F401
+from visuomotor_gym.agents import make_agent
 from visuomotor_gym.bench.evaluate import evaluate, make_env
 from visuomotor_gym.registration import POOR_VISION_SCALE
 from visuomotor_gym.vision.foveation import DEG, VisionParams
@@ -426,7 +426,7 @@ def test_gaze_is_executed_through_the_human_plant():
         if prev_sacc and not info["in_saccade"]:
             landed.append(e)
         prev_sacc = bool(info["in_saccade"])
-        if 0.25 <= info["time"] and np.linalg.norm(rel) > 1.0:  # before the hand's reach
+        if info["time"] >= 0.25 and np.linalg.norm(rel) > 1.0:  # before the hand's reach
             ecc.append(e)
     assert info["is_success"]
     assert onsets and onsets[0] >= 0.18 - 1e-9  # human saccadic latency

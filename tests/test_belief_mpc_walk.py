@@ -7,12 +7,17 @@ import math
 import gymnasium as gym
 import numpy as np
 import pytest
+from visuomotor_gym.baselines.belief_mpc.belief import covariance_step
+from visuomotor_gym.baselines.belief_mpc.stone_belief import (
+    plan_gaze,
+    plane_variance,
+    schedules,
+    static_sigma_step,
+)
+from visuomotor_gym.baselines.belief_mpc.stones import StonesBeliefMPCAgent, StonesBeliefMPCParams
 
 import visuomotor_gym  # noqa: F401
 from visuomotor_gym.agents import make_agent
-from visuomotor_gym.baselines.belief_mpc.belief import covariance_step
-from visuomotor_gym.baselines.belief_mpc.stone_belief import plan_gaze, plane_variance, schedules, static_sigma_step
-from visuomotor_gym.baselines.belief_mpc.stones import StonesBeliefMPCAgent, StonesBeliefMPCParams
 from visuomotor_gym.vision.foveation import DEG, VisionParams
 
 ENV = "SteppingStones-v0"

@@ -18,7 +18,7 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-import visuomotor_gym  # noqa: F401  (registers the ids)
+import visuomotor_gym  # registers the ids
 from visuomotor_gym.body.walker import GAIT_RULES, GaitParams
 from visuomotor_gym.control.hand import HAND_RULES, HandControlParams
 from visuomotor_gym.core.args import Choice, Flag, Int, Many, Num, Optional, Pair, Weights, field_rule

@@ -312,7 +312,7 @@ def test_pursuit_onset_latency(latency):
     plant = new_plant(params)
     start = 0.1  # the request at step k = 6 (t = 0.12 s) is the first that moved
     target = ramp(10.0, start_s=start)
-    run(plant, [target(k) for k in range(0, 30)])
+    run(plant, [target(k) for k in range(30)])
     revealed = 6 * DT
     t, g = plant.trace()
     moved = np.array([ang(X, x) for x in g])

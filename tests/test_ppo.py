@@ -5,9 +5,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from visuomotor_gym.baselines.ppo import train
 
 from visuomotor_gym.agents import make_agent
-from visuomotor_gym.baselines.ppo import train
 from visuomotor_gym.bench.evaluate import evaluate
 from visuomotor_gym.envs.walk import WALK_LAYOUT
 
@@ -143,8 +143,8 @@ def test_belief_intercept_base_catches_with_exact_vision_and_maps_residuals():
     assert result.summary["caught"] >= 3
 
     import gymnasium as gym
-
     from visuomotor_gym.baselines.ppo.belief import BeliefFeatures
+
     from visuomotor_gym.body.seated import HAND_WORKSPACE
 
     env = gym.make("EyeCatchOracle-v0")
@@ -174,7 +174,6 @@ def test_gated_gaze_maps_the_look_gate_to_the_belief_request_and_zero_to_held_ga
     residual alone around the line of sight (0: gaze held); before the filter's first sample the gate
     does nothing. The hand block stays the intercept residual."""
     import gymnasium as gym
-
     from visuomotor_gym.baselines.ppo.belief import BeliefFeatures
 
     env = gym.make("EyeCatch-v0")
@@ -219,7 +218,6 @@ def test_frozen_gaze_action_sees_what_gated_sees_and_holds_gaze_and_head():
     """gaze_action="frozen" (a policy *trained* with its gaze held): the gated mode's inputs, the env's
     9 action values, gaze and head held at 0 whatever the policy says; hand, grasp, fixation its own."""
     import gymnasium as gym
-
     from visuomotor_gym.baselines.ppo.belief import BeliefFeatures
 
     env = gym.make("EyeCatch-v0")
@@ -301,9 +299,9 @@ def test_frozen_holds_the_blocks_the_gaze_blind_twin_holds():
     """belief.GAZE_HEAD (the frozen mode's held slices) are the env's 'gaze' and 'head' blocks, as
     ``GazeBlind`` reads them from its action_structure."""
     import gymnasium as gym
+    from visuomotor_gym.baselines.ppo.belief import ENV_ACTION_DIM, GAZE_HEAD
 
     from visuomotor_gym.agents import GazeBlind
-    from visuomotor_gym.baselines.ppo.belief import ENV_ACTION_DIM, GAZE_HEAD
 
     structure = gym.make("EyeCatch-v0").unwrapped.action_structure
     twin = GazeBlind(None, structure)

@@ -467,7 +467,7 @@ def _reference_targets(gait, tick):
         hy = g.hip_y if side == 0 else -g.hip_y
         du, dv = foot[0] - pu, foot[1] - (pv + hy)
         zmax = foot[2] + math.sqrt(max(g.d_max * g.d_max - du * du - dv * dv, 0.0))
-        if zmax < z:  # noqa: PLR1730 (the original's form)
+        if zmax < z:  # the original's form
             z = zmax
         hips.append((du, dv))
     pc, ps = g.path_cos, g.path_sin
