@@ -387,11 +387,11 @@ def test_a_bad_record_names_its_field(changes, error, match):
 
 
 def test_bad_extra_env_and_belief_mpc_specs_name_their_field():
-    with pytest.raises(ValueError, match="ExtraEnv.id must be an id like"):
+    with pytest.raises(ValueError, match=r"ExtraEnv\.id must be an id like"):
         ExtraEnv("bounce", {}, "x")
     with pytest.raises(ValueError, match=r"ExtraEnv.max_episode_steps of A-v0 must be a positive int or None"):
         ExtraEnv("A-v0", {}, "x", max_episode_steps=-1)
-    with pytest.raises(ValueError, match="BeliefMPC.params must be a 'visuomotor_gym.module:attribute'"):
+    with pytest.raises(ValueError, match=r"BeliefMPC\.params must be a 'visuomotor_gym\.module:attribute'"):
         BeliefMPC("visuomotor_gym.baselines.belief_mpc:BeliefMPCAgent", "BeliefMPCParams")
 
 

@@ -1,4 +1,4 @@
-"""belief_mpc on SteppingStones-v0 (issue 13): Eom's static-object belief, the gaze plan, a real episode."""
+"""belief_mpc on SteppingStones-v0: Eom's static-object belief, the gaze plan, a real episode."""
 
 from __future__ import annotations
 
@@ -190,7 +190,7 @@ def test_dodge_dispatch_and_a_short_episode():
     for _ in range(120):
         a, _ = agent.predict(obs)
         assert np.all(np.isfinite(a)) and np.all(np.abs(a) <= 1.0)
-        obs, _, term, trunc, info = env.step(a)
+        obs, _, term, trunc, _info = env.step(a)
         if term or trunc:
             break
     env.close()

@@ -1,4 +1,4 @@
-"""Every field of every parameter dataclass the envs accept is checked at construction (issue 24, point 6).
+"""Every field of every parameter dataclass the envs accept is checked at construction.
 
 Each field is walked with NaN, +-inf, a negative (or, where the field's rule allows negatives, a value
 below its lower bound), a value above its upper bound, a wrong type and, for ranges, an inverted pair:

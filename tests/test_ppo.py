@@ -78,7 +78,7 @@ def test_ppo_entry_is_submitted_and_rescored_from_its_packed_file(tiny_run, tmp_
     (root / "protocol.json").write_text(json.dumps(proto, indent=2))
     assert main(["leaderboard", "submit", "--agent", f"ppo:{tiny_run}", "--name", "ppo-tiny", "--env", "EyeCatch-v0",
                  "--dir", str(root), "--workers", "1", "--no-progress"]) == 0
-    policy = root / "agents" / "ppo-tiny__EyeCatch-v0.npz"  # pickle-free (issue 16), converted at submit
+    policy = root / "agents" / "ppo-tiny__EyeCatch-v0.npz"  # pickle-free, converted at submit
     assert policy.is_file()
     record = json.loads((root / "results" / "ppo-tiny__EyeCatch-v0.entry.json").read_text())
     assert record["policy"]["format"] == "ppo-npz"
@@ -109,7 +109,7 @@ def test_hyperparameters_resolve_default_then_env_then_overrides():
 
 
 def test_walk_id_trains_without_the_catch_features_and_its_npz_walks(tmp_path):
-    """ObstacleWalk-v0 (issue 15): its hyperparameters replace the catch family's shaped reward (only the
+    """ObstacleWalk-v0: its hyperparameters replace the catch family's shaped reward (only the
     env's own progress term is shaped), no belief features; a tiny run packs to ppo-npz and is scored."""
     config = train.load_config(train.parse_args(["--env", "ObstacleWalk-v0"]))
     assert config["belief"] is False and config["hand_action"] == "absolute" and config["intercept_shaping"] == 0.0
@@ -165,7 +165,7 @@ def test_belief_intercept_base_catches_with_exact_vision_and_maps_residuals():
         BeliefFeatures("EyeCatch-v0", "relative")
 
 
-# ---------------------------------------------------------------- the gated gaze action (issue 15)
+# ---------------------------------------------------------------- the gated gaze action
 
 
 def test_gated_gaze_maps_the_look_gate_to_the_belief_request_and_zero_to_held_gaze():

@@ -35,13 +35,13 @@ def synthetic_trace(n=51, gaze=None, hand=None, ball=None, ball_vel=None, eye=No
         saccade_onset=np.zeros(n, bool) if onset is None else np.asarray(onset, bool),
         action=np.full((n, 9), np.nan), latency_s=np.full(n, np.nan),
         success=caught, diverged=False, truncated=False,
-        task=dict(
-            ball_pos=np.tile([3.0, 0.0, 1.2], (n, 1)) if ball is None else np.asarray(ball, float),
-            ball_vel=np.zeros((n, 3)) if ball_vel is None else np.asarray(ball_vel, float),
-            hand_pos=np.tile([0.3, -0.2, 0.9], (n, 1)) if hand is None else np.asarray(hand, float),
-            ball_visible=np.ones(n, bool), missed=not caught,
-            release_pos=np.array([3.0, 0.0, 1.2]), arrival_pos=np.array([0.3, -0.2, 0.9]), flight_time=1.0,
-        ),
+        task={
+            "ball_pos": np.tile([3.0, 0.0, 1.2], (n, 1)) if ball is None else np.asarray(ball, float),
+            "ball_vel": np.zeros((n, 3)) if ball_vel is None else np.asarray(ball_vel, float),
+            "hand_pos": np.tile([0.3, -0.2, 0.9], (n, 1)) if hand is None else np.asarray(hand, float),
+            "ball_visible": np.ones(n, bool), "missed": not caught,
+            "release_pos": np.array([3.0, 0.0, 1.2]), "arrival_pos": np.array([0.3, -0.2, 0.9]), "flight_time": 1.0,
+        },
     )
 
 
