@@ -90,8 +90,9 @@ def test_a_path_that_rests_at_its_end_still_fits():
 
 @pytest.mark.parametrize("degree", [2, 3, 4])
 def test_fit_is_the_least_squares_minimiser(degree):
-    # Oracle: a generic nonlinear least-squares solver on SS = sum_i |Z_i - C(s_i)|^2 (Faraway et al. 2007, Sec. 3.2),
-    # with the curve evaluated by scipy's BPoly and the end control points pinned to the data's ends.
+    # Oracle: a generic nonlinear least-squares solver on SS = sum_i |Z_i - C(s_i)|^2 (Faraway et al. 2007,
+    # Sec. 3.2), with the curve evaluated by scipy's BPoly and the end control points pinned to the
+    # data's ends.
     rng = np.random.default_rng(RNG_SEED + degree)
     z = np.cumsum(rng.normal(size=(40, 3)), axis=0)
     s = H.arc_length_parameter(z)
@@ -213,9 +214,9 @@ def test_minimum_jerk_path_is_straight_with_bell_speed():
 # Faraway's chosen model (Faraway et al. 2007, Sec. 4)
 # ---------------------------------------------------------------------------------------------------
 def test_faraway_offsets_reproduce_the_papers_centimetres():
-    # Faraway et al. (2007): "For the median reach distance of 56.7 cm, this gives offsets of (-1.4, -8.4, 4.3) cm
-    # and (-0.8, -7.9, -0.1) cm." The printed means have 3 decimals (+-0.0005 * 56.7 = 0.03 cm) and the
-    # cm values 1 decimal (+-0.05 cm), so agreement within 0.08 cm is all the print allows.
+    # Faraway et al. (2007): "For the median reach distance of 56.7 cm, this gives offsets of (-1.4, -8.4,
+    # 4.3) cm and (-0.8, -7.9, -0.1) cm." The printed means have 3 decimals (+-0.0005 * 56.7 = 0.03 cm) and
+    # the cm values 1 decimal (+-0.05 cm), so agreement within 0.08 cm is all the print allows.
     start = np.array([0.1, -0.2, 1.0])
     direction = np.array([0.6, -0.5, -0.2])
     end = start + 0.567 * direction / np.linalg.norm(direction)

@@ -7,8 +7,8 @@ request would (new files, edited files), and runs ``vmgym leaderboard check`` as
 submissions made in the tests stand in for a clean checkout by recording the temporary repository's
 own commit as their ``git_sha`` (``git_state`` is the only thing replaced, for the submitter).
 
-The first eleven attacks were accepted by the first version of the check; the rest were refused already and stay so.
-Tests 26-43 are the second round: links, the ppo-npz budget and headers, Markdown
+The first eleven attacks were accepted by the first version of the check; the rest were refused already and
+stay so. Tests 26-43 are the second round: links, the ppo-npz budget and headers, Markdown
 injection, latency shown rather than ruled, names, provenance claims and new protocol rows.
 """
 

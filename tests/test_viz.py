@@ -40,7 +40,8 @@ def synthetic_trace(n=51, gaze=None, hand=None, ball=None, ball_vel=None, eye=No
             "ball_vel": np.zeros((n, 3)) if ball_vel is None else np.asarray(ball_vel, float),
             "hand_pos": np.tile([0.3, -0.2, 0.9], (n, 1)) if hand is None else np.asarray(hand, float),
             "ball_visible": np.ones(n, bool), "missed": not caught,
-            "release_pos": np.array([3.0, 0.0, 1.2]), "arrival_pos": np.array([0.3, -0.2, 0.9]), "flight_time": 1.0,
+            "release_pos": np.array([3.0, 0.0, 1.2]), "arrival_pos": np.array([0.3, -0.2, 0.9]),
+            "flight_time": 1.0,
         },
     )
 

@@ -10,7 +10,8 @@ relative-speed profile.
 
 What is here
 ------------
-- :func:`bernstein`, :func:`bezier`: the curve, Faraway et al. (2007) Sec. 3.1 (Eq. for ``B_i^d`` and ``C(t)``).
+- :func:`bernstein`, :func:`bezier`: the curve, Faraway et al. (2007) Sec. 3.1 (Eq. for ``B_i^d``
+  and ``C(t)``).
 - :func:`arc_length_parameter`, :func:`fit_bezier`, :func:`fit_error`: the fit of Sec. 3.2 and the
   "maximum error" of Sec. 4 (Table 1).
 - :func:`beta_progress`, :func:`beta_peak_time`, :func:`minimum_jerk_progress`: timing profiles.
@@ -53,7 +54,8 @@ data's arc length). The geometric path is the same; the timing is not: the Bézi
 model's curve is far from its arc length, so the two place the hand up to 3 cm (56.7 cm reach to the
 right-front) to 6 cm (straight-forward reach) apart at the same time, and under ``"parameter"`` the
 speed peak moves with the target direction (0.37 to 0.61 of the reach in our checks), which
-contradicts the measured near-symmetric profile. Faraway et al. (2007, Sec. 5) weigh spatial error above timing.
+contradicts the measured near-symmetric profile. Faraway et al. (2007, Sec. 5) weigh spatial error
+above timing.
 """
 
 from __future__ import annotations
@@ -67,8 +69,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy import special
 
-# Faraway et al. (2007), Sec. 4 ("The observed means for the distance-scaled control points offset from the axis
-# points"), dimensionless (metres of offset per metre of reach), rows (lateral, forward, up).
+# Faraway et al. (2007), Sec. 4 ("The observed means for the distance-scaled control points offset from the
+# axis points"), dimensionless (metres of offset per metre of reach), rows (lateral, forward, up).
 FARAWAY_Y1 = (-0.025, -0.148, 0.077)
 FARAWAY_Y2 = (-0.015, -0.139, -0.002)
 # Faraway et al. (2007), Sec. 4: median ML estimates of the Beta relative-speed profile.
@@ -77,8 +79,8 @@ FARAWAY_BETA = 1.75
 # Faraway et al. (2007), Sec. 4: the median reach distance, at which the offsets are quoted in cm.
 FARAWAY_MEDIAN_REACH_M = 0.567
 # Flash & Hogan (1985) minimum-jerk progress 10t^3 - 15t^4 + 6t^5 has speed 30 t^2 (1 - t)^2, the
-# Beta(3, 3) density. (Faraway et al. 2007, Sec. 4, call it "a beta density with alpha = 2 and beta = 2"; that is a
-# slip: Beta(2, 2) has density 6 t (1 - t).)
+# Beta(3, 3) density. (Faraway et al. 2007, Sec. 4, call it "a beta density with alpha = 2 and beta = 2"; that
+# is a slip: Beta(2, 2) has density 6 t (1 - t).)
 MINIMUM_JERK_ALPHA = 3.0
 MINIMUM_JERK_BETA = 3.0
 
@@ -151,7 +153,8 @@ def _reach(start: ArrayLike, end: ArrayLike) -> tuple[np.ndarray, np.ndarray, fl
 # Bézier curves (Faraway et al. 2007, Sec. 3.1)
 # ---------------------------------------------------------------------------------------------------
 def bernstein(degree: int, t: ArrayLike) -> np.ndarray:
-    """Bernstein basis ``B_i^d(t) = C(d, i) t^i (1 - t)^(d - i)`` (Faraway et al. 2007, Sec. 3.1), shape (len(t), d + 1).
+    """Bernstein basis ``B_i^d(t) = C(d, i) t^i (1 - t)^(d - i)`` (Faraway et al. 2007, Sec. 3.1),
+    shape (len(t), d + 1).
 
     Parameters
     ----------
@@ -201,7 +204,8 @@ def elevate_degree(control_points: ArrayLike) -> np.ndarray:
 # fitting (Faraway et al. 2007, Sec. 3.2) and the fit error (Sec. 4, Table 1)
 # ---------------------------------------------------------------------------------------------------
 def arc_length_parameter(points: ArrayLike) -> np.ndarray:
-    """Relative arc length ``s_i = sum_{j<=i} a_j / sum_j a_j``, ``a_j = |Z_j - Z_{j-1}|`` (Faraway et al. 2007, Sec. 3.2).
+    """Relative arc length ``s_i = sum_{j<=i} a_j / sum_j a_j``, ``a_j = |Z_j - Z_{j-1}|``
+    (Faraway et al. 2007, Sec. 3.2).
 
     Parameters
     ----------
@@ -280,7 +284,8 @@ def fit_bezier(points: ArrayLike, degree: int = 3, s: ArrayLike | None = None) -
 
 
 def fit_error(points: ArrayLike, control_points: ArrayLike, s: ArrayLike | None = None) -> float:
-    """Maximum error ``max_i |Z_i - C(s_i)|`` of a fitted curve (Faraway et al. 2007, Sec. 4, the Table 1 measure).
+    """Maximum error ``max_i |Z_i - C(s_i)|`` of a fitted curve (Faraway et al. 2007, Sec. 4, the
+    Table 1 measure).
 
     ``s`` defaults to the relative arc length of ``points`` (as in :func:`fit_bezier`).
     """
@@ -383,8 +388,8 @@ def faraway_control_points(
 ) -> np.ndarray:
     """Control points of Faraway's chosen model, the null axis model with distance scaling, shape (4, 3).
 
-    ``P_0 = start``, ``P_3 = end``, axis points ``A_i = P_0 + (i/3)(P_3 - P_0)`` (Faraway et al. 2007, Sec. 3.3,
-    Fig. 5) and ``P_i = A_i + d * Y_i`` with ``d = |P_3 - P_0|`` and ``Y_i`` in the body frame of
+    ``P_0 = start``, ``P_3 = end``, axis points ``A_i = P_0 + (i/3)(P_3 - P_0)`` (Faraway et al. 2007, Sec.
+    3.3, Fig. 5) and ``P_i = A_i + d * Y_i`` with ``d = |P_3 - P_0|`` and ``Y_i`` in the body frame of
     :func:`body_frame` (Faraway et al. 2007, Sec. 4; see the module docstring for the axis convention).
     """
     p0, p3, d = _reach(start, end)
@@ -428,8 +433,8 @@ def faraway_path(
 
     The curve is :func:`faraway_control_points`; the point at relative time ``tau_k = k / (n - 1)`` is at
     relative arc length ``F(tau_k)`` (``progress="arc_length"``, default) or curve parameter ``F(tau_k)``
-    (``progress="parameter"``), ``F`` the Beta(alpha, beta) CDF (Faraway et al. 2007, Sec. 4). Units follow the
-    inputs (the model is scale-free).
+    (``progress="parameter"``), ``F`` the Beta(alpha, beta) CDF (Faraway et al. 2007, Sec. 4). Units follow
+    the inputs (the model is scale-free).
 
     Parameters
     ----------
@@ -563,9 +568,9 @@ def hand_path_realism(
 ) -> HandPathRealism:
     """Spatial realism measures of a recorded reach from ``path[0]`` to ``path[-1]`` (lengths in metres).
 
-    The comparison is spatial (equal relative arc length), as Faraway et al. (2007, Sec. 5) weigh spatial error above
-    timing; the timing enters only through ``peak_speed``/``peak_time``. Reading: Faraway et al.'s 8.0 cm
-    (chosen model) and 12.6 cm (Flash-Hogan) are errors *against human reaches*, not distances to the
+    The comparison is spatial (equal relative arc length), as Faraway et al. (2007, Sec. 5) weigh spatial
+    error above timing; the timing enters only through ``peak_speed``/``peak_time``. Reading: Faraway et al.'s
+    8.0 cm (chosen model) and 12.6 cm (Flash-Hogan) are errors *against human reaches*, not distances to the
     model's path - a straight reach of 56.7 cm is only ~6 cm from Faraway's path. Use
     ``curvature_index`` (and ``faraway_max`` over many reaches) to tell straight from human-like paths;
     ``docs/reproductions/faraway.md`` gives their spread on synthetic human-like reaches.

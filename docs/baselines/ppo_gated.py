@@ -1,5 +1,5 @@
-"""What a gated-gaze PPO policy learned (docs/baselines/ppo.md): catch, where the eye looks, and how often the look
-gate is on, beside its frozen-gaze twin, the structure's fixed bases and Eyecatch.
+"""What a gated-gaze PPO policy learned (docs/baselines/ppo.md): catch, where the eye looks, and how often the
+look gate is on, beside its frozen-gaze twin, the structure's fixed bases and Eyecatch.
 
 Each agent plays the pinned throws (episode i: seed i) through the evaluator's own ``run_episode``
 on the registered env, so catch rates equal ``vmgym bench``'s. Per agent: catch rate with its Wilson

@@ -15,9 +15,9 @@ forward, up) of :func:`visuomotor_gym.handpath.body_frame`; -1..1 maps onto -0.5
 ``grasp``. A reach starts at the hand reference and ends at ``hand_target``; the two offsets and the
 duration are latched at its start, the end point follows ``hand_target`` while it runs (on-line
 correction). At relative time tau the reference sits at relative arc length F(tau) of the curve, F the
-Beta(1.63, 1.75) CDF (Faraway et al. 2007, Sec. 4; :func:`visuomotor_gym.handpath.faraway_path`'s default timing).
-Zero offsets give a straight reach; ``bezier_y1 = FARAWAY_Y1 / 0.5`` and ``bezier_y2 = FARAWAY_Y2 / 0.5``
-give Faraway's mean path. Between reaches the reference holds the last reach's end.
+Beta(1.63, 1.75) CDF (Faraway et al. 2007, Sec. 4; :func:`visuomotor_gym.handpath.faraway_path`'s default
+timing). Zero offsets give a straight reach; ``bezier_y1 = FARAWAY_Y1 / 0.5`` and ``bezier_y2 = FARAWAY_Y2 /
+0.5`` give Faraway's mean path. Between reaches the reference holds the last reach's end.
 """
 
 from __future__ import annotations

@@ -3,8 +3,8 @@ Faraway, Reed & Wang's (2007) reach model, reported **beside** the catch family'
 
 Which part of a catch is compared with ``faraway_path``
 -------------------------------------------------------
-Faraway et al. (2007) model a point-to-point reach to a resting object: one movement from a start to an end, one
-speed peak (the Beta(1.63, 1.75) profile). A catch is not that: the hand leaves its rest position towards
+Faraway et al. (2007) model a point-to-point reach to a resting object: one movement from a start to an end,
+one speed peak (the Beta(1.63, 1.75) profile). A catch is not that: the hand leaves its rest position towards
 an interception point that the catcher's estimate keeps revising while the ball flies (Eyecatch sec. 4.3:
 overlapping ~400 ms submovements, one per ~200 ms visuomotor update), and once there it waits or
 follows the ball in small corrections until the ball arrives. So the compared segment
@@ -77,19 +77,20 @@ ARRIVAL_RADIUS_M = 0.03
 GAZE_ON_TARGET_DEG = 5.0  # "on the interception point": as metrics.reach_realism.GAZE_ON_OBJECT_DEG (our choice)
 
 # Verdict thresholds (path_verdict), on the medians over episodes:
-HUMAN_LIKE_MAX_CM = 8.0  # Faraway et al. (2007), Table 2: the chosen model's median error against human reaches
-# Faraway et al. (2007), Table 2: the straight minimum-jerk (Flash-Hogan) model's median error against human reaches.
-# A median distance to the chosen model above it is farther from the model than the rejected straight-line
-# model was from humans: not one reach. (It is *not* the distance of a straight path to faraway_path,
-# which is only ~6 cm at 56.7 cm: docs/reproductions/faraway.md.)
+# Faraway et al. (2007), Table 2: the chosen model's median error against human reaches.
+HUMAN_LIKE_MAX_CM = 8.0
+# Faraway et al. (2007), Table 2: the straight minimum-jerk (Flash-Hogan) model's median error against human
+# reaches. A median distance to the chosen model above it is farther from the model than the rejected
+# straight-line model was from humans: not one reach. (It is *not* the distance of a straight path to
+# faraway_path, which is only ~6 cm at 56.7 cm: docs/reproductions/faraway.md.)
 UNLIKE_REACH_MIN_CM = 12.6
 # The interquartile range of the curvature index of synthetic human reaches (docs/reproductions/faraway.md,
 # REACH_REFERENCE["curvature_index"]); a straight path has 0.
 HUMAN_CURVATURE_LOW = REACH_REFERENCE["curvature_index"]["low"]
 HUMAN_CURVATURE_HIGH = REACH_REFERENCE["curvature_index"]["high"]
 
-_APPLIED = (" Applied to the transport of a catch: modelling choice (Faraway et al. 2007 measured reaches to resting "
-            "objects; there is no human hand-path number for catching in REFERENCES.md).")
+_APPLIED = (" Applied to the transport of a catch: modelling choice (Faraway et al. 2007 measured reaches "
+            "to resting objects; there is no human hand-path number for catching in REFERENCES.md).")
 
 
 def _reference() -> dict[str, dict]:

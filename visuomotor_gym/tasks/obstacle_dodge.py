@@ -1,11 +1,11 @@
-"""The obstacle-dodge task (Eom, Han, Shin & Noh 2019, Sec. 7, "Moving obstacle avoidance"): walk to a goal 15-20 m ahead while
-pedestrians cross the path, seen only through the foveated eye; coming closer to one than the two bodies'
-radii is a collision and ends the episode.
+"""The obstacle-dodge task (Eom, Han, Shin & Noh 2019, Sec. 7, "Moving obstacle avoidance"): walk to a goal
+15-20 m ahead while pedestrians cross the path, seen only through the foveated eye; coming closer to one than
+the two bodies' radii is a collision and ends the episode.
 
 **Scenario** (:func:`sample_crowd`, drawn first from the env's ``np_random`` so every rung of the ladder
 gets the same crowd for a seed): the walker starts at the origin walking along +x at 1.3 m/s; the goal
-line lies 15-20 m ahead (modelling choice). ``N_PEDESTRIANS`` = 4 pedestrians appear one after the other (onset
-0.3-1.5 s after the start, then every 1.5-3 s: modelling choice, so that two or three walk at once),
+line lies 15-20 m ahead (modelling choice). ``N_PEDESTRIANS`` = 4 pedestrians appear one after the other
+(onset 0.3-1.5 s after the start, then every 1.5-3 s: modelling choice, so that two or three walk at once),
 each 4-6 m to one side, and walk straight across the path at 1.0-1.5 m/s (adults' comfortable walking
 speeds are 1.27-1.46 m/s, Bohannon 1997, Age Ageing 26:15; the wider range is a modelling choice), up to
 30 deg off the perpendicular (modelling choice). Each crosses the path where a walker going straight at

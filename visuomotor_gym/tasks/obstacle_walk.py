@@ -7,8 +7,8 @@ gets the same course for a seed): the path runs along +x from the walker's first
 origin to a finish line 15-20 m ahead. Obstacles follow one another along it with free gaps of
 1.6-3.0 m; each is a bar (5 cm deep, spanning the walkway: stepped over), a box (20-40 cm deep, 40-80 cm
 wide: stepped over or around) or a flat mat (70 x 70 cm, 1 cm: Iwao's cloth, stepped around; landing on
-it is a misstep), 5-30 cm high except the mats (modelling choice). Kinds, sizes and lateral offsets are uniform
-draws (modelling choice).
+it is a misstep), 5-30 cm high except the mats (modelling choice). Kinds, sizes and lateral offsets are
+uniform draws (modelling choice).
 
 **The walkway**: the path is a walkway ``walkway_width_m`` = 1.5 m wide (modelling choice: the passing
 width of accessible routes, ADA 2010 Standards 403.5.3, 60 in), its edges painted on the floor. A foot

@@ -1,5 +1,5 @@
-"""The stepping-stones task (Eom, Han, Shin & Noh 2019, Sec. 7, "Walking on stepping stones"): cross a gap on a path of
-stones seen only through the foveated eye; a foot that lands off every support ends the episode.
+"""The stepping-stones task (Eom, Han, Shin & Noh 2019, Sec. 7, "Walking on stepping stones"): cross a gap on
+a path of stones seen only through the foveated eye; a foot that lands off every support ends the episode.
 
 **Course** (:func:`sample_course`, drawn first from the env's ``np_random`` so every rung of the ladder
 gets the same course for a seed): the walker starts on a slab (``envs_assets/stones.xml``) whose far
