@@ -17,7 +17,7 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 SCANNED = ("visuomotor_gym", "baselines", "benchmarks", "tests", "docs", "examples")
 # Internal tags: a source paper's hand-in number, an issue number, a section of the design brief.
-UNFOLLOWABLE = re.compile(r"seed 00[0-9]|issue [0-9]+|DESIGN section", re.IGNORECASE)
+UNFOLLOWABLE = re.compile(r"seed 00[0-9]|issue [0-9]+|DESIGN(\.md)? (section|sec\.|§)", re.IGNORECASE)
 
 
 def _offences(text: str) -> list[tuple[int, str]]:
@@ -42,6 +42,7 @@ def test_no_unfollowable_citation_tags():
     "# seed 002 Sec. 4: the median reach",
     '"""The stones task (Issue 13): cross a gap."""',
     "the gaze-blind twin of DESIGN section 4",
+    "``gaze_blind=True`` is the gaze-blind twin (DESIGN.md Sec. 2)",
 ])
 def test_the_check_catches_each_tag(line):
     assert _offences(line) == [(1, line.strip())]
@@ -51,6 +52,7 @@ def test_the_check_catches_each_tag(line):
     "# Faraway et al. (2007), Sec. 4: the median reach",
     "seed = 002  # an rng seed is not a paper",
     "for seed in seeds: issue_id = 3",
+    "DESIGN_SEED = 100_000  # design seeds 100000-100039",
 ])
 def test_the_check_passes_paper_citations(line):
     assert _offences(line) == []
