@@ -3,13 +3,14 @@
 A family (catch, reach, walk, ...) is one env class, its five-rung observability ladder and a few
 extra ids, its metrics and its baselines. Its :class:`Family` record is declared once, at the end of
 its env module ``visuomotor_gym/envs/<family>.py``, and :mod:`visuomotor_gym.families` lists those
-modules: registration, the metrics dispatcher, the bench table, the agent factory, the leaderboard's
-policy formats and the golden digests read the records and hold no family table of their own.
+modules: registration, the metrics dispatcher, the bench table and results check, the agent factory,
+the leaderboard's policy formats, the golden digests, the plots and videos of ``visuomotor_gym.viz``
+and the family pages' generator read the records and hold no family table of their own.
 
-References to code above the env layer (the family's summariser, miss distance, belief-MPC classes)
-are ``"module:attribute"`` strings, resolved by :func:`resolve` when first used: an env module may not
-import metrics or baselines (``tests/test_architecture.py``: they sit above it and import it), so a
-direct reference would be an import cycle. Everything else (vision defaults, numbers, labels) is a
+References to code above the env layer (the family's summariser, miss distance, belief-MPC classes,
+figure) are ``"module:attribute"`` strings, resolved by :func:`resolve` when first used: an env module
+may not import metrics, baselines or viz (``tests/test_architecture.py``: they sit above it and import
+it), so a direct reference would be an import cycle. Everything else (vision defaults, numbers, labels) is a
 plain value. This module imports nothing of the package at module level, so any layer may import it,
 and importing a record builds no MuJoCo model.
 """
@@ -161,7 +162,7 @@ class Viz:
     figure: str
     contents: str
     trace_field: str
-    scene_view: Any
+    scene_view: str | FollowView
     video_stride: int = 1
     dpi: int = 100
     outcome_words: tuple[str, str] = ("succeeded", "failed")
