@@ -556,6 +556,7 @@ def test_every_record_says_how_its_episodes_are_shown():
 
     records = families()
     assert set(FAMILY_EPISODES) == {f.name for f in records}  # every family's figure is drawn from an episode
+    assert all(f.viz is not None for f in records), [f.name for f in records if f.viz is None]
     fields = [f.viz.trace_field for f in records]
     assert len(set(fields)) == len(fields), fields  # a trace field tells one family only
     for record in records:
