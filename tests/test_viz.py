@@ -358,7 +358,9 @@ def _walker_share(env, views, info):
     from visuomotor_gym.viz.video import FrameRenderer
 
     m = env.unwrapped.model
-    renderer = FrameRenderer(env, views, 160, 120)
+    # Without the line of sight: the translucent gaze line blends with what lies behind it, and a blended
+    # pixel decodes to no segment at all (MuJoCo's renderer then raises IndexError: ~1 run in 6).
+    renderer = FrameRenderer(env, views, 160, 120, line_of_sight=False)
     try:
         renderer.renderer.enable_segmentation_rendering()
         seg = renderer.render(info)
