@@ -241,7 +241,7 @@ RENDER_CAMERAS = tuple(EyeCatchEnv.render_cameras)
 
 
 # ---------------------------------------------------------------- the family record (visuomotor_gym.family)
-from visuomotor_gym.family import BeliefMPC, ExtraEnv, Family
+from visuomotor_gym.family import BeliefMPC, ExtraEnv, Family, Viz
 
 CATCH_MAX_EPISODE_STEPS = 125  # 2.5 s at 50 Hz: the longest flight is 1.4 s
 TWO_BALLS_MAX_EPISODE_STEPS = 150  # 3 s: the second ball arrives at most 2.2 s after the first release
@@ -280,4 +280,23 @@ FAMILY = Family(
     golden_extra=(("oracle", "EyeCatchOracle-v0"),),
     belief_mpc=BeliefMPC("visuomotor_gym.baselines.belief_mpc:BeliefMPCAgent",
                          "visuomotor_gym.baselines.belief_mpc.agent:BeliefMPCParams", env_vision=True),
+    rate_aliases=("catch_rate",),  # the catch summary's own name of the success rate
+    viz=Viz(
+        figure="visuomotor_gym.viz.plots:catch_figure",
+        contents="gaze vs ball azimuth/elevation over time with saccades (Eyecatch Fig. 3/12), hand and eye speed "
+                 "(Fig. 4), the visual field, 3-D ball and hand paths",
+        trace_field="ball_pos",
+        scene_view="scene_camera",
+        video_stride=1,
+        dpi=110,
+        outcome_words=("caught", "missed"),
+        failure_field="missed",
+    ),
+    doc_links=(("Eyecatch (Yeo et al. 2012)", "reproductions/eyecatch.md"),
+               ("Eom et al. 2019: belief MPC, two balls", "reproductions/eom.md"),
+               ("The default vision: moving-target localisation", "reproductions/gaze_default.md"),
+               ("PPO baselines", "baselines/ppo.md")),
+    doc_pictures=(("images/eyecatch_record_frame.png",
+                   ("The Eyecatch agent catching: scene camera (the green line is its line of sight) beside its "
+                    "eye camera")),),
 )

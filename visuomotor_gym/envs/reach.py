@@ -217,7 +217,7 @@ if ShelfReachEnv.__doc__:
 
 
 # ---------------------------------------------------------------- the family record (visuomotor_gym.family)
-from visuomotor_gym.family import Family
+from visuomotor_gym.family import Family, Viz
 
 REACH_MAX_EPISODE_STEPS = 150  # 3 s at 50 Hz: first saccade (~0.2 s), fixation, a ~0.6-1 s reach, slack (modelling choice)
 
@@ -234,4 +234,16 @@ FAMILY = Family(
     reaction_from_t0=True,  # the object appears at t = 0
     agents=("faraway",),
     golden_agent="faraway",
+    viz=Viz(
+        figure="visuomotor_gym.viz.family_plots:reach_figure",
+        contents="top and side view of the shelf: object, hand path, gaze point at the object's distance (coloured "
+                 "by time); gaze and object angles, gaze-object angle, hand-object distance and hand speed over time",
+        trace_field="object_pos",
+        scene_view="scene_camera",
+        video_stride=1,
+    ),
+    doc_links=(("Faraway et al. 2007: reaches as Bézier curves", "reproductions/faraway.md"),),
+    doc_pictures=(("images/shelfreach_record_frame.png", "The faraway agent reaching to a shelf target"),
+                  ("reproductions/images/faraway_reach_paths.png",
+                   "Hand paths of the faraway agent to the shelf targets")),
 )

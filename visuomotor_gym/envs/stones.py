@@ -176,7 +176,7 @@ if SteppingStonesEnv.__doc__:
 
 
 # ---------------------------------------------------------------- the family record (visuomotor_gym.family)
-from visuomotor_gym.family import BeliefMPC, Family
+from visuomotor_gym.family import BeliefMPC, Family, FollowView, Viz
 
 STONES_MAX_EPISODE_STEPS = 1000  # 20 s at 50 Hz: twice the nominal crossing (~18 steps of 0.5 s) (modelling choice)
 
@@ -198,4 +198,17 @@ FAMILY = Family(
     belief_mpc=BeliefMPC("visuomotor_gym.baselines.belief_mpc.stones:StonesBeliefMPCAgent",
                          "visuomotor_gym.baselines.belief_mpc.stones:StonesBeliefMPCParams",
                          vision_note="stones_vision"),
+    viz=Viz(
+        figure="visuomotor_gym.viz.family_plots:stones_figure",
+        contents="top view: numbered stones, pelvis path, footholds, gaze on the floor (coloured by time); gaze "
+                 "angles and the stone under the gaze vs the feet's next stone over time",
+        trace_field="stones",
+        # From behind the walker, higher, turning with it: the next stones ahead (the path turns by up to 60 deg).
+        scene_view=FollowView(distance=5.0, azimuth=30.0, elevation=-50.0, offset=(1.5, 0.0, -0.8),
+                              follow_heading=True),
+        video_stride=2,
+    ),
+    doc_links=(("Stepping stones (Eom et al. 2019, section 7; Patla & Vickers 2003)", "reproductions/stones.md"),),
+    doc_pictures=(("images/steppingstones_record_frame.png", "The lookahead agent on SteppingStones-v0"),
+                  ("reproductions/images/stones_turning.png", "The lookahead agent turning through a 60 deg course")),
 )

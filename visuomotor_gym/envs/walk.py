@@ -214,7 +214,7 @@ if ObstacleWalkEnv.__doc__:
 
 
 # ---------------------------------------------------------------- the family record (visuomotor_gym.family)
-from visuomotor_gym.family import Family
+from visuomotor_gym.family import Family, FollowView, Viz
 
 WALK_MAX_EPISODE_STEPS = 2000  # 40 s at 50 Hz: three times the nominal walk (1.3 m/s) of the longest (20 m) course
 
@@ -231,4 +231,18 @@ FAMILY = Family(
     outcome_labels=("success rate", "time to finish (s)", "distance left, failed walks (m)"),
     agents=("iwao",),
     golden_agent="iwao",
+    viz=Viz(
+        figure="visuomotor_gym.viz.family_plots:walk_figure",
+        contents="top view of the walkway: obstacles by kind and height, pelvis path, footholds, where the gaze "
+                 "meets the floor or an obstacle (coloured by time); side view of obstacle and sole heights; gaze "
+                 "angles and look-ahead distance over time",
+        trace_field="obstacles",
+        # From behind and to the right, above: the legs and the next 3-4 m of walkway with its obstacles.
+        scene_view=FollowView(distance=5.0, azimuth=55.0, elevation=-28.0, offset=(1.6, 0.0, -0.6)),
+        video_stride=2,
+    ),
+    doc_links=(("Iwao et al.: gaze while walking over obstacles", "reproductions/iwao.md"),
+               ("PPO baselines (the walk recipe)", "baselines/ppo.md")),
+    doc_pictures=(("images/obstaclewalk_iwao_seed0_frame.png",
+                   "The iwao agent on ObstacleWalk-v0: side view with the line of sight, and its eye camera"),),
 )
