@@ -505,7 +505,7 @@ def test_plot_help_says_what_it_draws_for_every_family(capsys):
 
     for record in families():
         assert f"  {record.name}: {record.viz.contents[:40]}" in text
-    assert plots.FAMILIES == tuple(f.name for f in families())  # the old name, derived from the records
+    assert tuple(f.name for f in families()) == plots.FAMILIES  # the old name, derived from the records
     assert "footholds" in text and "pedestrian" in text and "shelf" in text
 
 
