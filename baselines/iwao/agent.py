@@ -22,8 +22,8 @@ import math
 from dataclasses import dataclass, fields, replace
 
 import numpy as np
-
 from visuomotor_gym.baselines.crowding import crowded
+
 from visuomotor_gym.body.walker import GaitParams
 from visuomotor_gym.body.walker_body import WalkerBody
 from visuomotor_gym.envs.walk import WALK_LAYOUT

@@ -17,8 +17,8 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-
 from visuomotor_gym.baselines.crowding import crowd_std
+
 from visuomotor_gym.tasks.obstacle_walk import N_POINTS, CourseDistribution
 from visuomotor_gym.vision.foveation import VisionParams, _sigmas
 

@@ -33,8 +33,8 @@ import math
 from dataclasses import dataclass, fields, replace
 
 import numpy as np
-
 from visuomotor_gym.baselines.crowding import crowded
+
 from visuomotor_gym.body.walker import GaitParams
 from visuomotor_gym.body.walker_body import TurningWalkerBody as WalkerBody
 from visuomotor_gym.envs.stones import STONES_LAYOUT

@@ -19,6 +19,7 @@ from __future__ import annotations
 import math
 
 from visuomotor_gym.baselines.crowding import crowd_std
+
 from visuomotor_gym.tasks.stepping_stones import STONE_TOP_Z
 from visuomotor_gym.vision.foveation import VisionParams, _sigmas
 
