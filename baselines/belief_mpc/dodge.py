@@ -43,6 +43,7 @@ from visuomotor_gym.registration import env_vision, env_vision_params
 from visuomotor_gym.vision.foveation import DEG, VisionParams
 
 from .belief import ObservationNoise, covariance_step, observation_variance
+from .field import field_limit
 from .stone_belief import saccade_duration_s, schedules
 
 SEEN_HEIGHT_M = 1.5  # tasks.obstacle_dodge.SEEN_HEIGHT_M: the point the eye sees on a pedestrian
@@ -84,10 +85,25 @@ class DodgeBeliefMPCAgent(FajenWarrenAgent):
         self.timing: dict[str, float] = {}
         super().__init__(params or DodgeBeliefMPCParams())
         p = self.params
-        self.plan_vision = vision or replace(VisionParams(field_of_view_deg=20.0), noise_scale=p.vision_noise_scale,
-                                             foveated=p.foveated)
-        self.noise = ObservationNoise.from_vision(self.plan_vision)
+        self.vision = vision or replace(VisionParams(field_of_view_deg=20.0), noise_scale=p.vision_noise_scale,
+                                        foveated=p.foveated)
         self.n_nodes = max(2, int(round(p.window_s / p.plan_dt_s)))
+
+    @property
+    def vision(self) -> VisionParams:
+        """The eye the agent models, for its samples (``FajenWarrenAgent``) and its gaze plan alike: setting
+        it (``agents.match_vision`` does, with the env's ``VisionParams``) resets the planner's noise."""
+        return self._vision
+
+    @vision.setter
+    def vision(self, value: VisionParams) -> None:
+        self._vision = value
+        self.noise = ObservationNoise.from_vision(value)
+
+    @property
+    def plan_vision(self) -> VisionParams:
+        """The planner's vision: the agent's (``vision``)."""
+        return self._vision
 
     @classmethod
     def for_env(cls, env_id: str, **overrides) -> DodgeBeliefMPCAgent:
@@ -135,7 +151,7 @@ class DodgeBeliefMPCAgent(FajenWarrenAgent):
             pos = np.array([x, y, eye[2]])
             d = pos - eye
             ecc = math.acos(max(-1.0, min(1.0, float(d @ gaze) / float(np.linalg.norm(d)))))
-            seen = (not self._in_saccade) and ecc <= self.plan_vision.field_of_view_deg * DEG
+            seen = (not self._in_saccade) and ecc <= field_limit(gaze, d / float(np.linalg.norm(d)), self.plan_vision)
             r = observation_variance(self.noise, math.atan2(gaze[1], gaze[0]), math.asin(max(-1.0, min(1.0, gaze[2]))),
                                      pos, eye) if seen else math.inf
             self.search_sigma[az] = covariance_step(self.search_sigma[az], np.asarray(r), dt, p.alpha_per_s * dt)
@@ -208,8 +224,8 @@ class DodgeBeliefMPCAgent(FajenWarrenAgent):
         du = (relv - np.sum(relv * u, axis=2)[..., None] * u) / d[..., None]
         slip2 = np.sum((du[:, None, :, :] - du[:, :, None, :]) ** 2, axis=3)
         r = observation_variance(self.noise, az, el, P[:, None, :, :], E[:, None, None, :], slip2=slip2)  # (N, F, J)
-        if self.plan_vision.foveated:
-            r = np.where(theta <= self.plan_vision.field_of_view_deg * DEG, r, np.inf)
+        if self.plan_vision.foveated:  # the field around each fixated f in the direction of each j
+            r = np.where(theta <= field_limit(u[:, :, None, :], u[:, None, :, :], self.plan_vision), r, np.inf)
         amp_0 = np.arccos(np.clip(u[0] @ gaze, -1.0, 1.0))
         per_node = max(1, int(round(h / p.control_dt)))
         earliest = 0 if not self._in_saccade else int(math.ceil(p.saccade_refractory_s / h))

@@ -61,6 +61,8 @@ import numpy as np
 
 from visuomotor_gym.vision.foveation import ARCMIN, DEG, VisionParams
 
+from .field import field_limit, position_e2_rad
+
 FLOOR_M2 = 1e-6  # belief.ObservationNoise.floor_m2: 1 mm std (as the Eyecatch filter's measurement floor)
 
 
@@ -73,25 +75,29 @@ def static_sigma_step(sp, r, q: float):
     return a / (1.0 + a * info)
 
 
-def plane_variance(distance, eccentricity, slip, depression_sin, vision: VisionParams, eps_rad: float = 0.2 * DEG):
+def plane_variance(distance, eccentricity, slip, depression_sin, vision: VisionParams, eps_rad: float = 0.2 * DEG,
+                   limit=None):
     """Isotropic ``r`` (m^2) of one sample of a point on the stones' plane (module docstring); broadcasts.
 
     ``distance`` (m), ``eccentricity`` (rad), ``slip`` (rad/s), ``depression_sin`` the sine of the
-    line of sight's depression. ``inf`` beyond the field of view (foveated vision only)."""
+    line of sight's depression. ``inf`` beyond the field of view (foveated vision only): the
+    eccentricity ``limit`` (rad, broadcast; ``field.field_limit``), by default the cone's
+    ``field_of_view_deg``. The lateral std grows with the position law's E2 when the env's vision has
+    one (``field.position_e2_rad``), else the acuity law's."""
     d = np.asarray(distance, dtype=float)
     th = np.asarray(eccentricity, dtype=float)
     sq = vision.noise_scale * vision.retinal_position_std_arcmin * ARCMIN
     if vision.foveated:
         knee = vision.position_slip_knee_deg_s * DEG
         slip_f = np.maximum(1.0, np.abs(slip) / knee) if math.isfinite(knee) else 1.0
-        amp = 1.0 + np.sqrt(th * th + eps_rad * eps_rad) / (vision.fovea_e2_deg * DEG)
+        amp = 1.0 + np.sqrt(th * th + eps_rad * eps_rad) / position_e2_rad(vision)
     else:
         slip_f, amp = 1.0, 1.0
     s = d * sq * slip_f * amp
     dep = np.maximum(np.asarray(depression_sin, dtype=float), 0.02)  # lookahead's MIN_DEPRESSION
     r = 0.5 * s * s * (1.0 + 1.0 / (dep * dep)) + FLOOR_M2
     if vision.foveated:
-        r = np.where(th <= vision.field_of_view_deg * DEG, r, np.inf)
+        r = np.where(th <= (vision.field_of_view_deg * DEG if limit is None else limit), r, np.inf)
     shape = np.broadcast_shapes(d.shape, th.shape, np.shape(slip), np.shape(depression_sin))
     return np.broadcast_to(r, shape).copy() if np.shape(r) != shape else r
 
@@ -192,7 +198,9 @@ def plan_gaze(stones_xy: np.ndarray, sp0: np.ndarray, eye0: np.ndarray, eye_vel:
     theta = np.arccos(cosang)
     slip = np.linalg.norm(du[:, None, :, :] - du[:, :, None, :], axis=3)  # (N, F, J)
     dep = -u[..., 2]
-    r = plane_variance(d[:, None, :], theta, slip, dep[:, None, :], vision)  # (N, F, J)
+    # the field around each fixated candidate f, in the direction of each j (the cone: a scalar)
+    limit = field_limit(u[:, :, None, :], u[:, None, :, :], vision) if vision.foveated else None
+    r = plane_variance(d[:, None, :], theta, slip, dep[:, None, :], vision, limit=limit)  # (N, F, J)
     # saccade blindness in a switch node: the amplitude from the previous stone (theta) or the gaze now
     amp_0 = np.arccos(np.clip(u[0] @ gaze0, -1.0, 1.0))  # (M,) from the gaze now
     per_node = max(1, int(round(h / dt)))

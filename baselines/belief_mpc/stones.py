@@ -48,6 +48,7 @@ from visuomotor_gym.registration import env_vision, env_vision_params
 from visuomotor_gym.tasks.stepping_stones import FOOT_CENTRE_AHEAD_M, K_SLOTS, CourseDistribution
 from visuomotor_gym.vision.foveation import DEG, VisionParams
 
+from .field import field_limit_eye
 from .stone_belief import plan_gaze, plane_variance, static_sigma_step
 
 _S = STONES_LAYOUT.slices
@@ -237,7 +238,12 @@ class StonesBeliefMPCAgent(LookaheadAgent):
         gx, gy, gz = rows[0][0], rows[1][0], rows[2][0]
         ecc = math.acos(max(-1.0, min(1.0, (gx * dx + gy * dy + gz * dz) / d)))
         slip = self.memory.retinal_slip(xy[0], xy[1], world, prev, self.params.control_dt)
-        return float(plane_variance(d, ecc, slip, -dz / d, self.vision))
+        limit = None
+        if self.vision.field_shape == "human":  # the field in the eye's own frame (columns: its axes)
+            uy = (rows[0][1] * dx + rows[1][1] * dy + rows[2][1] * dz) / d
+            uz = (rows[0][2] * dx + rows[1][2] * dy + rows[2][2] * dz) / d
+            limit = field_limit_eye(uy, uz, self.vision)
+        return float(plane_variance(d, ecc, slip, -dz / d, self.vision, limit=limit))
 
     # --- gaze plan ------------------------------------------------------------------------------------
     def _track_eye(self, t: float, eye) -> None:

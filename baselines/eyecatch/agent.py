@@ -370,7 +370,9 @@ class EyecatchAgent:
         near = rot.T @ (self.filter.x[:3] - eye) if self.filter.initialised else z[:3]
         speed = max(self._retinal_speed(near, vel, eye_turn), self._retinal_speed(near, z[3:], eye_turn))
         pos = self._noise_point(z[:3], rot, eye, speed)
-        R_meas = foveation.covariance(pos, speed, self.vision)
+        # fixation: the eye's vergence distance (proprioception), for the depth law of
+        # VisionParams.depth_pedestal_arcmin (no effect without it)
+        R_meas = foveation.covariance(pos, speed, self.vision, float(obs[_S["fixation"]][0]))
         before = self.filter.resets
         self.filter.update(z, R_meas, rot, eye)
         if self.filter.resets != before:

@@ -65,11 +65,15 @@ import numpy as np
 
 from visuomotor_gym.body.dodge_body import DodgeBody
 from visuomotor_gym.envs.dodge import DODGE_LAYOUT
+from visuomotor_gym.oculomotor.plant import OculomotorParams
 from visuomotor_gym.registration import env_vision
 from visuomotor_gym.tasks.obstacle_dodge import K_SLOTS, NOMINAL_SPEED
 from visuomotor_gym.vision.foveation import DEG, VisionParams, _los_rows, _sigmas
 
 _S = DODGE_LAYOUT.slices
+_FIXATION = _S["fixation"].start  # the eye's vergence distance (m): proprioception
+# The plant's fixation range, onto which the fixation action is log-mapped (core.eye.Eye.command).
+_LOG_FIX = tuple(math.log(x) for x in OculomotorParams().fixation_range_m)
 MIN_STD = 1e-3  # floor of the measurement std (the oracle rung is noiseless)
 
 
@@ -174,11 +178,14 @@ class PedestrianFilter:
 
 
 
-def look_action(eye, point, yaw: float, rot, gaze_range: float, head_share: float) -> list:
+def look_action(eye, point, yaw: float, rot, gaze_range: float, head_share: float, verge: bool = False) -> list:
     """Gaze, fixation and head actions that turn the eye from the ``eye`` position (path frame) to
     ``point``: the direction in the pelvis frame (heading ``yaw``), then in the eye frame (``rot``: the
     eye_rot block, row-major), as a gaze change in units of ``gaze_range``; the head yaws
-    ``head_share`` of the direction's azimuth (neck yaw range +-80 deg)."""
+    ``head_share`` of the direction's azimuth (neck yaw range +-80 deg). ``verge``: also ask for
+    vergence at the point's distance (the log map of ``core.eye.Eye.command`` onto the plant's
+    fixation range; for the depth law of ``VisionParams.depth_pedestal_arcmin``), else the fixation
+    action 0 (v0)."""
     ex, ey, ez = eye
     tx, ty, tz = point
     c, s = math.cos(yaw), math.sin(yaw)
@@ -194,7 +201,11 @@ def look_action(eye, point, yaw: float, rot, gaze_range: float, head_share: floa
     d_el = math.atan2(e2, math.hypot(e0, e1))
     r = gaze_range
     head_yaw = head_share * math.atan2(wy, wx)
-    return [min(max(d_az / r, -1.0), 1.0), min(max(d_el / r, -1.0), 1.0), 0.0,
+    fix = 0.0
+    if verge:
+        lo, hi = _LOG_FIX
+        fix = min(max(2.0 * (math.log(min(max(n, 0.3), 20.0)) - lo) / (hi - lo) - 1.0, -1.0), 1.0)
+    return [min(max(d_az / r, -1.0), 1.0), min(max(d_el / r, -1.0), 1.0), fix,
             min(max(head_yaw / (80.0 * DEG), -1.0), 1.0), 0.0]
 
 class FajenWarrenAgent:
@@ -289,7 +300,7 @@ class FajenWarrenAgent:
                 continue
             ecc = math.acos(max(-1.0, min(1.0, pe[0] / d)))
             lateral_speed = math.sqrt(max(ve[0] ** 2 + ve[1] ** 2 + ve[2] ** 2 - (sum(a * b for a, b in zip(pe, ve)) / d) ** 2, 0.0))
-            sig = _sigmas(d, ecc, lateral_speed / d, self.vision)
+            sig = _sigmas(d, ecc, lateral_speed / d, self.vision, ol[_FIXATION])  # vergence: the depth law
             los = np.array(_los_rows(pe[0] / d, pe[1] / d, pe[2] / d))
             Re = np.array(rot).reshape(3, 3)  # eye axes in the pelvis frame
             Rw = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]) @ Re @ los  # line-of-sight axes, path frame
@@ -472,4 +483,5 @@ class FajenWarrenAgent:
             az = side * p.search_azimuth_deg * DEG
             tx, ty, tz = ex + p.search_distance_m * math.cos(az), ey + p.search_distance_m * math.sin(az), ez
         self.log.append((t, target, self.phi))
-        return look_action((ex, ey, ez), (tx, ty, tz), odo[2], rot, self.gaze_range, p.head_share)
+        return look_action((ex, ey, ez), (tx, ty, tz), odo[2], rot, self.gaze_range, p.head_share,
+                           verge=self.vision.depth_pedestal_arcmin is not None)

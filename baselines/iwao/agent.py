@@ -22,10 +22,12 @@ import math
 from dataclasses import dataclass, fields, replace
 
 import numpy as np
+from visuomotor_gym.baselines.crowding import crowded
 
 from visuomotor_gym.body.walker import GaitParams
 from visuomotor_gym.body.walker_body import WalkerBody
 from visuomotor_gym.envs.walk import WALK_LAYOUT
+from visuomotor_gym.oculomotor.plant import OculomotorParams
 from visuomotor_gym.registration import env_vision, env_vision_params
 from visuomotor_gym.tasks.obstacle_walk import K_SLOTS, N_POINTS
 from visuomotor_gym.vision.foveation import VisionParams
@@ -37,6 +39,9 @@ from .planner import FootstepPlanner, PlannerParams
 _S = WALK_LAYOUT.slices
 # Where the blocks the agent reads start in the flat observation (read from a list of floats each step).
 _EYE_POS, _EYE_ROT, _ODOMETRY, _PELVIS = (_S[b].start for b in ("eye_pos", "eye_rot", "odometry", "pelvis"))
+_FIXATION = _S["fixation"].start  # the eye's vergence distance (m): proprioception
+# The plant's fixation range, onto which the fixation action is log-mapped (core.eye.Eye.command).
+_LOG_FIX = tuple(math.log(x) for x in OculomotorParams().fixation_range_m)
 _GAIT_PHASE, _FOOTHOLDS, _TIME = _S["gait_phase"].start, _S["footholds"].start, _S["time"].start
 _SLOTS = tuple(_S[f"obstacle_{k}"].start for k in range(K_SLOTS))
 NECK_PITCH_DOWN_DEG = 50.0  # the head action's -1 (envs_assets/common/head_eye.xml: neck_pitch -50 .. 40)
@@ -75,16 +80,17 @@ class IwaoAgent:
     """See the module docstring. ``predict(obs) -> (action, state)`` on flat ObstacleWalk observations."""
 
     def __init__(self, params: IwaoParams | None = None, gaze: IwaoGazeParams | None = None,
-                 planner: PlannerParams | None = None, gait: GaitParams | None = None) -> None:
+                 planner: PlannerParams | None = None, gait: GaitParams | None = None,
+                 vision: VisionParams | None = None) -> None:
         self.params = p = params or IwaoParams()
         self.gaze_params = gaze or IwaoGazeParams()
         self.gait = gait or GaitParams()
         self.planner = FootstepPlanner(self.gait, planner)
-        self.vision = VisionParams(noise_scale=p.vision_noise_scale, foveated=p.foveated,
-                                   position_slip_knee_deg_s=p.position_slip_knee_deg_s)
+        self.memory = ObstacleMemory(vision or VisionParams(noise_scale=p.vision_noise_scale, foveated=p.foveated,
+                                                           position_slip_knee_deg_s=p.position_slip_knee_deg_s),
+                                     self.planner.p.walkway_half_width_m)
         self.delay_steps = round(p.visual_delay_s / p.control_dt)
         self.gaze_range = p.gaze_action_range_deg * DEG
-        self.memory = ObstacleMemory(self.vision, self.planner.p.walkway_half_width_m)
         self.period_steps = round(self.gait.step_s / p.control_dt)
         self.lead_steps = min(round(p.pursuit_lead_s / p.control_dt), self.period_steps)
         self.reset()
@@ -98,7 +104,25 @@ class IwaoAgent:
         unknown = sorted(set(overrides) - known)
         if unknown:
             raise TypeError(f"unknown iwao parameter(s) {unknown}; known: {sorted(known)}")
-        return cls(replace(base, **overrides))
+        # The eye's every constant (env_vision_params: the walk family's, with the human periphery's
+        # fields when the id is registered with them), so the obstacle memory weights each sample as
+        # this eye makes it; the noise scale, foveation and slip knee given as overrides win.
+        params = replace(base, **overrides)
+        vision = env_vision_params(env_id)
+        mine = {"vision_noise_scale": "noise_scale", "foveated": "foveated",
+                "position_slip_knee_deg_s": "position_slip_knee_deg_s"}
+        vision = replace(vision, **{mine[k]: getattr(params, k) for k in overrides if k in mine})
+        return cls(params, vision=vision)
+
+    @property
+    def vision(self) -> VisionParams:
+        """The vision model the agent weights its samples with: its obstacle memory's (one object, so
+        ``agents.match_vision`` setting it reaches the memory too)."""
+        return self.memory.vision
+
+    @vision.setter
+    def vision(self, value: VisionParams) -> None:
+        self.memory.vision = value
 
     def reset(self) -> None:
         self.memory.reset()
@@ -137,7 +161,7 @@ class IwaoAgent:
         if len(self.poses) > self.delay_steps + 1:
             self.poses.pop(0)
         seen_pose = self.poses[0] if len(self.poses) > self.delay_steps else pose
-        self._perceive(ol, seen_pose)
+        self._perceive(ol, seen_pose, ol[_FIXATION])
 
         g0 = _GAIT_PHASE
         phase, latch_in = ol[g0], ol[g0 + 2]
@@ -148,12 +172,21 @@ class IwaoAgent:
             return np.array(self.footstep + [0.0, 0.0, 0.0, 0.0, 0.0], dtype=np.float32)
         return np.array(self.footstep + self._look(obs, phase, pose), dtype=np.float32)
 
-    def _perceive(self, ol: list, pose) -> None:
+    def _perceive(self, ol: list, pose, vergence: float | None = None) -> None:
         eye_pos, rot_rows, odo = pose
         seen_eye = _eye_in_path(pose)
         prev, self.prev_seen_eye = self.prev_seen_eye, seen_eye
         motion = None if prev is None else eye_motion(prev, seen_eye, self.params.control_dt)
         f = 1 + 3 * N_POINTS  # the seen flags follow the id and the points
+        if self.vision.crowding:
+            # with crowding in the vision model, a point that may be pooled with another obstacle's is fused
+            # with the spread of its crowding zone (baselines.crowding); one obstacle's points do not crowd
+            seen = [(round(ol[b]), which, ol[b + 1 + 3 * which:b + 4 + 3 * which]) for b in _SLOTS
+                    for which in range(N_POINTS) if ol[b + f + which] > 0.0]
+            drop = crowded([p for _, _, p in seen], [index for index, _, _ in seen], self.vision)
+            for n, (index, which, p_eye) in enumerate(seen):
+                self.memory.add(index, which, p_eye, eye_pos, rot_rows, odo, motion, vergence, crowded=n in drop)
+            return
         for b in _SLOTS:
             flags = ol[b + f:b + f + N_POINTS]
             if 1.0 not in flags:
@@ -161,7 +194,8 @@ class IwaoAgent:
             index = round(ol[b])
             for which, seen in enumerate(flags):
                 if seen > 0.0:
-                    self.memory.add(index, which, ol[b + 1 + 3 * which:b + 4 + 3 * which], eye_pos, rot_rows, odo, motion)
+                    self.memory.add(index, which, ol[b + 1 + 3 * which:b + 4 + 3 * which], eye_pos, rot_rows, odo, motion,
+                                    vergence)
 
     def _footholds(self, obs: np.ndarray, odo) -> list[tuple[float, float, float]]:
         f = obs[_S["footholds"]].reshape(3, 3)
@@ -187,6 +221,26 @@ class IwaoAgent:
         # Slots seen on one edge only, or not yet: the travel point ahead on the ground.
         eye_x = odo[0] + pose[0][0]
         return (eye_x + self.params.travel_look_ahead_m, odo[1], 0.0), -1
+
+    def _verge(self, ex, ey, ez, wx, wy, wz, fixating: bool) -> float:
+        """The fixation (vergence) action. Without the depth law in the agent's vision model 0 (the
+        fixation range's log midpoint, 1.4 m: iwao v0, golden digests). With it (``depth_pedestal_arcmin``:
+        depth is precise only near the vergence distance, Blakemore 1970), verge on what the gaze is
+        sent to: the cycle's fixation point while fixating, else where the requested line of sight
+        (path frame ``wx, wy, wz``; pelvis yaw does not change its pitch) meets the plane of the target's
+        top, at most the target's distance when it points above that plane (modelling choice: humans
+        verge on the fixated point)."""
+        if self.vision.depth_pedestal_arcmin is None:
+            return 0.0
+        if fixating:
+            fx, fy, fz = self.fixation
+            d = math.sqrt((fx - ex) ** 2 + (fy - ey) ** 2 + (fz - ez) ** 2)
+        else:
+            tx, ty, tz = self.target
+            d = math.sqrt((tx - ex) ** 2 + (ty - ey) ** 2 + (tz - ez) ** 2)
+            if wz < -0.05:
+                d = min((ez - tz) / -wz, d) if ez > tz else d
+        return _fixation_action(min(max(d, 0.3), 20.0))
 
     def _look(self, obs: np.ndarray, phase: float, pose) -> list:
         gp = self.gaze_params
@@ -262,9 +316,15 @@ class IwaoAgent:
         d_el = math.atan2(e2, math.hypot(e0, e1))
         r = self.gaze_range
         return [min(max(d_az / r, -1.0), 1.0), min(max(d_el / r, -1.0), 1.0),
-                0.0,  # fixation distance: unused in v0
+                self._verge(ex, ey, ez, wx, wy, wz, fixating),
                 0.0,  # head yaw straight
                 min(max(-head / (NECK_PITCH_DOWN_DEG * DEG), -1.0), 0.0)]
+
+
+def _fixation_action(distance: float) -> float:
+    """The fixation action that asks for vergence at ``distance`` m (the log map of ``Eye.command``)."""
+    lo, hi = _LOG_FIX
+    return min(max(2.0 * (math.log(distance) - lo) / (hi - lo) - 1.0, -1.0), 1.0)
 
 
 def _angles(x: float, y: float, z: float) -> tuple[float, float]:

@@ -17,6 +17,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from visuomotor_gym.baselines.crowding import crowd_std
 
 from visuomotor_gym.tasks.obstacle_walk import N_POINTS, CourseDistribution
 from visuomotor_gym.vision.foveation import VisionParams, _sigmas
@@ -140,7 +141,8 @@ class ObstacleMemory:
     def reset(self) -> None:
         self.corners = {}
 
-    def add(self, index: int, which: int, p_eye, eye_pos, rot_rows, odo, motion=None) -> None:
+    def add(self, index: int, which: int, p_eye, eye_pos, rot_rows, odo, motion=None, vergence=None,
+            crowded: bool = False) -> None:
         """One sample of point ``which`` (``TOP_POINTS`` order: 0 near-left, 1 far-right, 2 near-edge
         midpoint, 3 far-edge midpoint) of obstacle ``index``: ``p_eye`` in
         the eye frame, ``eye_pos`` and ``rot_rows`` (3x3, columns = eye axes) in the pelvis frame,
@@ -148,7 +150,11 @@ class ObstacleMemory:
         (eye velocity, gaze angular velocity), path frame, over the control step that ended with this
         sample (the agent's efference copy and proprioception: :func:`eye_motion`): the retinal slip of
         a still point, which widens the lateral noise above the knee (``VisionParams``
-        ``position_slip_knee_deg_s``, Westheimer & McKee 1975), is predicted from it; None: no slip."""
+        ``position_slip_knee_deg_s``, Westheimer & McKee 1975), is predicted from it; None: no slip.
+        ``vergence``: the eye's vergence distance (m, proprioception) for the depth law of
+        ``VisionParams.depth_pedestal_arcmin`` (no effect without it). ``crowded``: the sample may be
+        pooled with another obstacle's (``baselines.crowding``): both stds are at least
+        ``crowding.crowd_std`` (the spread of the crowding zone)."""
         ex, ey, ez = p_eye
         d = math.sqrt(ex * ex + ey * ey + ez * ez)
         if d <= 0.0:
@@ -190,7 +196,9 @@ class ObstacleMemory:
                 return
         d_ref = min(max(d_ref, 0.3), 30.0)
         slip = 0.0 if motion is None else still_point_slip(u, d_ref, *motion)
-        s_depth, s_lat = _sigmas(d_ref, ecc, slip, self.vision)[:2]
+        s_depth, s_lat = _sigmas(d_ref, ecc, slip, self.vision, vergence)[:2]
+        if crowded:
+            s_depth, s_lat = max(s_depth, crowd_std(d_ref, ecc, self.vision)), max(s_lat, crowd_std(d_ref, ecc, self.vision))
         corner.add(z, u, max(s_depth, MIN_STD_M), max(s_lat, MIN_STD_M))
 
     def obstacle(self, index: int) -> ObstacleEstimate | None:

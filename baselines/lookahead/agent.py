@@ -33,6 +33,7 @@ import math
 from dataclasses import dataclass, fields, replace
 
 import numpy as np
+from visuomotor_gym.baselines.crowding import crowded
 
 from visuomotor_gym.body.walker import GaitParams
 from visuomotor_gym.body.walker_body import TurningWalkerBody as WalkerBody
@@ -78,10 +79,9 @@ class LookaheadAgent:
                  vision: VisionParams | None = None) -> None:
         self.params = p = params or LookaheadParams()
         self.gait = gait or GaitParams()
-        self.vision = vision or VisionParams(noise_scale=p.vision_noise_scale, foveated=p.foveated)
+        self.memory = StoneMemory(vision or VisionParams(noise_scale=p.vision_noise_scale, foveated=p.foveated))
         self.delay_steps = round(p.visual_delay_s / p.control_dt)
         self.gaze_range = p.gaze_action_range_deg * DEG
-        self.memory = StoneMemory(self.vision)
         self.reset()
 
     @classmethod
@@ -93,6 +93,16 @@ class LookaheadAgent:
         if unknown:
             raise TypeError(f"unknown lookahead parameter(s) {unknown}; known: {sorted(known)}")
         return cls(replace(base, **overrides), vision=env_vision_params(env_id))
+
+    @property
+    def vision(self) -> VisionParams:
+        """The vision model the agent weights its samples with: its stone memory's (one object, so
+        ``agents.match_vision`` setting it reaches the memory too)."""
+        return self.memory.vision
+
+    @vision.setter
+    def vision(self, value: VisionParams) -> None:
+        self.memory.vision = value
 
     def reset(self) -> None:
         self.memory.reset()
@@ -131,11 +141,14 @@ class LookaheadAgent:
         seen_prev = self.poses[-self.delay_steps - 2] if len(self.poses) >= self.delay_steps + 2 else None
         prev = None if seen_prev is None else StoneMemory.eye_pose(*seen_prev)
         self.next_stone = round(ol[_S["stone_0"].start])
-        for k in range(K_SLOTS):
-            b = _S[f"stone_{k}"].start
-            if ol[b + 4] > 0.0:
-                self.memory.add(round(ol[b]), ol[b + 1:b + 4], seen_pose[0], seen_pose[1], seen_pose[2], prev,
-                                self.params.control_dt)
+        seen = [_S[f"stone_{k}"].start for k in range(K_SLOTS) if ol[_S[f"stone_{k}"].start + 4] > 0.0]
+        # with crowding in the vision model, a sample that may be pooled with a neighbour's is fused with the
+        # spread of its crowding zone (baselines.crowding)
+        drop = crowded([ol[b + 1:b + 4] for b in seen], [round(ol[b]) for b in seen], self.vision) \
+            if self.vision.crowding else ()
+        for n, b in enumerate(seen):
+            self.memory.add(round(ol[b]), ol[b + 1:b + 4], seen_pose[0], seen_pose[1], seen_pose[2], prev,
+                            self.params.control_dt, crowded=n in drop)
         latch_in = ol[_S["gait_phase"].start + 2]
         if latch_in <= self.params.control_dt + 1e-6:  # this step's command is read at mid-stance
             self.footstep = self._plan(obs, odo)

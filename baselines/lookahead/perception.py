@@ -18,6 +18,8 @@ from __future__ import annotations
 
 import math
 
+from visuomotor_gym.baselines.crowding import crowd_std
+
 from visuomotor_gym.tasks.stepping_stones import STONE_TOP_Z
 from visuomotor_gym.vision.foveation import VisionParams, _sigmas
 
@@ -78,11 +80,14 @@ class StoneMemory:
         dot = max(-1.0, min(1.0, a[0] * b[0] + a[1] * b[1] + a[2] * b[2]))
         return math.acos(dot) / dt
 
-    def add(self, index: int, p_eye, eye_pos, rot_rows, odo, prev: EyePose | None = None, dt: float = 0.02) -> None:
+    def add(self, index: int, p_eye, eye_pos, rot_rows, odo, prev: EyePose | None = None, dt: float = 0.02,
+            crowded: bool = False) -> None:
         """One sample of stone ``index``: ``p_eye`` in the eye frame, ``eye_pos`` and ``rot_rows`` (3x3,
         columns = eye axes) in the pelvis frame, ``odo`` = (x, y, yaw, pelvis height) of the pelvis;
         ``prev`` the eye's pose (:meth:`eye_pose`) one control step ``dt`` earlier, for the retinal slip
-        that blurs a moving image (the lateral std grows above a knee: ``foveation.slip_factor``)."""
+        that blurs a moving image (the lateral std grows above a knee: ``foveation.slip_factor``).
+        ``crowded``: the sample may be pooled with a neighbour's (``baselines.crowding``): its std is at
+        least the crowding zone's spread (``crowding.crowd_std`` at the plane's distance)."""
         ex, ey, ez = p_eye
         d = math.sqrt(ex * ex + ey * ey + ez * ez)
         if d <= 1e-9:
@@ -108,6 +113,8 @@ class StoneMemory:
         qx, qy = est[0] if est is not None else (px, py)
         slip = self.retinal_slip(qx, qy, self.eye_pose(eye_pos, rot_rows, odo), prev, dt)
         s_lat = max(_sigmas(t, ecc, slip, self.vision)[1] * t / d, MIN_STD_M)
+        if crowded:
+            s_lat = max(s_lat, crowd_std(t, ecc, self.vision))
         h = math.hypot(hx, hy)
         if h <= 1e-9:  # straight down: isotropic
             a_info = c_info = 1.0 / (s_lat * s_lat)

@@ -1,0 +1,162 @@
+"""The walker baselines model the eye they see with, the human periphery included (issue 23).
+
+iwao's obstacle memory and lookahead's stone memory weight every sample with the env's own
+``VisionParams`` (``agents.match_vision``, called by ``make_agent``, reaches them); the belief-MPC
+planners of the dodge and stones families predict what they will see with the env's field shape and
+position law (``baselines/belief_mpc/field.py``), each checked against a hand-computed case.
+"""
+
+from __future__ import annotations
+
+import math
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from visuomotor_gym.baselines.belief_mpc.field import field_limit, field_limit_eye, position_e2_rad
+from visuomotor_gym.baselines.belief_mpc.stone_belief import plane_variance
+
+import visuomotor_gym  # noqa: F401
+from visuomotor_gym.agents import make_agent, match_vision
+from visuomotor_gym.vision import periphery
+from visuomotor_gym.vision.foveation import ARCMIN, DEG, VisionParams
+
+HUMAN = {"field_shape": "human", "position_e2_deg": 0.7, "crowding": True, "depth_pedestal_arcmin": 10.0}
+
+
+def _inner(policy):
+    while hasattr(policy, "base"):
+        policy = policy.base
+    return policy
+
+
+@pytest.mark.parametrize("env_id, agent, memory", [("ObstacleWalk-v0", "iwao", "memory"),
+                                                    ("SteppingStones-v0", "lookahead", "memory"),
+                                                    ("SteppingStones-v0", "belief_mpc", "memory")])
+@pytest.mark.parametrize("spec", ["{}", "gaze_blind:{}"])
+def test_the_memory_weights_samples_with_the_env_vision(env_id, agent, memory, spec):
+    env = gym.make(env_id, vision_params=dict(HUMAN))
+    try:
+        policy = make_agent(spec.format(agent), env_id, int(env.action_space.shape[0]))
+        inner = _inner(policy)
+        # make_agent gives the registered id's vision (20 deg cone, no periphery)
+        assert getattr(inner, memory).vision.field_shape == "cone"
+        assert getattr(inner, memory).vision.field_of_view_deg == 20.0
+        match_vision(policy, env.unwrapped.vision_params)
+        seen = getattr(inner, memory).vision
+        assert seen is inner.vision is env.unwrapped.vision_params
+        assert (seen.field_shape, seen.position_e2_deg, seen.crowding, seen.depth_pedestal_arcmin) == \
+            ("human", 0.7, True, 10.0)
+    finally:
+        env.close()
+
+
+def test_iwao_for_env_keeps_vision_overrides():
+    from visuomotor_gym.baselines.iwao.agent import IwaoAgent
+
+    agent = IwaoAgent.for_env("ObstacleWalk-v0", vision_noise_scale=3.0, foveated=False)
+    assert agent.memory.vision.noise_scale == 3.0 and agent.memory.vision.foveated is False
+    assert IwaoAgent.for_env("ObstacleWalk-v0").memory.vision.field_of_view_deg == 20.0
+
+
+def test_field_limit_of_the_cone_is_its_half_angle():
+    v = VisionParams(field_of_view_deg=20.0)
+    assert field_limit(np.array([1.0, 0.0, 0.0]), np.array([0.0, 0.0, 1.0]), v) == 20.0 * DEG
+
+
+def test_field_limit_of_the_human_field_by_hand():
+    v = VisionParams(field_shape="human")
+    g = np.array([1.0, 0.0, 0.0])  # gaze along x: the eye frame is the path frame
+    up, down, left = np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, -1.0]), np.array([0.0, 1.0, 0.0])
+    assert field_limit(g, up, v) == pytest.approx(60.0 * DEG)
+    assert field_limit(g, down, v) == pytest.approx(75.0 * DEG)
+    assert field_limit(g, left, v) == pytest.approx(100.0 * DEG)
+    assert field_limit(g, -left, v) == pytest.approx(100.0 * DEG)
+    # 45 deg up-left: 1 / sqrt(0.5 / S^2 + 0.5 / V^2), S = 100 deg, V = 60 deg
+    diag = np.array([0.0, 1.0, 1.0]) / math.sqrt(2.0)
+    expected = 1.0 / math.sqrt(0.5 / (100.0 * DEG) ** 2 + 0.5 / (60.0 * DEG) ** 2)
+    assert field_limit(g, diag, v) == pytest.approx(expected)
+    # the same geometry seen with the gaze turned 90 deg left (yaw): left is then -x
+    g2 = np.array([0.0, 1.0, 0.0])
+    assert field_limit(g2, np.array([-1.0, 0.0, 0.0]), v) == pytest.approx(100.0 * DEG)
+    assert field_limit(g2, down, v) == pytest.approx(75.0 * DEG)
+
+
+def test_field_limit_eye_matches_the_retina_law():
+    v = VisionParams(field_shape="human")
+    rng = np.random.default_rng(0)
+    for uy, uz in rng.uniform(-1.0, 1.0, size=(50, 2)):
+        assert float(field_limit_eye(uy, uz, v)) == pytest.approx(periphery.human_field_limit(uy, uz, v), rel=1e-12)
+    assert float(field_limit_eye(0.0, 0.0, v)) == pytest.approx(100.0 * DEG)
+
+
+def test_plane_variance_follows_the_position_law_and_the_field():
+    d, th, slip, dep = 2.0, 5.0 * DEG, 0.0, 0.5
+    for e2_deg, vision in ((2.0, VisionParams()), (0.7, VisionParams(position_e2_deg=0.7))):
+        assert position_e2_rad(vision) == pytest.approx(e2_deg * DEG)
+        s = d * ARCMIN * (1.0 + math.sqrt(th * th + (0.2 * DEG) ** 2) / (e2_deg * DEG))
+        expected = 0.5 * s * s * (1.0 + 1.0 / dep**2) + 1e-6  # + FLOOR_M2 (1 mm std)
+        assert float(plane_variance(d, th, slip, dep, vision)) == pytest.approx(expected, rel=1e-6, abs=1e-12)
+    # beyond the limit: nothing seen; the default limit is the cone
+    assert math.isinf(float(plane_variance(d, 25.0 * DEG, slip, dep, VisionParams(field_of_view_deg=20.0))))
+    assert math.isfinite(float(plane_variance(d, 25.0 * DEG, slip, dep, VisionParams(field_of_view_deg=20.0),
+                                              limit=60.0 * DEG)))
+
+
+def test_dodge_planner_models_the_env_vision():
+    env_id = "ObstacleDodge-v0"
+    env = gym.make(env_id, vision_params=dict(HUMAN))
+    try:
+        policy = make_agent("belief_mpc", env_id, int(env.action_space.shape[0]))
+        assert policy.plan_vision.field_of_view_deg == 20.0 and policy.plan_vision.field_shape == "cone"
+        before = policy.noise
+        match_vision(policy, env.unwrapped.vision_params)
+        assert policy.plan_vision is policy.vision is env.unwrapped.vision_params
+        assert policy.plan_vision.field_shape == "human"
+        assert policy.noise is not before
+    finally:
+        env.close()
+
+
+def test_iwao_verges_on_its_gaze_target_only_under_the_depth_law():
+    """Without the depth law the fixation action stays 0 (iwao v0); with it, it asks for a vergence
+    distance on the ground ahead (the fixated point: 1.8-8 m for the walkway's eye 1.6 m up), never the
+    action 0's 1.4 m."""
+    from visuomotor_gym.baselines.iwao.agent import _LOG_FIX
+
+    lo, hi = _LOG_FIX
+    for fields, check in (({}, lambda a: a == 0.0),
+                          ({"depth_pedestal_arcmin": 10.0},
+                           lambda a: 1.8 <= math.exp(lo + (a + 1.0) * 0.5 * (hi - lo)) <= 8.0)):
+        env = gym.make("ObstacleWalk-v0", vision_params=fields) if fields else gym.make("ObstacleWalk-v0")
+        try:
+            policy = make_agent("iwao", "ObstacleWalk-v0", int(env.action_space.shape[0]))
+            match_vision(policy, env.unwrapped.vision_params)
+            fix = env.unwrapped.action_structure  # the fixation action's index in the flat action
+            index = sum(n for name, n in list(fix.items())[:list(fix).index("fixation")])
+            obs, _ = env.reset(seed=0)
+            for _ in range(40):
+                action, _ = policy.predict(obs)
+                assert check(float(action[index])), (fields, float(action[index]))
+                obs, _, terminated, truncated, _ = env.step(action)
+                assert not (terminated or truncated)
+        finally:
+            env.close()
+
+
+def test_crowded_flags_only_targets_within_the_critical_spacing():
+    """Target at 10 deg: a flanker of another object 4.9 deg away crowds it (b theta = 5 deg), one at
+    5.1 deg does not, a point of the same object never does; a target inside the 0.5 deg fovea is never
+    crowded; without crowding in the vision model nothing is flagged."""
+    from visuomotor_gym.baselines.crowding import crowd_std, crowded
+
+    def at(az_deg):
+        return (math.cos(az_deg * DEG), math.sin(az_deg * DEG), 0.0)
+
+    v = VisionParams(crowding=True)
+    assert crowded([at(10.0), at(14.9)], [1, 2], v) == {0, 1}  # 4.9 < 0.5 x 14.9 too
+    assert 0 not in crowded([at(10.0), at(15.1)], [1, 2], v)
+    assert crowded([at(10.0), at(14.9)], [1, 1], v) == set()
+    assert 0 not in crowded([at(0.3), at(0.35)], [1, 2], v)
+    assert crowded([at(10.0), at(14.9)], [1, 2], VisionParams()) == set()
+    assert crowd_std(2.0, 10.0 * DEG, v) == pytest.approx(0.5 * 0.5 * 10.0 * DEG * 2.0)
