@@ -1,4 +1,4 @@
-"""The walker baselines model the eye they see with, the human periphery included (issue 23).
+"""The walker baselines model the eye they see with, the human periphery included.
 
 iwao's obstacle memory and lookahead's stone memory weight every sample with the env's own
 ``VisionParams`` (``agents.match_vision``, called by ``make_agent``, reaches them); the belief-MPC

@@ -24,7 +24,7 @@ before it; beyond the longest step (still on the slab) the distance is split int
 along the current heading.
 
 ``gaze_blind=True`` holds gaze and head (gaze action 0: gaze stays level along the slab where the
-episode put it; head straight): the gaze-blind twin of DESIGN section 2, the same belief and planner.
+episode put it; head straight): the gaze-blind twin (docs/gaze_gain.md), the same belief and planner.
 """
 
 from __future__ import annotations

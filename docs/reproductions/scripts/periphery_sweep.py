@@ -1,4 +1,4 @@
-"""The human periphery, mechanism by mechanism, on every family (issue 23, measurement part).
+"""The human periphery, mechanism by mechanism, on every family (docs/reproductions/data/periphery/).
 
 For each family's best baseline, its held twin (``gaze_blind:<agent>``) and its best static twin
 (``static_gaze:<agent>``, the posture searched under the *default* vision, from
