@@ -258,7 +258,7 @@ def plot_gaze_vs_ball(trace: EpisodeTrace, ax=None, origin: str = "eye"):
     if ax is None:
         fig = _new_figure((7.5, 5.5))
         axes = list(fig.subplots(2, 1, sharex=True))
-    elif isinstance(ax, Sequence) or isinstance(ax, np.ndarray):
+    elif isinstance(ax, (Sequence, np.ndarray)):
         axes = list(ax)
         if len(axes) != 2:
             raise ValueError("ax must be one Axes or a pair (azimuth, elevation)")
