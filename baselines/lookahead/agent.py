@@ -34,7 +34,7 @@ depth noise brought them near the eye; with any mechanism its memory models a sa
 of its perceived eccentricity and that of the stone's estimate (:mod:`.perception`).
 
 ``gaze_blind=True`` holds gaze and head (gaze action 0: gaze stays level along the slab where the
-episode put it; head straight): the gaze-blind twin of DESIGN section 2, the same belief and planner.
+episode put it; head straight): the gaze-blind twin (docs/gaze_gain.md), the same belief and planner.
 """
 
 from __future__ import annotations
