@@ -1,4 +1,4 @@
-"""SteppingStones terrain sweep (issue 23): an agent, its held twin and static twins on a course preset
+"""SteppingStones terrain sweep: an agent, its held twin and static twins on a course preset
 under the human periphery, with success, failure causes and the stones realism score.
 
 Each condition is a set of ``SteppingStonesEnv`` keyword arguments (``course_distribution`` preset,

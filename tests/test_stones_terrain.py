@@ -1,4 +1,4 @@
-"""SteppingStones' opt-in "rough" course preset (issue 23): reproducible, the same path as the default
+"""SteppingStones' opt-in "rough" course preset: reproducible, the same path as the default
 course, hazards placed by the documented rule (a hand-computed case), hazards never hold a foot, no
 observation leak of unseen hazards or stones (counterfactual scenes; slot ids advance only on landings),
 the lookahead agent's periphery adaptations gated on its vision model, and the static-gaze search on env
@@ -180,7 +180,7 @@ def test_slot_ids_advance_only_when_a_foot_lands():
     env = SteppingStonesEnv(course_distribution="rough", vision_params=ALL_FOUR)
     agent = make_agent("lookahead", "SteppingStones-v0", 9)
     match_vision(agent, env.vision_params)
-    obs, info = env.reset(seed=2)
+    obs, _ = env.reset(seed=2)
     agent.reset()
     slot0 = STONES_LAYOUT.slices["stone_0"].start
     changes = 0
@@ -188,7 +188,7 @@ def test_slot_ids_advance_only_when_a_foot_lands():
     for _ in range(600):
         before = obs[slot0]
         act, _ = agent.predict(obs)
-        obs, _, term, trunc, info = env.step(act)
+        obs, _, term, trunc, _ = env.step(act)
         if term or trunc:
             break
         if obs[slot0] != before:

@@ -23,7 +23,7 @@ foothold's heading; length and width follow in that frame. An unseen stone is ex
 before it; beyond the longest step (still on the slab) the distance is split into equal nominal steps
 along the current heading.
 
-**Under the human periphery** (issue 23; each change only when the agent's vision model has the
+**Under the human periphery** (each change only when the agent's vision model has the
 mechanism, so with the default vision the agent is the original one): with crowding it looks at the
 first stone no foothold is planned for yet as soon as the previous footstep is latched
 (``look_past_plan``: ~0.5 s of fixation before the read, 2-3 steps ahead as on rough terrain, Matthis,

@@ -126,7 +126,7 @@ class SteppingStonesEnv(WalkerEnv):
     * v0: initial release. Redefined in place (ALLSTEPS' turns): the walker turns
       (a fourth footstep value, the ``foothold_headings`` block) and the path may drift to +-60 deg, where
       the first definition's walker kept its heading and the path stayed within +-20 deg (8 actions).
-      Opt-in rough terrain (issue 23, prototype): ``course_distribution="rough"`` (stones of radius 0.15 m,
+      Opt-in rough terrain (prototype): ``course_distribution="rough"`` (stones of radius 0.15 m,
       two hazards beside each, ``envs_assets/stones_rough.xml``); the default course is unchanged.
     """
 

@@ -30,7 +30,7 @@ stone no foot has landed on yet): when the footstep onto stone ``n + 1`` is chos
 read) the slots reach two stones beyond it, as the walker must see >= 2 steps ahead (Matthis & Fajen
 2014) and ALLSTEPS' policy sees the next 2 targets. A stone not seen this step reads as zeros.
 
-**Rough terrain (opt-in, issue 23)**: ``course_distribution="rough"`` (:data:`COURSE_PRESETS`) keeps the
+**Rough terrain (opt-in)**: ``course_distribution="rough"`` (:data:`COURSE_PRESETS`) keeps the
 path of the default course for the same seed (its draws come first) and adds what makes footholds hard
 to localise without looking at them: smaller stones (``stone_radius_m``) and, beside each stone,
 ``hazards_per_stone`` *hazards* (loose rocks: :func:`sample_hazards`; the scene ``stones_rough.xml``) that
@@ -116,7 +116,7 @@ class CourseDistribution:
     turn_slack_deg: float = 5.0  # modelling choice: a steppable course needs turns 5 deg short of the gait's limit
     start_foot_x_m: float = 1.95 + FOOT_CENTRE_AHEAD_M  # nominal foot centre of the last foothold on the slab
     start_foot_y_m: float = -0.06  # ... (the right foot, half the 0.12 m nominal step width to the right)
-    # --- the "rough" terrain (issue 23; off by default: the fields below leave the course as above) ---
+    # --- the "rough" terrain (off by default: the fields below leave the course as above) ---
     # Radius of every stone (m); None: the scene's 0.25 m (ALLSTEPS).
     stone_radius_m: float | None = None
     # Hazards (loose rocks that do not hold a foot: a foot landing on one falls) drawn beside each stone;
@@ -138,7 +138,7 @@ class CourseDistribution:
         return ROUGH_SCENE if self.hazards_per_stone else STONES_SCENE
 
 
-# The opt-in course presets (``SteppingStonesEnv(course_distribution="rough")``). "rough" (issue 23; its
+# The opt-in course presets (``SteppingStonesEnv(course_distribution="rough")``). "rough" (its
 # measurements in docs/reproductions/data/terrain/stepping_stones.md): footholds that must be located
 # precisely and early, among clutter where crowding acts. Stones of radius 0.15 m (modelling choice: a
 # 30 cm stone, the midfoot must land within 15 cm of its centre, where ALLSTEPS' 0.25 m stones leave 25 cm),
