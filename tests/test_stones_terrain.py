@@ -204,7 +204,7 @@ def test_lookahead_adapts_only_when_its_vision_model_has_the_periphery():
     the golden digests). Depth law: the fixation action asks for vergence at the gaze target's distance
     (1.5-6 m on the stones, never the action 0's 1.4 m); crowding: gaze on the first unplanned stone and
     peripheral samples flagged."""
-    from baselines.lookahead.agent import _LOG_FIX, beyond_fovea, fixation_action
+    from visuomotor_gym.baselines.lookahead.agent import _LOG_FIX, beyond_fovea, fixation_action
 
     lo, hi = _LOG_FIX
     assert fixation_action(math.exp(0.5 * (lo + hi))) == pytest.approx(0.0)
@@ -270,3 +270,27 @@ def test_rough_crossing_needs_the_moving_eye():
                          for s in range(3))
         env.close()
     assert wins["lookahead"] == 3 and wins["gaze_blind:lookahead"] == 0
+
+
+def test_belief_mpc_plane_variance_knows_crowding():
+    """With crowding in the vision model a sample beyond the 0.5 deg fovea has at least the crowding zone's
+    variance on the plane: std c = 0.5 * b * theta * d across the line of sight, c / sin(depression) along
+    it, r = c^2 (1 + 1 / dep^2) / 2 (hand-computed at d = 2 m, theta = 10 deg, dep = 0.6); inside the
+    fovea and without crowding the vision model's own."""
+    from dataclasses import replace
+
+    from visuomotor_gym.baselines.belief_mpc.stone_belief import plane_variance
+
+    from visuomotor_gym.vision.foveation import VisionParams
+
+    plain = VisionParams(field_shape="human")
+    crowd = replace(plain, crowding=True)
+    th = math.radians(10.0)
+    c = 0.5 * 0.5 * th * 2.0
+    expected = 0.5 * c * c * (1.0 + 1.0 / 0.36)
+    r_plain = float(plane_variance(2.0, th, 0.0, 0.6, plain, limit=math.radians(90)))
+    r_crowd = float(plane_variance(2.0, th, 0.0, 0.6, crowd, limit=math.radians(90)))
+    assert r_plain < expected and r_crowd == pytest.approx(expected)
+    fov = math.radians(0.4)
+    assert float(plane_variance(2.0, fov, 0.0, 0.6, crowd, limit=math.radians(90))) == \
+        float(plane_variance(2.0, fov, 0.0, 0.6, plain, limit=math.radians(90)))

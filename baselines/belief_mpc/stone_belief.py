@@ -96,6 +96,12 @@ def plane_variance(distance, eccentricity, slip, depression_sin, vision: VisionP
     s = d * sq * slip_f * amp
     dep = np.maximum(np.asarray(depression_sin, dtype=float), 0.02)  # lookahead's MIN_DEPRESSION
     r = 0.5 * s * s * (1.0 + 1.0 / (dep * dep)) + FLOOR_M2
+    if vision.foveated and getattr(vision, "crowding", False):
+        # With crowding every sample beyond the crowding-free fovea may be pooled with a flanker the
+        # observation does not report: its std is at least half the critical spacing at its distance
+        # (baselines.crowding.crowd_std; the lookahead agent's distrust_periphery), on the plane as above.
+        c = 0.5 * vision.crowding_bouma * th * d
+        r = np.where(th > vision.crowding_fovea_deg * DEG, np.maximum(r, 0.5 * c * c * (1.0 + 1.0 / (dep * dep))), r)
     if vision.foveated:
         r = np.where(th <= (vision.field_of_view_deg * DEG if limit is None else limit), r, np.inf)
     shape = np.broadcast_shapes(d.shape, th.shape, np.shape(slip), np.shape(depression_sin))

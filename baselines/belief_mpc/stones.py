@@ -39,6 +39,7 @@ from visuomotor_gym.baselines.lookahead.agent import (
     NECK_YAW_DEG,
     LookaheadAgent,
     LookaheadParams,
+    beyond_fovea,
 )
 from visuomotor_gym.baselines.lookahead.perception import STONE_PLANE_Z, StoneMemory
 
@@ -162,11 +163,18 @@ class StonesBeliefMPCAgent(LookaheadAgent):
 
         # --- 1. real belief update: means (plane fusion) and Eom's compact covariance ------------------
         seen_now = {}
+        # with crowding in the vision model, samples beyond the crowding-free fovea are fused with the
+        # crowding zone's spread (the lookahead agent's distrust_periphery; none without crowding)
+        crowd = self.vision.foveated and bool(getattr(self.vision, "crowding", False)) \
+            and p.distrust_periphery is not False
+        fovea = self.vision.crowding_fovea_deg * DEG
         for k in range(K_SLOTS):
             b = _S[f"stone_{k}"].start
             i = round(ol[b])
             if ol[b + 4] > 0.0:
-                self.memory.add(i, ol[b + 1:b + 4], seen_pose[0], seen_pose[1], seen_pose[2], prev, p.control_dt)
+                flag = crowd and bool(beyond_fovea([ol[b + 1:b + 4]], fovea))
+                self.memory.add(i, ol[b + 1:b + 4], seen_pose[0], seen_pose[1], seen_pose[2], prev, p.control_dt,
+                                crowded=flag)
                 seen_now[i] = True
             else:
                 seen_now.setdefault(i, False)
