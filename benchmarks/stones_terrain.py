@@ -82,27 +82,30 @@ def play(agent: str, kwargs: dict, seeds: list[int], env_id: str = ENV_ID) -> tu
     return traces, stones_gaze_realism(traces)
 
 
-def table(sweep: Path, statics: dict[str, Path]) -> str:
-    """Markdown: condition x (baseline, held twin, best static twin, gain, realism) from the sweep JSON and,
-    per condition, a static-gaze search JSON whose chosen posture was replayed in the sweep (its row's
-    agent is the chosen spec)."""
+def table(sweep: Path, folder: Path, agent: str = "lookahead") -> str:
+    """Markdown: condition x (``agent``, held twin, best static twin, gain, realism) from the sweep JSON and,
+    per condition of :data:`STATIC_SEARCHES`, the static-gaze search JSON in ``folder``
+    (``stepping_stones_static_<slug>[_<agent>].json``; the lookahead's without the suffix) whose chosen
+    posture was replayed in the sweep (its row's agent is the chosen spec)."""
     rows = json.loads(sweep.read_text())["rows"]
     by = {(r["condition"], r["agent"]): r for r in rows}
-    out = ["| condition | lookahead | held twin | best static twin (posture; design seeds) | gain | "
-           "realism (lookahead / static) |", "|---|---|---|---|---|---|"]
+    suffix = "" if agent == "lookahead" else f"_{agent}"
+    out = [f"| condition | {agent} | held twin | best static twin (posture; design seeds) | gain | "
+           f"realism ({agent} / static) |", "|---|---|---|---|---|---|"]
     for name in CONDITIONS:
-        base, held = by.get((name, "lookahead")), by.get((name, "gaze_blind:lookahead"))
+        base, held = by.get((name, agent)), by.get((name, f"gaze_blind:{agent}"))
         if base is None:
             continue
         static_text, static_rate, static_real, unsearched = "not searched", None, "-", 0.0
-        other = [r for (c, a), r in by.items() if c == name and a.startswith("static_gaze:")]
+        other = [r for (c, a), r in by.items() if c == name and a.startswith("static_gaze:") and a.endswith(f":{agent}")]
         if other:  # a posture played but not searched under this condition (the default vision's)
             r = other[0]
             static_text = f"{100 * r['rate']:.1f} % (`{r['agent'].split(':')[1]}`, not searched here)"
             static_real = f"{r['realism']:.3f}"
             unsearched = r["rate"]
-        if name in statics and statics[name].exists():
-            rec = json.loads(statics[name].read_text())
+        path = folder / f"stepping_stones_static_{STATIC_SEARCHES.get(name, '-')}{suffix}.json"
+        if name in STATIC_SEARCHES and path.exists():
+            rec = json.loads(path.read_text())
             c = rec["chosen"]
             row = by.get((name, c["spec"]))
             static_real = "-"
@@ -114,15 +117,17 @@ def table(sweep: Path, statics: dict[str, Path]) -> str:
             posture = f"az {c['az']:g}, el {c['el']:g}, neck {c['neck_yaw']:g}/{c['neck_pitch']:g}"
             static_text = (f"{100 * static_rate:.1f} % ({posture}; {c['successes']}/{c['episodes']})"
                            if static_rate is not None else f"not replayed ({posture})")
-        best_twin = max(held["rate"] if held else 0.0, static_rate if static_rate is not None else 0.0)
+        held_rate = held["rate"] if held else 0.0
+        best_twin = max(held_rate, static_rate if static_rate is not None else 0.0)
         # without a search here: an upper bound (against the held twin and the posture played, if any)
         gain = f"{100 * (base['rate'] - best_twin):+.1f}" if static_rate is not None else \
             f"(<= {100 * (base['rate'] - max(best_twin, unsearched)):+.1f})"
-        out.append(f"| {name} | {100 * base['rate']:.1f} % | {100 * held['rate']:.1f} % | {static_text} | {gain} | "
+        held_text = f"{100 * held_rate:.1f} %" if held else "-"
+        out.append(f"| {name} | {100 * base['rate']:.1f} % | {held_text} | {static_text} | {gain} | "
                    f"{base['realism']:.3f} / {static_real} |")
-    ladder = [(name, by[(name, "lookahead")]) for name in LADDER if (name, "lookahead") in by]
+    ladder = [(name, by[(name, agent)]) for name in LADDER if (name, agent) in by]
     if ladder:
-        out += ["", "| rung (rough + all four) | env id | lookahead | realism |", "|---|---|---|---|"]
+        out += ["", f"| rung (rough + all four) | env id | {agent} | realism |", "|---|---|---|---|"]
         out += [f"| {name.split(' @ ')[-1]} | {r['env_id']} | {100 * r['rate']:.1f} % | {r['realism']:.3f} |"
                 for name, r in ladder]
     return "\n".join(out) + "\n"
@@ -141,8 +146,7 @@ def main(argv=None) -> None:
     args = ap.parse_args(argv)
     if args.table:
         folder = Path(args.out).parent
-        print(table(Path(args.out), {name: folder / f"stepping_stones_static_{slug}.json"
-                                     for name, slug in STATIC_SEARCHES.items()}), end="")
+        print("\n".join(table(Path(args.out), folder, agent) for agent in args.agents.split(",")), end="")
         return
     sys.path.insert(0, str(ROOT))
     import visuomotor_gym  # noqa: F401  (registers the ids)
