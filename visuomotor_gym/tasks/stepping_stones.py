@@ -146,8 +146,9 @@ class CourseDistribution:
 # two hazards (loose rocks, radius 0.12 m, 0.32-0.45 m from the stone's centre, at least 5 cm rim to rim
 # from any other rock: modelling choices). A hazard is a flanker of the stone's own kind: seen more than
 # about twice its angular distance from the line of sight (Bouma's critical spacing, b = 0.5), the stone
-# is pooled with it (crowding, VisionParams.crowding) and its perceived centre moves toward the hazard by
-# about a third to a half of their distance, 10-22 cm, beyond what the stone's radius forgives.
+# is pooled with it (crowding, VisionParams.crowding): its perceived centre is the mean of the stone and
+# its crowding flankers, 16-22 cm toward a lone hazard (half their distance), beyond what the stone's radius
+# forgives (two hazards on opposite sides partly cancel).
 COURSE_PRESETS = {
     "rough": {"stone_radius_m": 0.15, "hazards_per_stone": 2, "hazard_radius_m": 0.12,
               "hazard_distance_m": (0.32, 0.45), "hazard_clearance_m": 0.05},
@@ -218,8 +219,8 @@ def sample_hazards(rng: np.random.Generator, dist: CourseDistribution, stones: n
     """``dist.hazards_per_stone`` hazards beside each stone, in stone order: a direction uniform round the
     stone and a centre distance uniform in ``hazard_distance_m``, redrawn (up to :data:`HAZARD_TRIES`
     times, else left out) until its rim clears every stone's and every earlier hazard's rim by
-    ``hazard_clearance_m`` and it lies beyond the slab's far edge (x > 2.3 m, so no foot on the slab
-    stands beside one). Returns the (M, 2) centres and the (M,) index of the stone each flanks."""
+    ``hazard_clearance_m`` and its rim lies beyond the slab's far edge (x - radius > 2.3 m, so no foot on
+    the slab stands beside one). Returns the (M, 2) centres and the (M,) index of the stone each flanks."""
     r_s = dist.stone_radius_m if stone_radius is None else stone_radius
     r_s = STONE_RADIUS_M if r_s is None else r_s
     r_h, gap = dist.hazard_radius_m, dist.hazard_clearance_m
