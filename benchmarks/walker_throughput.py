@@ -2,7 +2,7 @@
 physics on the same model and substeps, same run.
 
 The walk is a 20 m course with 10 cm bars every ~2 m, stepped over with a 20 cm toe clearance (so the
-contact checks near obstacles, the watched substeps of ``WalkerGait.step_physics``, are exercised, and
+contact checks near obstacles, the watched substeps of ``LegContacts.step_physics``, are exercised, and
 nothing trips); episodes restart at the end of the course. Each control step calls ``set_next_footstep``, ``advance`` and ``step_physics``. The
 reference restores each recorded physics state (``mj_setState``) and calls ``mj_step`` with the same
 substeps, as ``benchmarks/env_throughput.py`` does for the envs (which also times the pure-Python path
@@ -31,7 +31,9 @@ import numpy as np
 from visuomotor_gym.assets import asset_path
 from visuomotor_gym.bench.provenance import provenance, report_benchmark
 from visuomotor_gym.body import walker_names as wn
-from visuomotor_gym.body.walker import WalkerGait
+from visuomotor_gym.body.gait import WalkerGait
+from visuomotor_gym.tasks.walk_contacts import LegContacts
+from visuomotor_gym.tasks.walk_scene import ObstaclePool
 
 CONTROL_DT = 0.02  # the catch family's control period: 10 substeps of 2 ms
 COURSE_M = 20.0
@@ -45,10 +47,12 @@ def walker_run(steps: int, record: bool):
     model = mujoco.MjModel.from_xml_path(str(asset_path(wn.WALKER_SCENE)))
     data = mujoco.MjData(model)
     gait = WalkerGait(model)
+    pool = ObstaclePool(model)
+    contacts = LegContacts(model, gait, pool)
     n_substeps = round(CONTROL_DT / model.opt.timestep)
-    gait.pool.park_all(model, data)
+    pool.park_all(model, data)
     for i, u in enumerate(BARS_U):
-        gait.pool.place(model, data, i, u, 0.0, 0.05, 1.0, BAR_HEIGHT_M)
+        pool.place(model, data, i, u, 0.0, 0.05, 1.0, BAR_HEIGHT_M)
     gait.reset(model, data)
     spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
     states = np.empty((steps, mujoco.mj_stateSize(model, spec))) if record else None
@@ -59,12 +63,13 @@ def walker_run(steps: int, record: bool):
             mujoco.mj_getState(model, data, states[i], spec)
         gait.set_next_footstep(0.65, 0.0, CLEARANCE_M)
         gait.advance(data, CONTROL_DT)
-        gait.step_physics(model, data, n_substeps)
+        contacts.step_physics(model, data, n_substeps)
         if data.qpos[0] > COURSE_M:
-            events += len(gait.events)
+            events += len(contacts.events)
             gait.reset(model, data)
+            contacts.reset()
     elapsed = time.perf_counter() - start
-    return elapsed, states, model, n_substeps, events + len(gait.events)
+    return elapsed, states, model, n_substeps, events + len(contacts.events)
 
 
 def raw_run(model: mujoco.MjModel, states: np.ndarray, n_substeps: int) -> float:

@@ -163,7 +163,7 @@ def test_01_fabricated_results_for_a_worse_agent(monkeypatch, pr):
     rec_path.write_text(dumps_record(rec))
     s = summary_from_records(rec["episodes"])  # every total the static rules compare, forged to match
     edit_results(pr, key, lambda o: o.update(
-        caught=4, catch_rate=4 / 6, catch_rate_ci95=list(wilson_interval(4, 6)), success_rate=4 / 6,
+        caught=4, catch_rate=4 / 6, catch_rate_ci95=list(wilson_interval(4, 6)), success=4, success_rate=4 / 6,
         success_rate_ci95=list(wilson_interval(4, 6)), time_to_catch_s=s["time_to_catch_s"],
         miss_distance_m=s["miss_distance_m"]))
     report = check(pr)
@@ -327,7 +327,7 @@ def test_12_tampered_catch_rate(pr):
 def test_13_consistently_forged_counts(monkeypatch, pr):
     key = honest_new_entry(monkeypatch, pr)
     edit_results(pr, key, lambda o: o.update(
-        caught=2, catch_rate=2 / 6, catch_rate_ci95=list(wilson_interval(2, 6)), success_rate=2 / 6,
+        caught=2, catch_rate=2 / 6, catch_rate_ci95=list(wilson_interval(2, 6)), success=2, success_rate=2 / 6,
         success_rate_ci95=list(wilson_interval(2, 6))))
     refused(check(pr, rescore=False), "consistency", "caught = 2 in the results", "per-episode records give 0")
 

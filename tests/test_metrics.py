@@ -661,8 +661,8 @@ def test_catch_hand_path_reference_is_sourced_and_leaves_gaze_realism_alone():
 
 
 def test_catch_hand_path_in_the_results_of_a_simulated_run():
-    from visuomotor_gym.bench.evaluate import evaluate
     from visuomotor_gym.bench.commands import summary_rows
+    from visuomotor_gym.bench.evaluate import evaluate
     from visuomotor_gym.bench.results import ResultsError, build_results, validate_results
 
     res = evaluate("eyecatch", "EyeCatch-v0", episodes=2, seed=0)
@@ -678,3 +678,78 @@ def test_catch_hand_path_in_the_results_of_a_simulated_run():
     bad["hand_path"]["verdict"] = "great"
     with pytest.raises(ResultsError, match="hand_path"):
         validate_results(bad)
+    # The family-neutral count: written, checked, and optional (results written before it lack it).
+    assert obj["success"] == obj["caught"] == round(obj["success_rate"] * obj["episodes"])
+    assert rows["catch rate"].endswith(f"({obj['success']}/2)")
+    wrong = json.loads(json.dumps(obj))
+    wrong["success"] = obj["success"] + 1
+    with pytest.raises(ResultsError, match=r"\$.success: success = .* is not success_rate x episodes"):
+        validate_results(wrong)
+    older = json.loads(json.dumps(obj))
+    del older["success"]
+    validate_results(older)
+
+
+# --- the family dispatch (metrics.summary reads each family's record; metrics.common is the scaffolding) ----
+@pytest.fixture(scope="module")
+def reach_traces():
+    """Two real ShelfReach-v0 episodes of the faraway baseline: seed 1 reaches, seed 0 fails."""
+    import gymnasium as gym
+
+    import visuomotor_gym  # noqa: F401
+    from visuomotor_gym.agents import make_agent
+    from visuomotor_gym.bench.trace import run_episode
+
+    env = gym.make("ShelfReach-v0")
+    try:
+        out = []
+        for seed, agent in ((1, "faraway"), (0, "faraway")):
+            policy = make_agent(agent, "ShelfReach-v0", env.action_space.shape[0], seed=seed)
+            out.append(run_episode(env, policy, seed=seed, env_id="ShelfReach-v0", agent=agent))
+    finally:
+        env.close()
+    return out
+
+
+def test_reach_summary_is_goal_summary_plus_the_hand_onset(reach_traces):
+    from visuomotor_gym.metrics.common import goal_summary
+    from visuomotor_gym.metrics.hand import hand_onset_time
+    from visuomotor_gym.metrics.reach_realism import closest_distance, reach_realism, reach_summary
+    from visuomotor_gym.metrics.stats import mean_median
+
+    assert [bool(tr.success) for tr in reach_traces] == [True, False]  # both branches of the outcome
+    reach = M.to_json_safe(reach_summary(reach_traces))
+    goal = M.to_json_safe(goal_summary(reach_traces, reach_realism, closest_distance))
+    hand = M.to_json_safe(mean_median([hand_onset_time(tr) for tr in reach_traces]))
+    assert hand["mean"] is not None  # the one field that differs is defined on reach
+    assert goal["reaction_times_s"]["hand_onset"] == {"mean": None, "median": None}
+    goal["reaction_times_s"]["hand_onset"] = hand
+    assert reach == goal and list(reach) == list(goal)
+    assert M.summarize(reach_traces) == reach  # the dispatcher reads the reach record's summariser
+    assert reach["miss_distance_m"]["mean"] == pytest.approx(closest_distance(reach_traces[1]))
+
+
+def test_the_dispatcher_reads_each_familys_record(reach_traces):
+    from visuomotor_gym.metrics.outcome import miss_distance
+    from visuomotor_gym.metrics.reach_realism import closest_distance
+    from visuomotor_gym.metrics.summary import episode_miss_distance
+
+    assert episode_miss_distance(reach_traces[1]) == closest_distance(reach_traces[1])
+    catch = make_trace(caught=False)  # env_id "EyeCatch-v0"
+    assert episode_miss_distance(catch) == miss_distance(catch)
+    unknown = make_trace(caught=False)
+    unknown.env_id = "EyeCatchRetired-v0"  # an old results file's id: read as the default (catch) family
+    as_catch = M.summarize([catch])
+    assert "hand_path" in as_catch  # single-ball catch ids only
+    as_catch.pop("hand_path")
+    assert M.summarize([unknown]) == as_catch
+    assert episode_miss_distance(unknown) == miss_distance(unknown)
+
+
+def test_every_summary_has_the_same_keys(reach_traces):
+    catch = M.summarize([make_trace(caught=True), make_trace(caught=False)])
+    reach = M.summarize(reach_traces)
+    catch.pop("hand_path", None)
+    assert list(catch) == list(reach)
+    assert reach["success"] == reach["caught"] == 1 and reach["catch_rate"] == reach["success_rate"] == 0.5
+    assert catch["success"] == catch["caught"] == 1

@@ -1,6 +1,8 @@
-"""SteppingStones-v0 (issue 13): API checkers, determinism, pickling, bad input, no leak of the stones'
-true positions, every rung from the registry, the course sampler, falls, the lookahead baseline against
-its gaze-blind twin, stepping-target realism."""
+"""SteppingStones-v0: no leak of the stones' true positions, every rung from the registry on the same
+course, the course sampler and its argument check, falls, the lookahead baseline against its gaze-blind
+twin, stepping-target realism.
+The family-independent checks (API checkers, docstring tables, determinism, pickling, bad input,
+reward terms, memory) run for every rung in tests/test_families.py."""
 
 from __future__ import annotations
 
@@ -10,7 +12,6 @@ from types import SimpleNamespace
 import gymnasium as gym
 import numpy as np
 import pytest
-from family_checks import assert_reproducible_and_picklable, rollout, run_env_checkers
 
 import visuomotor_gym  # noqa: F401  (registers the ids)
 from visuomotor_gym.agents import make_agent
@@ -39,48 +40,15 @@ def test_every_rung_runs_from_the_registry_on_the_same_course(env_id):
         assert env.observation_space.contains(obs) and np.isfinite(obs).all()
 
 
-def test_gymnasium_and_sb3_checkers():
-    run_env_checkers(SteppingStonesEnv)
-
-
-def test_layout_docstring_and_spaces_agree():
+def test_layout_and_action_blocks():
     env = SteppingStonesEnv()
     assert env.observation_structure == STONES_LAYOUT.structure
     assert env.action_structure == {"footstep": 4, "gaze": 2, "fixation": 1, "head": 2}
-    assert "| 0-4 | stone_0 | 5 |" in SteppingStonesEnv.__doc__
-    assert f"({STONES_LAYOUT.size},)" in SteppingStonesEnv.__doc__
 
 
-def test_same_seed_same_episode_and_pickling_mid_episode():
-    rng = np.random.default_rng(0)
-    actions = rng.uniform(-1, 1, (60, 9)).astype(np.float32)
-    assert_reproducible_and_picklable(SteppingStonesEnv, actions)
-    a = rollout(SteppingStonesEnv(), 3, actions)
-    c = rollout(SteppingStonesEnv(), 4, actions)
-    assert not all(np.array_equal(x, y) for x, y in zip(a, c))
-
-
-def test_bad_input_gives_clear_errors():
-    env = SteppingStonesEnv()
-    env.reset(seed=0)
-    bad = np.zeros(9, np.float32)
-    bad[3] = np.nan  # the turn
-    with pytest.raises(ValueError, match="NaN or inf"):
-        env.step(bad)
-    with pytest.raises(ValueError, match="shape"):
-        env.step(np.zeros(8, np.float32))
-    with pytest.raises(TypeError, match="unknown argument"):
-        SteppingStonesEnv(n_balls=2)
-    with pytest.raises(ValueError, match="unknown term"):
-        SteppingStonesEnv(reward_weights={"trip": 1.0})
-    with pytest.raises(TypeError, match="unknown field"):
-        SteppingStonesEnv(vision_params={"fov": 30})
-    with pytest.raises(ValueError, match="vision"):
-        SteppingStonesEnv(vision="xray")
+def test_bad_course_and_agent_input_give_clear_errors():
     with pytest.raises(ValueError, match="n_stones"):
         SteppingStonesEnv(course_distribution={"n_stones": 40})
-    with pytest.raises(RuntimeError, match="before reset"):
-        SteppingStonesEnv().step(np.zeros(9, np.float32))
     agent = make_agent("lookahead", "SteppingStones-v0", 9)
     with pytest.raises(ValueError, match="observation of size"):
         agent.predict(np.zeros(5))
@@ -145,6 +113,7 @@ def _steppable(course, dist, w_lo, w_hi, max_turn_deg):
     return True
 
 
+@pytest.mark.slow
 def test_course_sampler_follows_allsteps_turns_beyond_20_deg_and_every_course_is_steppable():
     dist = CourseDistribution()
     turns, in_range, widest = [], [], []
@@ -234,6 +203,7 @@ def test_lookahead_turns_the_walker_along_a_curving_course():
     assert np.sign(yaws[np.argmax(np.abs(yaws))]) == np.sign(headings[np.argmax(np.abs(headings))])
 
 
+@pytest.mark.slow
 def test_lookahead_crosses_more_courses_than_its_gaze_blind_twin():
     seeds = range(300, 306)
     looking = _successes("lookahead", seeds)

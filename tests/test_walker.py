@@ -1,4 +1,6 @@
-"""The walker body and its scripted gait (``envs_assets/walker.xml``, ``visuomotor_gym/body/walker.py``).
+"""The walker body and its scripted gait (``envs_assets/walker.xml``, ``visuomotor_gym/body/gait.py``), with
+the task-side obstacle pool (``tasks/walk_scene.py``) and trip and misstep classification
+(``tasks/walk_contacts.py``).
 
 Real MuJoCo physics and contacts throughout: the servos track the gait, obstacles are real geoms, and
 trips and missteps are read from ``data.contact``.
@@ -8,6 +10,8 @@ from __future__ import annotations
 
 import math
 import pickle
+import re
+from pathlib import Path
 
 import mujoco
 import numpy as np
@@ -16,7 +20,9 @@ import pytest
 from visuomotor_gym import assets
 from visuomotor_gym.body import names
 from visuomotor_gym.body import walker_names as wn
-from visuomotor_gym.body.walker import DEG, GaitParams, TurningGait, WalkerGait
+from visuomotor_gym.body.gait import DEG, GaitParams, TurningGait, WalkerGait
+from visuomotor_gym.tasks.walk_contacts import LegContacts
+from visuomotor_gym.tasks.walk_scene import ObstaclePool
 
 OBJ = {
     "body": mujoco.mjtObj.mjOBJ_BODY,
@@ -35,26 +41,46 @@ def model():
     return mujoco.MjModel.from_xml_path(str(assets.asset_path(wn.WALKER_SCENE)))
 
 
+class Walker:
+    """A gait (a ``gait_cls``) with ObstacleWalk's task-side parts: the obstacle pool and the trip and
+    misstep classifier, wired as the task wires them."""
+
+    def __init__(self, model, gait_cls=WalkerGait, params=None):
+        self.model = model
+        self.gait = gait_cls(model, params)
+        self.pool = ObstaclePool(model)
+        self.contacts = LegContacts(model, self.gait, self.pool)
+
+
 def walk(model, duration_s, command=None, setup=None, x=0.0, y=0.0, yaw=0.0, record=None, params=None,
          gait_cls=WalkerGait):
-    """Reset a fresh walker (a ``gait_cls``), optionally place obstacles (``setup(gait, data)``), and
-    walk ``duration_s`` seconds; ``command(gait)`` returns the footstep to set each control step."""
+    """Reset a fresh :class:`Walker`, optionally place obstacles (``setup(walker, data)``), and walk
+    ``duration_s`` seconds; ``command(gait)`` returns the footstep to set each control step. Returns
+    (walker, data)."""
     model = model if params is None else mujoco.MjModel.from_xml_path(str(assets.asset_path(wn.WALKER_SCENE)))
     data = mujoco.MjData(model)
-    gait = gait_cls(model, params)
-    gait.pool.park_all(model, data)
+    w = Walker(model, gait_cls, params)
+    gait = w.gait
+    w.pool.park_all(model, data)
     if setup is not None:
-        setup(gait, data)
+        setup(w, data)
     gait.reset(model, data, x, y, yaw)
+    w.contacts.reset()
     n = round(duration_s / DT)
     for _ in range(n):
         if command is not None:
             gait.set_next_footstep(*command(gait))
         gait.advance(data, DT)
-        gait.step_physics(model, data, NSUB)
+        w.contacts.step_physics(model, data, NSUB)
         if record is not None:
             record(gait, data)
-    return gait, data
+    return w, data
+
+
+def _quiet(w):
+    """No trip, no misstep, no event."""
+    c = w.contacts
+    return c.events == [] and not c.tripped and not c.misstepped
 
 
 def test_model_compiles_and_every_walker_name_resolves(model):
@@ -126,9 +152,10 @@ def test_flat_15m_walk_nominal_footsteps(model):
             sole = data.site_xpos[gait.sole_sites[gait.side_of(k)]]
             landed.append((sole[0], sole[1], sole[2]) + gait.foothold_world(k))
 
-    gait, data = walk(model, 12.0, record=record)
+    w, data = walk(model, 12.0, record=record)
+    gait = w.gait
     assert float(data.qpos[0]) > 15.0
-    assert gait.events == [] and not gait.tripped and not gait.misstepped
+    assert _quiet(w)
     landed = np.array(landed)
     err = np.hypot(landed[:, 0] - landed[:, 3], landed[:, 1] - landed[:, 4])
     assert len(landed) >= 22 and err.max() < 0.01, err.max()  # within 1 cm of the commanded foothold
@@ -169,8 +196,9 @@ def test_commanded_footsteps_land_where_told(model):
         if gait.tick - k * gait.T == round(0.2 / gait.timestep):
             landed[k] = data.site_xpos[gait.sole_sites[gait.side_of(k)], :2].copy()
 
-    gait, _ = walk(model, 8.0, command=command, record=record, x=1.0, y=-2.0, yaw=0.4)
-    assert not gait.events
+    w, _ = walk(model, 8.0, command=command, record=record, x=1.0, y=-2.0, yaw=0.4)
+    gait = w.gait
+    assert not w.contacts.events
     checked = 0
     for j, cmd in plan.items():
         if j in landed and j in gait.commanded:
@@ -204,10 +232,10 @@ def test_footstep_is_read_at_mid_stance_for_the_next_step_of_that_foot(model):
     assert gait.u[3] == pytest.approx(gait.u[2] + gait.p.nominal_step_m)
 
 
-def _bar_at_mid_step(gait, data, height):
+def _bar_at_mid_step(w, data, height):
     """A 1 m wide, 5 cm deep bar across the path midway between footholds 4 and 5 (u = 2.925 m)."""
-    u = 0.5 * (gait.u.get(4, 4 * 0.65) + gait.u.get(5, 5 * 0.65))
-    gait.pool.place(gait.model, data, 0, u, 0.0, 0.05, 1.0, height)
+    u = 0.5 * (w.gait.u.get(4, 4 * 0.65) + w.gait.u.get(5, 5 * 0.65))
+    w.pool.place(w.model, data, 0, u, 0.0, 0.05, 1.0, height)
 
 
 def _clearance_over(steps, clearance):
@@ -217,47 +245,48 @@ def _clearance_over(steps, clearance):
 
 
 def test_low_clearance_over_a_bar_trips(model):
-    gait, data = walk(model, 4.0, command=_clearance_over((5, 6), 0.08),
-                      setup=lambda g, d: _bar_at_mid_step(g, d, 0.20))
-    assert gait.tripped and gait.events[0].kind == "trip"
-    first = gait.events[0]
+    w, _ = walk(model, 4.0, command=_clearance_over((5, 6), 0.08),
+                setup=lambda g, d: _bar_at_mid_step(g, d, 0.20))
+    assert w.contacts.tripped and w.contacts.events[0].kind == "trip"
+    first = w.contacts.events[0]
     assert first.side == 1 and first.part == "foot"  # the right foot swinging to foothold 5 strikes it
     assert abs(first.normal_z) < 0.5  # against the bar's face
     assert 2.1 < first.time < 2.5  # during that swing (2.1 .. 2.5 s)
 
 
 def test_enough_clearance_steps_over_the_same_bar(model):
-    gait, data = walk(model, 4.0, command=_clearance_over((5, 6), 0.30),
-                      setup=lambda g, d: _bar_at_mid_step(g, d, 0.20))
-    assert gait.events == [] and not gait.tripped and not gait.misstepped
+    w, data = walk(model, 4.0, command=_clearance_over((5, 6), 0.30),
+                   setup=lambda g, d: _bar_at_mid_step(g, d, 0.20))
+    assert _quiet(w)
     assert float(data.qpos[0]) > 4.5  # both feet are past the bar
 
 
 def test_a_box_under_the_planned_foothold_is_a_misstep(model):
-    def setup(gait, data):  # a 10 cm box under foothold 5 (right foot, u = 3.25 m)
-        gait.pool.place(model, data, 0, 5 * 0.65, -0.06, 0.4, 0.3, 0.10)
+    def setup(w, data):  # a 10 cm box under foothold 5 (right foot, u = 3.25 m)
+        w.pool.place(model, data, 0, 5 * 0.65, -0.06, 0.4, 0.3, 0.10)
 
-    gait, _ = walk(model, 4.0, command=_clearance_over((5,), 0.15), setup=setup)
-    assert gait.misstepped and not gait.tripped
-    assert [(e.kind, e.side) for e in gait.events] == [("misstep", 1)]
-    assert gait.events[0].normal_z > 0.9  # standing on its top
+    w, _ = walk(model, 4.0, command=_clearance_over((5,), 0.15), setup=setup)
+    c = w.contacts
+    assert c.misstepped and not c.tripped
+    assert [(e.kind, e.side) for e in c.events] == [("misstep", 1)]
+    assert c.events[0].normal_z > 0.9  # standing on its top
     # A flat mat (1 cm, like Iwao's 70 cm cloth) stepped on is a misstep too.
-    gait, _ = walk(model, 4.0, setup=lambda g, d: g.pool.place(model, d, 0, 5 * 0.65, 0.0, 0.7, 0.7, 0.01))
-    assert [e.kind for e in gait.events] == ["misstep"] and not gait.tripped
+    w, _ = walk(model, 4.0, setup=lambda g, d: g.pool.place(model, d, 0, 5 * 0.65, 0.0, 0.7, 0.7, 0.01))
+    assert [e.kind for e in w.contacts.events] == ["misstep"] and not w.contacts.tripped
 
 
 def test_resized_obstacles_collide_over_their_whole_extent(model):
     """A bar made 4 m wide still trips a walker 1.5 m from its centre (sizes and bounding volumes are
     updated), and a parked pool touches nothing."""
-    def setup(gait, data):
-        gait.pool.place(model, data, 0, 2.925, 1.5, 0.05, 4.0, 0.20)
+    def setup(w, data):
+        w.pool.place(model, data, 0, 2.925, 1.5, 0.05, 4.0, 0.20)
 
-    gait, _ = walk(model, 3.0, setup=setup)
-    assert gait.tripped
-    gait, data = walk(model, 3.0)
-    assert gait.events == [] and data.ncon == 0
+    w, _ = walk(model, 3.0, setup=setup)
+    assert w.contacts.tripped
+    w, data = walk(model, 3.0)
+    assert w.contacts.events == [] and data.ncon == 0
     with pytest.raises(ValueError, match="positive"):
-        gait.pool.place(model, data, 0, 0.0, 0.0, 0.1, 0.0, 0.1)
+        w.pool.place(model, data, 0, 0.0, 0.0, 0.1, 0.0, 0.1)
 
 
 def test_walking_is_deterministic(model):
@@ -302,17 +331,17 @@ def test_throughput_benchmark_runs_and_reports_a_ratio(tmp_path):
     assert result["substeps_per_control_step"] == 10 and result["trips_and_missteps"] == 0
 
 
-def _per_substep_reference(gait, model, data, n, short_circuit):
+def _per_substep_reference(contacts, model, data, n, short_circuit):
     """The plain contact checks: one mj_step per substep and a check after each (``short_circuit``: as
     the env's substep loop, no check after the first that reports a new event)."""
     new = False
     for _ in range(n):
         mujoco.mj_step(model, data)
         if short_circuit:
-            if not new and gait.check_contacts(data):
+            if not new and contacts.check(data):
                 new = True
         else:
-            new |= gait.check_contacts(data)
+            new |= contacts.check(data)
     return new
 
 
@@ -330,25 +359,26 @@ def test_watched_substeps_classify_contacts_as_checks_after_every_substep(model,
         runs = []
         for watched in (False, True):
             data = mujoco.MjData(model)
-            gait = WalkerGait(model)
-            gait.pool.park_all(model, data)
+            w = Walker(model)
+            gait, contacts = w.gait, w.contacts
+            w.pool.park_all(model, data)
             for i, bar in enumerate(bars):
-                gait.pool.place(model, data, i, *bar)
+                w.pool.place(model, data, i, *bar)
             gait.reset(model, data)
             log = []
             for step in steps:
                 gait.set_next_footstep(*step)
                 gait.advance(data, DT)
                 if watched:
-                    gait.watch_substeps(data)
+                    contacts.watch(data)
                     mujoco.mj_step(model, data, nstep=NSUB)
-                    new = gait.watched_contacts(data, NSUB, every=not short_circuit, final=short_circuit)
+                    new = contacts.watched(data, NSUB, every=not short_circuit, final=short_circuit)
                 else:
-                    new = _per_substep_reference(gait, model, data, NSUB, short_circuit)
+                    new = _per_substep_reference(contacts, model, data, NSUB, short_circuit)
                     if short_circuit and not new:
-                        new = gait.check_contacts(data)  # the env's check on the final state
-                log.append((new, data.qpos.tobytes(), data.qvel.tobytes(), sorted(gait._touching)))
-            runs.append((log, [(e.time, e.kind, e.side, e.part, e.obstacle, e.normal_z) for e in gait.events]))
+                        new = contacts.check(data)  # the env's check on the final state
+                log.append((new, data.qpos.tobytes(), data.qvel.tobytes(), sorted(contacts.touching)))
+            runs.append((log, [(e.time, e.kind, e.side, e.part, e.obstacle, e.normal_z) for e in contacts.events]))
         assert runs[0] == runs[1]
         n_events += len(runs[0][1])
     assert n_events > 0  # the walks did touch obstacles
@@ -358,28 +388,29 @@ def test_watched_substeps_after_a_divergence_replay_the_checks(model):
     """When the physics diverged (MuJoCo resets the data), ``replay=True`` still classifies the
     contacts of the substeps before it from the saved state."""
     data = mujoco.MjData(model)
-    gait = WalkerGait(model)
-    gait.pool.park_all(model, data)
+    w = Walker(model)
+    gait, contacts = w.gait, w.contacts
+    w.pool.park_all(model, data)
     gait.reset(model, data)
-    gait.pool.place(model, data, 0, float(data.qpos[0]) + 0.3, 0.0, 0.05, 1.0, 0.3)  # in the swing's way
+    w.pool.place(model, data, 0, float(data.qpos[0]) + 0.3, 0.0, 0.05, 1.0, 0.3)  # in the swing's way
     for _ in range(40):
         gait.advance(data, DT)
-        gait.watch_substeps(data)
+        contacts.watch(data)
         mujoco.mj_step(model, data, nstep=NSUB)
         if data.maxuse_con > 0:
             break
-        gait.watched_contacts(data, NSUB)
+        contacts.watched(data, NSUB)
     assert data.maxuse_con > 0
     mujoco.mj_resetData(model, data)  # what a divergence does to the data
-    assert gait.watched_contacts(data, NSUB, final=False, replay=True)
-    assert gait.events and not gait._watching
-    assert gait._scratch is not None and pickle.loads(pickle.dumps(gait))._scratch is None  # rebuilt on need
+    assert contacts.watched(data, NSUB, final=False, replay=True)
+    assert contacts.events and not contacts.watching
+    assert contacts._scratch is not None and pickle.loads(pickle.dumps(contacts))._scratch is None  # rebuilt on need
 
 
 def _reference_targets(gait, tick):
     """The gait's joint targets by the plain formulas (FootPlan-free copies of the original
     ``_stance_foot``, ``_swing_foot``, ``targets_at`` with numpy's clip), for the bit-identity test."""
-    from visuomotor_gym.body.walker import DEG, _smooth
+    from visuomotor_gym.body.gait import DEG, _smooth
 
     p, g = gait.p, gait
 
@@ -423,7 +454,7 @@ def _reference_targets(gait, tick):
         hip = math.atan2(fx, dperp) + math.atan2(g.L2 * math.sin(knee), g.L1 + g.L2 * math.cos(knee))
         return roll, hip, knee
 
-    pu, pv = g._pelvis_uv(tick)
+    pu, pv = g.pelvis_at(tick)
     phase = 2.0 * math.pi * ((tick - g.T_mid) % g.T) / g.T
     z = p.pelvis_height_m - 0.5 * p.bob_m * (1.0 - math.cos(phase))
     k = tick // g.T
@@ -439,7 +470,8 @@ def _reference_targets(gait, tick):
         if zmax < z:  # noqa: PLR1730 (the original's form)
             z = zmax
         hips.append((du, dv))
-    out = [g.origin[0] + g._c * pu - g._s * pv, g.origin[1] + g._s * pu + g._c * pv, z, g.yaw]
+    pc, ps = g.path_cos, g.path_sin
+    out = [g.origin[0] + pc * pu - ps * pv, g.origin[1] + ps * pu + pc * pv, z, g.yaw]
     for side, foot in enumerate(feet):
         fx, fy = hips[side]
         roll, hip, knee = leg_ik(fx, fy, foot[2] - z)
@@ -506,8 +538,9 @@ def test_turning_gait_follows_its_footholds_headings(model):
             fx = data.xmat[feet[side]].reshape(3, 3)[:, 0]
             mid[k] = (float(data.qpos[3]), math.atan2(fx[1], fx[0]))
 
-    gait, data = _turning_walk(model, 10.0, command, record, x=0.5, y=1.0, yaw=-0.3)
-    assert gait.events == [] and not gait.tripped and not gait.misstepped
+    w, data = _turning_walk(model, 10.0, command, record, x=0.5, y=1.0, yaw=-0.3)
+    gait = w.gait
+    assert _quiet(w)
     assert np.isfinite(data.qpos).all()
     checked = 0
     for j, cmd in plan.items():
@@ -557,3 +590,51 @@ def test_turns_are_clipped_and_checked(model):
         g.set_next_footstep(0.6, 0.0, 0.05, turn=float("nan"))
     g2 = pickle.loads(pickle.dumps(g))
     assert g2.pending_turn == g.pending_turn
+
+
+PACKAGE = Path(__file__).resolve().parent.parent / "visuomotor_gym"
+
+
+def test_no_task_or_body_reaches_into_the_gaits_privates():
+    """Tasks, bodies, envs and baselines read the gait through its public methods and attributes: no
+    ``gait._name`` (nor ``g._name`` where ``g = self.gait``) outside the gait's own module."""
+    roots = [PACKAGE / "tasks", PACKAGE / "body", PACKAGE / "envs", PACKAGE.parent / "baselines"]
+    reach = re.compile(r"\bgait\._\w|\bg\._(?!cos\b|sin\b)\w")  # (g._cos/_sin: a RootFrame's, not the gait's)
+    found = []
+    for root in roots:
+        for path in sorted(root.rglob("*.py")):
+            if path.name == "gait.py":
+                continue
+            for n, line in enumerate(path.read_text().splitlines(), 1):
+                if reach.search(line.split("#", 1)[0]):
+                    found.append(f"{path.relative_to(PACKAGE.parent)}:{n}: {line.strip()}")
+    assert not found, "\n".join(found)
+
+
+def test_turning_gait_changes_only_the_hooks():
+    """TurningGait is WalkerGait with other hooks: it re-writes none of the per-step path."""
+    per_step = {"_targets", "_leg_targets", "_leg_ik", "_latch", "_pelvis_at", "_pelvis_segment", "advance",
+                "_swing_height"}
+    hooks = {"place_foothold", "pelvis_waypoint", "stance_pose", "swing_pose", "ankles_from_hips", "root_yaw"}
+    assert not per_step & set(vars(TurningGait))
+    assert hooks <= set(vars(TurningGait)) and hooks <= set(vars(WalkerGait))
+    for name in hooks:
+        assert getattr(WalkerGait, name).__doc__.startswith("Hook:"), name
+
+
+def test_the_walker_module_still_exports_the_gait():
+    """``visuomotor_gym.body.walker`` is a thin re-export of ``visuomotor_gym.body.gait``; the gait holds
+    no obstacles and classifies no contacts (task side: walk_scene, walk_contacts)."""
+    from visuomotor_gym.body import gait, walker
+
+    for name in walker.__all__:
+        assert getattr(walker, name) is getattr(gait, name)
+    for name in ("pool", "events", "tripped", "misstepped", "check_contacts", "step_physics", "watch_substeps"):
+        assert not hasattr(WalkerGait, name) and not hasattr(WalkerGait(mujoco.MjModel.from_xml_path(
+            str(assets.asset_path(wn.WALKER_SCENE)))), name), name
+
+
+def test_the_pool_and_the_classifier_refuse_a_scene_without_them():
+    catch = mujoco.MjModel.from_xml_path(str(assets.asset_path("catch.xml")))
+    with pytest.raises(ValueError, match="obstacle pool"):
+        ObstaclePool(catch)

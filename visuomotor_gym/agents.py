@@ -152,20 +152,21 @@ def _parse_value(text: str) -> Any:
     return text
 
 
-# The env families (visuomotor_gym.registration.FAMILIES) each agent is built for; an agent not listed
-# plays every family (random, zero; ppo: its policy file says what it was trained on; gaze_blind: its
-# base agent's families).
-AGENT_FAMILIES: dict[str, tuple[str, ...]] = {
-    "eyecatch": ("catch",),
-    "fixed_gaze": ("catch",),
-    "oracle": ("catch",),
-    "belief_intercept": ("catch",),
-    "belief_mpc": ("catch", "stones", "dodge"),
-    "iwao": ("walk",),
-    "faraway": ("reach",),
-    "fajen_warren": ("dodge",),
-    "lookahead": ("stones",),
-}
+def _agent_families() -> dict[str, tuple[str, ...]]:
+    """Agent name -> the families whose record lists it (``Family.agents``), in registration order."""
+    from visuomotor_gym.families import families
+
+    out: dict[str, tuple[str, ...]] = {}
+    for record in families():
+        for agent in record.agents:
+            out[agent] = out.get(agent, ()) + (record.name,)
+    return out
+
+
+# The env families each agent is built for (each family's record lists its agents); an agent no family
+# lists plays every family (random, zero; ppo: its policy file says what it was trained on; gaze_blind:
+# its base agent's families).
+AGENT_FAMILIES: dict[str, tuple[str, ...]] = _agent_families()
 
 
 def check_agent_family(spec: str, env_id: str) -> None:
@@ -358,19 +359,14 @@ def _eyecatch(env_id, action_dim, seed, **kw):
 
 
 def _belief_mpc(env_id, action_dim, seed, **kw):
-    from visuomotor_gym.registration import family_of
+    from visuomotor_gym.families import family_for
+    from visuomotor_gym.family import resolve
 
-    if family_of(env_id) == "stones":  # Eom's belief MPC over the next footholds (issue 13)
-        from visuomotor_gym.baselines.belief_mpc.stones import StonesBeliefMPCAgent
-
-        return StonesBeliefMPCAgent.for_env(env_id, **kw)  # for_env gives it the env's VisionParams
-    if family_of(env_id) == "dodge":  # experimental: Eom's uncertainty term on fajen_warren's locomotion
-        from visuomotor_gym.baselines.belief_mpc.dodge import DodgeBeliefMPCAgent
-
-        return DodgeBeliefMPCAgent.for_env(env_id, **kw)
-    from visuomotor_gym.baselines.belief_mpc import BeliefMPCAgent
-
-    return _with_env_vision(BeliefMPCAgent.for_env(env_id, **kw), env_id, kw)
+    spec = family_for(env_id).belief_mpc  # which belief MPC plays the family (its record says)
+    if spec is None:
+        raise ValueError(f"agent 'belief_mpc' does not play {env_id}'s {family_for(env_id).name} family")
+    agent = resolve(spec.agent).for_env(env_id, **kw)
+    return _with_env_vision(agent, env_id, kw) if spec.env_vision else agent
 
 
 def _ppo(env_id, action_dim, seed, path=None, **kw):

@@ -83,36 +83,29 @@ def _mean_median(stats: dict) -> str:
     return f"mean {_fmt(stats.get('mean'))}  median {_fmt(stats.get('median'))}"
 
 
-# Row labels of the outcome measures per family (the results keep the catch family's key names; see
-# metrics.summary: time to catch is the time to success, miss distance the family's own distance).
-_OUTCOME_LABELS = {
-    "catch": ("catch rate", "time to catch (s)", "miss distance (m)"),
-    "reach": ("success rate", "time to success (s)", "closest distance, failed reaches (m)"),
-    "walk": ("success rate", "time to finish (s)", "distance left, failed walks (m)"),
-    "stones": ("success rate", "time to the last stone (s)", "stones left, failed crossings"),
-    "dodge": ("success rate", "time to goal (s)", "distance left, failed walks (m)"),
-}
-
-
-def _family_of(env_id: str) -> str:
-    from visuomotor_gym.registration import family_of
+def _family_of(env_id: str):
+    """The family record of ``env_id`` (its outcome labels, whether reaction times apply); the default
+    family's for an id this version does not register (an old results file)."""
+    from visuomotor_gym.families import default_family, family_for
 
     try:
-        return family_of(env_id)
-    except ValueError:  # an id this version does not register (an old results file)
-        return "catch"
+        return family_for(env_id)
+    except ValueError:
+        return default_family()
 
 
 def summary_rows(results: dict) -> list[tuple[str, str]]:
     """(metric, value) rows of the summary table, labelled in the env family's terms."""
     family = _family_of(results["env_id"])
-    rate_label, time_label, miss_label = _OUTCOME_LABELS.get(family, _OUTCOME_LABELS["catch"])
-    lo, hi = results["catch_rate_ci95"]
+    rate_label, time_label, miss_label = family.outcome_labels  # the results keep the catch key names
+    # The family-neutral keys; results written before them carry only catch_rate (the same number there).
+    rate = results.get("success_rate", results["catch_rate"])
+    lo, hi = results.get("success_rate_ci95", results["catch_rate_ci95"])
+    successes = results.get("success", results["caught"])
     gaze = results["gaze_realism"]
     lat = results["latency_ms"]
     rows = [
-        (rate_label, f"{results['catch_rate']:.3f}  95% CI [{lo:.3f}, {hi:.3f}]  "
-                     f"({results['caught']}/{results['episodes']})"),
+        (rate_label, f"{rate:.3f}  95% CI [{lo:.3f}, {hi:.3f}]  ({successes}/{results['episodes']})"),
         ("gaze realism", _fmt(gaze["score"])),
     ]
     gain = results.get("gaze_gain")
@@ -145,7 +138,7 @@ def summary_rows(results: dict) -> list[tuple[str, str]]:
         ("real time", f"{_fmt(results['real_time'])}  "
                       f"(p95 < {results['control_period_ms']:g} ms control period)"),
     ]
-    if family in ("catch", "reach"):  # reaction to a throw or to the object's appearance at t = 0
+    if family.reaction_from_t0:  # reaction to a throw or to the object's appearance at t = 0
         for kind, stats in results["reaction_times_s"].items():
             rows.append((f"reaction time, {kind.replace('_', ' ')} (s)", _mean_median(stats)))
     rows += [

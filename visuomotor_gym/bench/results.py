@@ -71,6 +71,7 @@ def build_results(eval_result, command: str | None, twin_result=None, static_res
         "caught": int(s["caught"]),
         "catch_rate": float(s["catch_rate"]),
         "catch_rate_ci95": [float(x) for x in s["catch_rate_ci95"]],
+        "success": int(s["success"]),
         "success_rate": float(s["success_rate"]),
         "success_rate_ci95": [float(x) for x in s["success_rate_ci95"]],
         "gaze_realism": s["gaze_realism"],
@@ -256,7 +257,8 @@ def _semantic_problems(obj: dict) -> list[tuple[str, str]]:
 
 def _success_problems(obj: dict, episodes: int | None, catch_rate, env_id) -> list[tuple[str, str]]:
     """``success_rate`` (optional: results written before it lack the pair) is k / episodes for an
-    integer k, its interval is the Wilson interval of k, and on a catch env id success is the catch."""
+    integer k, ``success`` (optional, newer still) is k, the interval is the Wilson interval of k, and
+    on a catch env id success is the catch."""
     from visuomotor_gym.registration import CATCH_ENV_IDS
 
     rate, ci = obj.get("success_rate"), obj.get("success_rate_ci95")
@@ -267,6 +269,9 @@ def _success_problems(obj: dict, episodes: int | None, catch_rate, env_id) -> li
     if abs(rate - k / episodes) > TOLERANCE:
         out.append(("$.success_rate", f"success_rate = {rate} is not a whole number of successes out of "
                                        f"episodes = {episodes}"))
+    elif "success" in obj and obj["success"] != k:
+        out.append(("$.success", f"success = {obj['success']} is not success_rate x episodes = {rate} x "
+                                  f"{episodes} = {k}"))
     elif isinstance(ci, list) and len(ci) == 2 and all(_is_num(x) for x in ci) and 0 <= k <= episodes:
         expected = _wilson(k, episodes)
         if expected is not None and any(abs(a - b) > TOLERANCE for a, b in zip(ci, expected)):

@@ -16,6 +16,7 @@ from visuomotor_gym.body import names
 from visuomotor_gym.control.hand import HandController, HandControlParams
 from visuomotor_gym.core.frames import SEAT_ORIGIN, FixedFrame
 from visuomotor_gym.core.observation import Block
+from visuomotor_gym.core.parts import Body
 from visuomotor_gym.oculomotor.plant import DEG
 
 CONTROL_MODES = ("hand", "joint")
@@ -53,7 +54,7 @@ def _index(ids) -> slice | np.ndarray:
     return ids
 
 
-class SeatedBody:
+class SeatedBody(Body):
     """Handles, posture, workspace, hand/joint actions and the grasp of the seated upper body."""
 
     frame = SEAT_FRAME

@@ -28,6 +28,7 @@ from visuomotor_gym.body import walker_names as wn
 from visuomotor_gym.body.walker import DEG, GaitParams, TurningGait, WalkerGait
 from visuomotor_gym.core.frames import RootFrame
 from visuomotor_gym.core.observation import Block
+from visuomotor_gym.core.parts import Body
 
 N_FOOTHOLDS_OBSERVED = 3  # the last three latched footholds (modelling choice: the landed one and the two planned)
 
@@ -45,7 +46,7 @@ WALKER_BLOCKS = (
 )
 
 
-class WalkerBody:
+class WalkerBody(Body):
     """Footstep actions, proprioception and events of the walker (``envs_assets/walker.xml``)."""
 
     observation_blocks = WALKER_BLOCKS
@@ -121,7 +122,7 @@ class WalkerBody:
             dx, dy = x - ox, y - oy
             values += (c * dx + s * dy, -s * dx + c * dy, z - oz)
         n = (g.next_latch_tick - g.T_mid) // T + 2  # g.next_footstep_index
-        gu, gv, (gx, gy), gc, gs = g.u, g.v, g.origin, g._c, g._s
+        gu, gv, (gx, gy), gc, gs = g.u, g.v, g.origin, g.path_cos, g.path_sin
         for j in range(n - N_FOOTHOLDS_OBSERVED, n):
             u, v = gu[j], gv[j]
             dx, dy = gx + gc * u - gs * v - ox, gy + gs * u + gc * v - oy
@@ -161,7 +162,7 @@ class TurningWalkerBody(WalkerBody):
     def __init__(self, model: mujoco.MjModel, params: GaitParams | None = None) -> None:
         super().__init__(model, params)
         self._turn = self.p.max_turn_deg * DEG
-        self._yaw_qpos = self.gait._qpos_idx[3]
+        self._yaw_qpos = self.gait.qpos_index[3]
 
     @staticmethod
     def action_from_turn(turn: float, p: GaitParams | None = None) -> float:

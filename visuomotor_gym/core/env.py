@@ -1,7 +1,9 @@
 """``VisuomotorEnv``: the Gymnasium skeleton every family shares.
 
-A concrete env builds its parts in ``__init__`` and calls :meth:`VisuomotorEnv._assemble` (the
-protocols a body and a task implement are in :mod:`visuomotor_gym.core.parts`):
+A concrete env (a family) declares its own constructor arguments, checks them, and forwards the
+shared ones (``**shared``) to :meth:`VisuomotorEnv.__init__`, which checks those, runs the build order
+and calls the family's :meth:`VisuomotorEnv._build` for its parts (the base classes a body and a task
+subclass are in :mod:`visuomotor_gym.core.parts`):
 
 * ``body`` - a body from :mod:`visuomotor_gym.body` (its action blocks, servo commands,
   proprioception, its frame);
@@ -18,10 +20,12 @@ body, the task's own state), info, rendering and pickling. The action is the bod
 
 from __future__ import annotations
 
+import inspect
 import math
 import os
 import warnings
 from dataclasses import asdict
+from typing import Any
 
 import gymnasium as gym
 import mujoco
@@ -33,6 +37,7 @@ from visuomotor_gym.core import args
 from visuomotor_gym.core.eye import EYE_ACTION_STRUCTURE, EYE_BLOCKS, Eye
 from visuomotor_gym.core.head import HEAD_ACTION_STRUCTURE, HEAD_BLOCKS, Head
 from visuomotor_gym.core.observation import ObservationLayout
+from visuomotor_gym.core.parts import Body, Task
 from visuomotor_gym.core.retina import VISION_MODES, Retina
 from visuomotor_gym.oculomotor.plant import DEG, OculomotorParams
 from visuomotor_gym.vision.foveation import VisionParams
@@ -42,6 +47,33 @@ MAX_VISION_NOISE_SCALE = 1000.0  # modelling choice: far beyond blindness (x10 i
 MAX_VISUAL_DELAY_S = 2.0  # modelling choice: 20x the human visual latency (~100 ms)
 _BAD_STATE_WARNINGS = (mujoco.mjtWarning.mjWARN_BADQPOS, mujoco.mjtWarning.mjWARN_BADQVEL,
                        mujoco.mjtWarning.mjWARN_BADQACC)
+
+# The meanings of the arguments every family shares (their defaults: VisuomotorEnv.__init__'s
+# signature): the generated Arguments tables' rows. A family's ``argument_meanings`` may replace one
+# with a family-specific text (what ``vision="oracle"`` sees, its cameras).
+SHARED_ARGUMENT_MEANINGS: dict[str, str] = {
+    "render_mode": '``"rgb_array"`` or ``"human"``',
+    "vision": ('``"foveated"``, ``"full_view"`` (foveal noise everywhere, no field-of-view limit, no saccadic '
+               'blindness) or ``"oracle"`` (true state)'),
+    "vision_noise_scale": ("multiplies every vision standard deviation (2: the PoorVision rung, 20/40 acuity; "
+                           "10: the Eyecatch paper's poor vision)"),
+    "vision_params": ("``VisionParams`` or a dict of its fields (acuity, retinal-slip knee, Weber fraction, depth "
+                      "noise, field of view)"),
+    "visual_delay_s": "visual latency, a multiple of the control period",
+    "obs_mode": '``"flat"`` or ``"dict"``',
+    "reward_weights": "dict overriding term weights",
+    "oculomotor_params": "``OculomotorParams`` or dict (saccade and pursuit limits, eye ranges, head speed)",
+    "control_dt": "control period (s); a whole multiple of the 2 ms physics step",
+    "gaze_action_range_deg": "gaze change at action +-1",
+    "render_camera": "which camera(s) ``render()`` shows",
+    "width": "size of each rendered camera image",
+    "record_plant": "keep the 500 Hz gaze trace (``env.unwrapped.plant.trace()``)",
+}
+
+
+def _doc_default(value) -> str:
+    """A default as the Arguments tables write it (a Python literal; strings in double quotes)."""
+    return f'``"{value}"``' if isinstance(value, str) else repr(value)
 
 
 class VisuomotorEnv(gym.Env):
@@ -53,6 +85,112 @@ class VisuomotorEnv(gym.Env):
     eye_camera: str = ""
 
     # --- construction -------------------------------------------------------------------------
+    # What a family declares (class attributes; see ``envs/*.py``):
+    scene: str = ""  # the MJCF file in ``envs_assets/`` (a property where it depends on an argument)
+    vision_defaults: VisionParams | None = None  # the family's default VisionParams (None: VisionParams())
+    reward_terms: tuple[str, ...] = ()  # the names ``reward_weights`` may set
+    default_reward_weights: dict[str, float] = {}  # noqa: RUF012  (read only; see _default_reward_weights)
+    # Meanings of the family's own arguments for the generated Arguments table, and family-specific
+    # meanings of shared ones (these replace the rows of SHARED_ARGUMENT_MEANINGS).
+    argument_meanings: dict[str, str] = {}  # noqa: RUF012
+
+    def __init__(
+        self,
+        render_mode: str | None = None,
+        *,
+        vision: str = "foveated",
+        vision_noise_scale: float = 1.0,
+        vision_params: VisionParams | dict | None = None,
+        visual_delay_s: float = 0.0,
+        obs_mode: str = "flat",
+        reward_weights: dict[str, float] | None = None,
+        oculomotor_params: OculomotorParams | dict | None = None,
+        control_dt: float = 0.02,
+        gaze_action_range_deg: float = 60.0,
+        render_camera: str = "both",
+        width: int = 480,
+        height: int = 360,
+        record_plant: bool = False,
+        **unknown: Any,
+    ):
+        """The arguments every family shares (their meanings: :data:`SHARED_ARGUMENT_MEANINGS`), checked
+        once, and the build order in one place. A family's ``__init__`` checks and keeps its own
+        arguments, then calls ``super().__init__(render_mode, **shared)``; this then rejects unknown
+        names, checks the shared ones, resolves the reward weights (:meth:`_default_reward_weights`,
+        ``reward_terms``), compiles ``scene`` and fixes the control period, sets the visual delay,
+        calls the family's :meth:`_build` for its body and task, and assembles the eye, head, retina,
+        spaces and observation layout."""
+        self._reject_unknown(unknown)
+        control_dt, visual_delay_s = self._check_eye_arguments(
+            render_mode=render_mode, vision=vision, vision_noise_scale=vision_noise_scale,
+            vision_params=vision_params, visual_delay_s=visual_delay_s, oculomotor_params=oculomotor_params,
+            gaze_action_range_deg=gaze_action_range_deg, control_dt=control_dt, obs_mode=obs_mode,
+            render_camera=render_camera, record_plant=record_plant, vision_defaults=self.vision_defaults,
+        )
+        self.reward_weights = self._reward_weights(self._default_reward_weights(), reward_weights,
+                                                   self.reward_terms)
+        self._load_physics(self.scene, control_dt)
+        self._set_visual_delay(visual_delay_s)
+        body, task = self._build()
+        self._assemble_eye(body=body, task=task, obs_mode=obs_mode, width=width, height=height)
+
+    def _build(self) -> tuple[Body, Task]:
+        """The family's body and task, built on ``self.model`` once the shared and the family's own
+        arguments are checked (``self.dt``, ``self.visual_delay_s``, ``self.reward_weights``,
+        ``self.oculomotor_params`` ... are set). Called once, by :meth:`__init__`."""
+        raise NotImplementedError(f"{type(self).__name__} must define _build() -> (body, task)")
+
+    def _default_reward_weights(self) -> dict[str, float]:
+        """The reward weights before ``reward_weights`` (called after the family's own arguments are
+        checked, so a reward mode may choose them). Default: ``default_reward_weights``."""
+        return self.default_reward_weights
+
+    def __init_subclass__(cls, **kwargs):
+        """A family's signature as a user sees it (``inspect.signature``, ``help()``): its own
+        arguments, then its parent's (the shared ones, and those of an intermediate class such as
+        the walker families'), all forwarded through ``**shared``; and its ``ARGUMENTS_TABLE``
+        docstring placeholder replaced by the table generated from that signature."""
+        super().__init_subclass__(**kwargs)
+        init = cls.__dict__.get("__init__")
+        if init is None:
+            return
+        own = [p for p in inspect.signature(init).parameters.values() if p.kind is not inspect.Parameter.VAR_KEYWORD]
+        taken = {p.name for p in own}
+        parent = inspect.signature(super(cls, cls).__init__).parameters.values()
+        merged = own + [p for p in parent if p.name not in taken and p.kind is not inspect.Parameter.VAR_KEYWORD]
+        keyword = [p for p in merged if p.kind is inspect.Parameter.KEYWORD_ONLY]
+        init.__signature__ = inspect.Signature([p for p in merged if p not in keyword] + keyword)
+        if cls.__doc__ and "ARGUMENTS_TABLE" in cls.__doc__:
+            cls.__doc__ = cls.__doc__.replace("ARGUMENTS_TABLE", "\n    ".join(cls.arguments_table().splitlines()))
+
+    @classmethod
+    def arguments_table(cls) -> str:
+        """The Arguments table (markdown) of the constructor's signature: one row per argument, in
+        signature order (``width`` and ``height`` share one), with its default and meaning (the
+        family's ``argument_meanings``, else :data:`SHARED_ARGUMENT_MEANINGS`)."""
+        params = [p for n, p in inspect.signature(cls.__init__).parameters.items()
+                  if n != "self" and p.kind is not inspect.Parameter.VAR_KEYWORD]
+        meanings = dict(SHARED_ARGUMENT_MEANINGS)
+        for klass in reversed(cls.__mro__):  # a subclass's meanings over its parents'
+            meanings.update(klass.__dict__.get("argument_meanings", {}))
+        if meanings["reward_weights"] == SHARED_ARGUMENT_MEANINGS["reward_weights"] and cls.reward_terms:
+            terms = ", ".join(f"``{t}``" for t in cls.reward_terms)
+            meanings["reward_weights"] = f"dict overriding term weights ({terms})"
+        rows = ["| argument | default | meaning |", "|---|---|---|"]
+        names = [p.name for p in params]
+        for p in params:
+            if p.name == "height" and "width" in names:
+                continue
+            if p.name not in meanings:
+                raise TypeError(f"{cls.__name__}: argument {p.name!r} has no meaning in argument_meanings")
+            if p.name == "width" and "height" in names:
+                h = next(q for q in params if q.name == "height")
+                rows.append(f"| ``width``, ``height`` | {_doc_default(p.default)}, {_doc_default(h.default)} "
+                            f"| {meanings['width']} |")
+                continue
+            rows.append(f"| ``{p.name}`` | {_doc_default(p.default)} | {meanings[p.name]} |")
+        return "\n".join(rows)
+
     def _check_eye_arguments(
         self,
         *,
@@ -154,6 +292,11 @@ class VisuomotorEnv(gym.Env):
             + tuple(task.trailing_blocks)
         )
         self.observation_structure = self.layout.structure
+        # Where each part's observe call must leave the value list (checked by _observe).
+        n_lead = sum(b.size for b in task.leading_blocks)
+        n_head = n_lead + sum(b.size for b in EYE_BLOCKS + HEAD_BLOCKS)
+        n_body = n_head + sum(b.size for b in body.observation_blocks)
+        self._observe_ends = (n_lead, n_head, n_body, self.layout.size)
         self.observation_space = self.layout.flat_space() if obs_mode == "flat" else self.layout.dict_space()
         self.width = args.integer(width, "width", low=1, high=8192)
         self.height = args.integer(height, "height", low=1, high=8192)
@@ -167,10 +310,8 @@ class VisuomotorEnv(gym.Env):
 
     @classmethod
     def _argument_names(cls) -> list[str]:
-        import inspect
-
         params = inspect.signature(cls.__init__).parameters
-        return [p for p in params if p not in ("self", "unknown")]
+        return [n for n, p in params.items() if n != "self" and p.kind is not inspect.Parameter.VAR_KEYWORD]
 
     def _reject_unknown(self, unknown: dict) -> None:
         if unknown:
@@ -344,16 +485,43 @@ class VisuomotorEnv(gym.Env):
         self.task.before_observe(d)
         samples = self.retina.sample(d, self.task.targets, self.eye, saccading, self.np_random)
         values: list = []
+        n_lead, n_head, n_body, n_obs = self._observe_ends
         self.task.observe_leading(values, samples)
+        if len(values) != n_lead:
+            self._observe_count_error("task", "observe_leading", values, 0, n_lead)
         self.eye.observe(values, self.frame)
         self.head.observe(values, d)
+        if len(values) != n_head:
+            self._observe_count_error("eye/head", "observe", values, n_lead, n_head)
         self.body.observe(values, d)
+        if len(values) != n_body:
+            self._observe_count_error("body", "observe", values, n_head, n_body)
         self.task.observe_trailing(values, samples, d)
+        if len(values) != n_obs:
+            self._observe_count_error("task", "observe_trailing", values, n_body, n_obs)
         if self._native:  # compiled np.array(values, dtype=np.float32) (floats and ints only, else None)
             obs = _native.kernels.float32_array(values)
             if obs is not None:
                 return obs
         return np.array(values, dtype=np.float32)
+
+    def _observe_count_error(self, part: str, hook: str, values: list, start: int, stop: int) -> None:
+        """Raise: a part's observe call appended other than its blocks' sizes (names the block)."""
+        owner = {"task": self.task, "body": self.body}.get(part)
+        who = f"{type(owner).__name__}.{hook}" if owner is not None else f"{part} {hook}"
+        blocks, offset, short = [], 0, None
+        for b in self.layout.blocks:
+            if start <= offset < stop:
+                blocks.append(f"{b.name} ({b.size})")
+                if short is None and offset + b.size > len(values):
+                    short = b.name
+            offset += b.size
+        n = len(values) - start
+        where = (f"block {short!r} is not filled" if short is not None
+                 else f"{n - (stop - start)} value(s) past block {blocks[-1].split()[0]!r}" if blocks
+                 else "it declares no blocks")
+        raise RuntimeError(f"{who} appended {n} observation values, its blocks hold {stop - start} "
+                           f"[{', '.join(blocks)}]: {where}")
 
     def _format(self, obs: np.ndarray):
         if self.obs_mode == "flat":
@@ -426,3 +594,4 @@ class VisuomotorEnv(gym.Env):
             self._viewer = mujoco.viewer.launch_passive(self.model, self.data)
         self._viewer.sync()
         return None
+

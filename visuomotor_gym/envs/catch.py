@@ -18,10 +18,8 @@ from visuomotor_gym.core import args
 from visuomotor_gym.core.env import VisuomotorEnv
 from visuomotor_gym.envs.observation import SECOND_BALL_OBSERVATION, ObservationLayout, catch_observation
 from visuomotor_gym.tasks.catch_rewards import REWARD_TERMS, SHAPED_WEIGHTS, SPARSE_WEIGHTS
-from visuomotor_gym.oculomotor.plant import OculomotorParams
 from visuomotor_gym.scenarios.throws import ThrowDistribution
 from visuomotor_gym.tasks.catch import CatchTask, catch_scene
-from visuomotor_gym.vision.foveation import VisionParams
 
 __all__ = ["EyeCatchEnv", "HAND_WORKSPACE", "SEAT_ORIGIN"]
 
@@ -129,30 +127,7 @@ class EyeCatchEnv(VisuomotorEnv):
 
     ## Arguments
 
-    | argument | default | meaning |
-    |---|---|---|
-    | ``render_mode`` | None | ``"rgb_array"`` or ``"human"`` |
-    | ``vision`` | ``"foveated"`` | ``"foveated"``, ``"full_view"`` (foveal noise everywhere, no field-of-view limit, no saccadic blindness) or ``"oracle"`` (true ball state) |
-    | ``vision_noise_scale`` | 1.0 | multiplies every vision standard deviation (2: the PoorVision rung, 20/40 acuity; 10: the Eyecatch paper's poor vision) |
-    | ``vision_params`` | None | ``VisionParams`` or a dict of its fields (acuity, retinal-slip knee, Weber fraction, depth noise, field of view) |
-    | ``visual_delay_s`` | 0.0 | visual latency, a multiple of the control period |
-    | ``bounce_wall`` | False | an invisible wall deflects the ball mid-flight |
-    | ``n_balls`` | 1 | 1, or 2 for two staggered balls (see Two balls) |
-    | ``release_after_catch_s`` | 0.2 | with two balls, a caught ball leaves the hand this long after its catch |
-    | ``control`` | ``"hand"`` | ``"hand"`` (Cartesian) or ``"joint"`` |
-    | ``obs_mode`` | ``"flat"`` | ``"flat"`` or ``"dict"`` |
-    | ``reward`` | ``"sparse"`` | ``"sparse"`` or ``"shaped"`` |
-    | ``reward_weights`` | None | dict overriding term weights |
-    | ``oculomotor_params`` | None | ``OculomotorParams`` or dict (saccade and pursuit limits, eye ranges, head speed) |
-    | ``hand_params`` | None | ``HandControlParams`` or dict (2 m/s cap, DLS damping) |
-    | ``throw_distribution`` | None | ``ThrowDistribution`` or dict |
-    | ``control_dt`` | 0.02 | control period (s); must be a whole multiple of the 2 ms physics step |
-    | ``catch_radius`` | 0.06 | radius (m) of the palm's catch volume |
-    | ``grasp_closed_fraction`` | 0.6 | finger closure above which the hand counts as closed |
-    | ``gaze_action_range_deg`` | 60.0 | gaze change at action +-1 |
-    | ``render_camera`` | ``"both"`` | ``"both"`` (scene beside eye view), ``"scene"``, ``"eye"``, ``"over_shoulder"`` |
-    | ``width``, ``height`` | 480, 360 | size of each rendered camera image |
-    | ``record_plant`` | False | keep the 500 Hz gaze trace (``env.unwrapped.plant.trace()``) |
+    ARGUMENTS_TABLE
 
     ## Version History
 
@@ -173,41 +148,37 @@ class EyeCatchEnv(VisuomotorEnv):
     }
     eye_camera = names.EYE_CAMERA
 
+    reward_terms = REWARD_TERMS
+    argument_meanings = {  # noqa: RUF012  (read only: the generated Arguments table)
+        "bounce_wall": "an invisible wall deflects the ball mid-flight",
+        "n_balls": "1, or 2 for two staggered balls (see Two balls)",
+        "release_after_catch_s": "with two balls, a caught ball leaves the hand this long after its catch",
+        "control": '``"hand"`` (Cartesian) or ``"joint"``',
+        "reward": '``"sparse"`` or ``"shaped"``',
+        "hand_params": "``HandControlParams`` or dict (2 m/s cap, DLS damping)",
+        "throw_distribution": "``ThrowDistribution`` or dict",
+        "catch_radius": "radius (m) of the palm's catch volume",
+        "grasp_closed_fraction": "finger closure above which the hand counts as closed",
+        "vision": ('``"foveated"``, ``"full_view"`` (foveal noise everywhere, no field-of-view limit, no saccadic '
+                   'blindness) or ``"oracle"`` (true ball state)'),
+        "render_camera": '``"both"`` (scene beside eye view), ``"scene"``, ``"eye"``, ``"over_shoulder"``',
+    }
+
     def __init__(
         self,
         render_mode: str | None = None,
         *,
-        vision: str = "foveated",
-        vision_noise_scale: float = 1.0,
-        vision_params: VisionParams | dict | None = None,
-        visual_delay_s: float = 0.0,
         bounce_wall: bool = False,
         n_balls: int = 1,
         release_after_catch_s: float = 0.2,
         control: str = "hand",
-        obs_mode: str = "flat",
         reward: str = "sparse",
-        reward_weights: dict[str, float] | None = None,
-        oculomotor_params: OculomotorParams | dict | None = None,
         hand_params: HandControlParams | dict | None = None,
         throw_distribution: ThrowDistribution | dict | None = None,
-        control_dt: float = 0.02,
         catch_radius: float = 0.06,
         grasp_closed_fraction: float = 0.6,
-        gaze_action_range_deg: float = 60.0,
-        render_camera: str = "both",
-        width: int = 480,
-        height: int = 360,
-        record_plant: bool = False,
-        **unknown: Any,
+        **shared: Any,
     ):
-        self._reject_unknown(unknown)
-        control_dt, visual_delay_s = self._check_eye_arguments(
-            render_mode=render_mode, vision=vision, vision_noise_scale=vision_noise_scale,
-            vision_params=vision_params, visual_delay_s=visual_delay_s, oculomotor_params=oculomotor_params,
-            gaze_action_range_deg=gaze_action_range_deg, control_dt=control_dt, obs_mode=obs_mode,
-            render_camera=render_camera, record_plant=record_plant,
-        )
         self.control = args.choice(control, CONTROL_MODES, "control")
         self.hand_params = args.coerce(HandControlParams, hand_params, "hand_params")
         self.throw_distribution = args.coerce(ThrowDistribution, throw_distribution, "throw_distribution")
@@ -222,11 +193,17 @@ class EyeCatchEnv(VisuomotorEnv):
         self.grasp_closed_fraction = args.real(grasp_closed_fraction, "grasp_closed_fraction", low=0.0, high=1.0,
                                                low_open=True)
         self.reward_mode = args.choice(reward, REWARD_MODES, "reward")
-        self.reward_weights = self._reward_weights(
-            SPARSE_WEIGHTS if self.reward_mode == "sparse" else SHAPED_WEIGHTS, reward_weights, REWARD_TERMS)
+        super().__init__(render_mode, **shared)
 
-        self._load_physics(catch_scene(self.n_balls), control_dt)
-        self._set_visual_delay(visual_delay_s)
+    @property
+    def scene(self) -> str:
+        """The scene file: ``catch.xml``, or ``catch_two_balls.xml`` with two balls."""
+        return catch_scene(self.n_balls)
+
+    def _default_reward_weights(self) -> dict[str, float]:
+        return SPARSE_WEIGHTS if self.reward_mode == "sparse" else SHAPED_WEIGHTS
+
+    def _build(self) -> tuple[SeatedBody, CatchTask]:
         body = SeatedBody(self.model, self.control, self.hand_params, self.dt)
         task = CatchTask(
             self.model, body, n_balls=self.n_balls, bounce_wall=self.bounce_wall,
@@ -236,8 +213,8 @@ class EyeCatchEnv(VisuomotorEnv):
             neutral_fixation_m=math.sqrt(self.oculomotor_params.fixation_range_m[0]
                                          * self.oculomotor_params.fixation_range_m[1]),
         )
-        self._assemble_eye(body=body, task=task, obs_mode=obs_mode, width=width, height=height)
         self.hand = body.hand
+        return body, task
 
     @property
     def throw(self):
@@ -261,3 +238,46 @@ if EyeCatchEnv.__doc__:
     )
 
 RENDER_CAMERAS = tuple(EyeCatchEnv.render_cameras)
+
+
+# ---------------------------------------------------------------- the family record (visuomotor_gym.family)
+from visuomotor_gym.family import BeliefMPC, ExtraEnv, Family
+
+CATCH_MAX_EPISODE_STEPS = 125  # 2.5 s at 50 Hz: the longest flight is 1.4 s
+TWO_BALLS_MAX_EPISODE_STEPS = 150  # 3 s: the second ball arrives at most 2.2 s after the first release
+PAPER_POOR_VISION_SCALE = 10.0  # Eyecatch (Yeo et al. 2012, section 5): every vision noise x10 (81.2 % caught)
+# The Eyecatch paper's vision model (Yeo et al. 2012, section 3.1): lateral position noise is static 20/20 acuity
+# whatever the image's speed on the retina. The default degrades it with retinal slip
+# (VisionParams.position_slip_knee_deg_s; docs/reproductions/gaze_default.md).
+PAPER_VISION = {"position_slip_knee_deg_s": math.inf}
+
+FAMILY = Family(
+    name="catch",
+    prefix="EyeCatch",
+    entry_point="visuomotor_gym.envs.catch:EyeCatchEnv",
+    max_episode_steps=CATCH_MAX_EPISODE_STEPS,
+    oracle_sees="ball",
+    body="seated",
+    summariser="visuomotor_gym.metrics.catch_summary:catch_summary",
+    miss_distance="visuomotor_gym.metrics.outcome:miss_distance",
+    outcome_labels=("catch rate", "time to catch (s)", "miss distance (m)"),
+    reaction_from_t0=True,  # the throw starts at t = 0
+    extra_envs=(
+        ExtraEnv("EyeCatchBounce-v0", {"bounce_wall": True},
+                 "foveated; the ball bounces off an invisible wall mid-flight (Eyecatch 5)"),
+        ExtraEnv("EyeCatchTwoBalls-v0", {"n_balls": 2},
+                 "foveated; two staggered balls from both sides, catch both (Eom 7)", TWO_BALLS_MAX_EPISODE_STEPS),
+        # The two vision conditions of the Eyecatch paper (section 5: 98 % normal, 81.2 % with the noise
+        # x10), for its reproduction page: the paper's static 20/20 acuity at any retinal speed, no slip term.
+        ExtraEnv("EyeCatchPaper-v0", {"vision_params": dict(PAPER_VISION)},
+                 "Eyecatch paper's vision: foveated, static acuity at any retinal speed"),
+        ExtraEnv("EyeCatchPaperPoorVision-v0",
+                 {"vision_params": dict(PAPER_VISION), "vision_noise_scale": PAPER_POOR_VISION_SCALE},
+                 "Eyecatch paper's vision with all noise x10 (Eyecatch 5: 81.2 %)"),
+    ),
+    agents=("eyecatch", "fixed_gaze", "oracle", "belief_intercept", "belief_mpc"),
+    golden_agent="eyecatch",
+    golden_extra=(("oracle", "EyeCatchOracle-v0"),),
+    belief_mpc=BeliefMPC("visuomotor_gym.baselines.belief_mpc:BeliefMPCAgent",
+                         "visuomotor_gym.baselines.belief_mpc.agent:BeliefMPCParams", env_vision=True),
+)

@@ -13,15 +13,12 @@ from typing import Any
 from visuomotor_gym.body import names
 from visuomotor_gym.body import walker_names as wn
 from visuomotor_gym.body.dodge_body import DodgeBody
-from visuomotor_gym.body.walker import GaitParams
 from visuomotor_gym.body.walker_body import WALKER_BLOCKS
 from visuomotor_gym.core import args
-from visuomotor_gym.core.env import VisuomotorEnv
 from visuomotor_gym.core.eye import EYE_BLOCKS
 from visuomotor_gym.core.head import HEAD_BLOCKS
 from visuomotor_gym.core.observation import ObservationLayout
-from visuomotor_gym.envs.walk import WALK_VISION
-from visuomotor_gym.oculomotor.plant import OculomotorParams
+from visuomotor_gym.envs.walk import WALK_VISION, WalkerEnv
 from visuomotor_gym.tasks.obstacle_dodge import (
     DEFAULT_REWARD_WEIGHTS,
     PERCEPT_BLOCKS,
@@ -30,7 +27,6 @@ from visuomotor_gym.tasks.obstacle_dodge import (
     CrowdDistribution,
     ObstacleDodgeTask,
 )
-from visuomotor_gym.vision.foveation import VisionParams
 
 __all__ = ["DODGE_LAYOUT", "DODGE_SCENE", "ObstacleDodgeEnv"]
 
@@ -40,7 +36,7 @@ RENDER_CAMERAS = ("both", "side", "follow", "top", "eye")
 DODGE_LAYOUT = ObservationLayout(PERCEPT_BLOCKS + EYE_BLOCKS + HEAD_BLOCKS + WALKER_BLOCKS + TRAILING_BLOCKS)
 
 
-class ObstacleDodgeEnv(VisuomotorEnv):
+class ObstacleDodgeEnv(WalkerEnv):
     """
     ## Description
 
@@ -105,23 +101,7 @@ class ObstacleDodgeEnv(VisuomotorEnv):
 
     ## Arguments
 
-    | argument | default | meaning |
-    |---|---|---|
-    | ``render_mode`` | None | ``"rgb_array"`` or ``"human"`` |
-    | ``vision`` | ``"foveated"`` | ``"foveated"``, ``"full_view"`` (foveal noise everywhere, no field-of-view limit, no saccadic blindness) or ``"oracle"`` (true state) |
-    | ``vision_noise_scale`` | 1.0 | multiplies every vision standard deviation (2: the PoorVision rung, 20/40 acuity; 10: the Eyecatch paper's poor vision) |
-    | ``vision_params`` | None | ``VisionParams`` or a dict of its fields; the default is the walk family's (``field_of_view_deg`` = 20) |
-    | ``visual_delay_s`` | 0.0 | visual latency, a multiple of the control period |
-    | ``obs_mode`` | ``"flat"`` | ``"flat"`` or ``"dict"`` |
-    | ``reward_weights`` | None | dict overriding term weights (``goal``, ``collision``, ``progress``) |
-    | ``oculomotor_params`` | None | ``OculomotorParams`` or dict |
-    | ``gait_params`` | None | ``GaitParams`` or dict (``visuomotor_gym.body.walker``) |
-    | ``crowd_distribution`` | None | ``CrowdDistribution`` or dict |
-    | ``control_dt`` | 0.02 | control period (s); a whole multiple of the 2 ms physics step |
-    | ``gaze_action_range_deg`` | 60.0 | gaze change at action +-1 |
-    | ``render_camera`` | ``"both"`` | ``"both"`` (top view beside the eye view), ``"side"``, ``"follow"``, ``"top"``, ``"eye"`` |
-    | ``width``, ``height`` | 480, 360 | size of each rendered camera image |
-    | ``record_plant`` | False | keep the 500 Hz gaze trace |
+    ARGUMENTS_TABLE
 
     ## Version History
 
@@ -137,46 +117,28 @@ class ObstacleDodgeEnv(VisuomotorEnv):
     }
     eye_camera = names.EYE_CAMERA
 
+    default_reward_weights = DEFAULT_REWARD_WEIGHTS
+    reward_terms = REWARD_TERMS
+    body_class = DodgeBody
+    argument_meanings = {  # noqa: RUF012  (read only: the generated Arguments table)
+        "crowd_distribution": "``CrowdDistribution`` or dict",
+        "render_camera": '``"both"`` (top view beside the eye view), ``"side"``, ``"follow"``, ``"top"``, ``"eye"``',
+    }
+    scene = DODGE_SCENE
+
     def __init__(
         self,
         render_mode: str | None = None,
         *,
-        vision: str = "foveated",
-        vision_noise_scale: float = 1.0,
-        vision_params: VisionParams | dict | None = None,
-        visual_delay_s: float = 0.0,
-        obs_mode: str = "flat",
-        reward_weights: dict[str, float] | None = None,
-        oculomotor_params: OculomotorParams | dict | None = None,
-        gait_params: GaitParams | dict | None = None,
         crowd_distribution: CrowdDistribution | dict | None = None,
-        control_dt: float = 0.02,
-        gaze_action_range_deg: float = 60.0,
-        render_camera: str = "both",
-        width: int = 480,
-        height: int = 360,
-        record_plant: bool = False,
-        **unknown: Any,
+        **shared: Any,
     ):
-        self._reject_unknown(unknown)
-        control_dt, visual_delay_s = self._check_eye_arguments(
-            render_mode=render_mode, vision=vision, vision_noise_scale=vision_noise_scale,
-            vision_params=vision_params, visual_delay_s=visual_delay_s, oculomotor_params=oculomotor_params,
-            gaze_action_range_deg=gaze_action_range_deg, control_dt=control_dt, obs_mode=obs_mode,
-            render_camera=render_camera, record_plant=record_plant,
-            vision_defaults=WALK_VISION,  # the walk family's 20 deg recognition field
-        )
-        self.gait_params = args.coerce(GaitParams, gait_params, "gait_params")
         self.crowd_distribution = args.coerce(CrowdDistribution, crowd_distribution, "crowd_distribution")
-        self.reward_weights = self._reward_weights(DEFAULT_REWARD_WEIGHTS, reward_weights, REWARD_TERMS)
+        super().__init__(render_mode, **shared)
 
-        self._load_physics(DODGE_SCENE, control_dt)
-        self._set_visual_delay(visual_delay_s)
-        body = DodgeBody(self.model, self.gait_params)
-        task = ObstacleDodgeTask(self.model, body, crowd_distribution=self.crowd_distribution,
+    def _build_task(self, body: DodgeBody) -> ObstacleDodgeTask:
+        return ObstacleDodgeTask(self.model, body, crowd_distribution=self.crowd_distribution,
                                  reward_weights=self.reward_weights, dt=self.dt)
-        self._assemble_eye(body=body, task=task, obs_mode=obs_mode, width=width, height=height)
-        self.gait = body.gait
 
     @property
     def crowd(self):
@@ -189,3 +151,28 @@ if ObstacleDodgeEnv.__doc__:
     ObstacleDodgeEnv.__doc__ = ObstacleDodgeEnv.__doc__.replace(
         "OBSERVATION_TABLE", "\n    ".join(DODGE_LAYOUT.markdown_table().splitlines())
     ).replace("(N,)", f"({DODGE_LAYOUT.size},)").replace("(N in the table)", "")
+
+
+# ---------------------------------------------------------------- the family record (visuomotor_gym.family)
+from visuomotor_gym.family import BeliefMPC, Family
+
+DODGE_MAX_EPISODE_STEPS = 2000  # 40 s at 50 Hz: about three times the nominal walk (1.3 m/s) to the farthest (20 m) goal
+
+FAMILY = Family(
+    name="dodge",
+    prefix="ObstacleDodge",
+    entry_point="visuomotor_gym.envs.dodge:ObstacleDodgeEnv",
+    max_episode_steps=DODGE_MAX_EPISODE_STEPS,
+    oracle_sees="pedestrian",
+    body="walker",
+    vision_defaults=WALK_VISION,  # the walk family's 20 deg recognition field
+    summariser="visuomotor_gym.metrics.dodge_realism:dodge_summary",
+    miss_distance="visuomotor_gym.metrics.dodge_realism:distance_left",
+    outcome_labels=("success rate", "time to goal (s)", "distance left, failed walks (m)"),
+    agents=("belief_mpc", "fajen_warren"),
+    golden_agent="fajen_warren",
+    # experimental: Eom's uncertainty term on fajen_warren's locomotion
+    belief_mpc=BeliefMPC("visuomotor_gym.baselines.belief_mpc.dodge:DodgeBeliefMPCAgent",
+                         "visuomotor_gym.baselines.belief_mpc.dodge:DodgeBeliefMPCParams",
+                         vision_note="env_vision_params"),
+)

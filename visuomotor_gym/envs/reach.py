@@ -25,7 +25,6 @@ from visuomotor_gym.core.env import VisuomotorEnv
 from visuomotor_gym.core.eye import EYE_BLOCKS
 from visuomotor_gym.core.head import HEAD_BLOCKS
 from visuomotor_gym.core.observation import ObservationLayout
-from visuomotor_gym.oculomotor.plant import OculomotorParams
 from visuomotor_gym.tasks.reach import (
     OBJECT_PERCEPT_BLOCKS,
     REWARD_TERMS,
@@ -34,7 +33,6 @@ from visuomotor_gym.tasks.reach import (
     TIME_BLOCK,
     ReachTask,
 )
-from visuomotor_gym.vision.foveation import VisionParams
 
 __all__ = ["ShelfReachEnv", "reach_observation"]
 
@@ -112,28 +110,7 @@ class ShelfReachEnv(VisuomotorEnv):
 
     ## Arguments
 
-    | argument | default | meaning |
-    |---|---|---|
-    | ``render_mode`` | None | ``"rgb_array"`` or ``"human"`` |
-    | ``vision`` | ``"foveated"`` | ``"foveated"``, ``"full_view"`` or ``"oracle"`` (true object position) |
-    | ``vision_noise_scale`` | 1.0 | multiplies every vision standard deviation |
-    | ``vision_params`` | None | ``VisionParams`` or a dict of its fields |
-    | ``visual_delay_s`` | 0.0 | visual latency, a multiple of the control period |
-    | ``control`` | ``"hand"`` | ``"hand"`` (Cartesian) or ``"joint"`` |
-    | ``hand_action`` | ``"target"`` | ``"target"`` (a hand target each step) or ``"bezier"`` (reaches as cubic Bézier curves: end point, two interior control-point offsets, duration; needs ``control="hand"``) |
-    | ``obs_mode`` | ``"flat"`` | ``"flat"`` or ``"dict"`` |
-    | ``reward`` | ``"sparse"`` | ``"sparse"`` or ``"shaped"`` |
-    | ``reward_weights`` | None | dict overriding term weights |
-    | ``oculomotor_params`` | None | ``OculomotorParams`` or dict |
-    | ``hand_params`` | None | ``HandControlParams`` or dict (2 m/s cap, DLS damping) |
-    | ``control_dt`` | 0.02 | control period (s); a whole multiple of the 2 ms physics step |
-    | ``reach_radius`` | 0.06 | success radius (m) around the catch site (the catch family's catch volume) |
-    | ``grasp_closed_fraction`` | 0.6 | finger closure above which the hand counts as closed |
-    | ``arrival_speed_m_s`` | 0.5 | the hand must be slower than this (m/s) to count as arrived (modelling choice: arriving, not sweeping past) |
-    | ``gaze_action_range_deg`` | 60.0 | gaze change at action +-1 |
-    | ``render_camera`` | ``"both"`` | ``"both"`` (scene beside eye view), ``"scene"``, ``"eye"``, ``"over_shoulder"``, ``"top"`` |
-    | ``width``, ``height`` | 480, 360 | size of each rendered camera image |
-    | ``record_plant`` | False | keep the 500 Hz gaze trace |
+    ARGUMENTS_TABLE
 
     ## Version History
 
@@ -149,39 +126,36 @@ class ShelfReachEnv(VisuomotorEnv):
     }
     eye_camera = names.EYE_CAMERA
 
+    reward_terms = REWARD_TERMS
+    scene = reach_names.SCENE
+    argument_meanings = {  # noqa: RUF012  (read only: the generated Arguments table)
+        "control": '``"hand"`` (Cartesian) or ``"joint"``',
+        "hand_action": ('``"target"`` (a hand target each step) or ``"bezier"`` (reaches as cubic Bézier curves: end '
+                        'point, two interior control-point offsets, duration; needs ``control="hand"``)'),
+        "reward": '``"sparse"`` or ``"shaped"``',
+        "hand_params": "``HandControlParams`` or dict (2 m/s cap, DLS damping)",
+        "reach_radius": "success radius (m) around the catch site (the catch family's catch volume)",
+        "grasp_closed_fraction": "finger closure above which the hand counts as closed",
+        "arrival_speed_m_s": ("the hand must be slower than this (m/s) to count as arrived (modelling choice: "
+                              "arriving, not sweeping past)"),
+        "vision": '``"foveated"``, ``"full_view"`` or ``"oracle"`` (true object position)',
+        "render_camera": ('``"both"`` (scene beside eye view), ``"scene"``, ``"eye"``, ``"over_shoulder"``, '
+                          '``"top"``'),
+    }
+
     def __init__(
         self,
         render_mode: str | None = None,
         *,
-        vision: str = "foveated",
-        vision_noise_scale: float = 1.0,
-        vision_params: VisionParams | dict | None = None,
-        visual_delay_s: float = 0.0,
         control: str = "hand",
         hand_action: str = "target",
-        obs_mode: str = "flat",
         reward: str = "sparse",
-        reward_weights: dict[str, float] | None = None,
-        oculomotor_params: OculomotorParams | dict | None = None,
         hand_params: HandControlParams | dict | None = None,
-        control_dt: float = 0.02,
         reach_radius: float = 0.06,
         grasp_closed_fraction: float = 0.6,
         arrival_speed_m_s: float = 0.5,
-        gaze_action_range_deg: float = 60.0,
-        render_camera: str = "both",
-        width: int = 480,
-        height: int = 360,
-        record_plant: bool = False,
-        **unknown: Any,
+        **shared: Any,
     ):
-        self._reject_unknown(unknown)
-        control_dt, visual_delay_s = self._check_eye_arguments(
-            render_mode=render_mode, vision=vision, vision_noise_scale=vision_noise_scale,
-            vision_params=vision_params, visual_delay_s=visual_delay_s, oculomotor_params=oculomotor_params,
-            gaze_action_range_deg=gaze_action_range_deg, control_dt=control_dt, obs_mode=obs_mode,
-            render_camera=render_camera, record_plant=record_plant,
-        )
         self.control = args.choice(control, CONTROL_MODES, "control")
         self.hand_action = args.choice(hand_action, HAND_ACTIONS, "hand_action")
         if self.hand_action == "bezier" and self.control != "hand":
@@ -192,19 +166,20 @@ class ShelfReachEnv(VisuomotorEnv):
                                                low_open=True)
         self.arrival_speed_m_s = args.real(arrival_speed_m_s, "arrival_speed_m_s", low=0.0, high=100.0, low_open=True)
         self.reward_mode = args.choice(reward, REWARD_MODES, "reward")
-        self.reward_weights = self._reward_weights(
-            SPARSE_WEIGHTS if self.reward_mode == "sparse" else SHAPED_WEIGHTS, reward_weights, REWARD_TERMS)
+        super().__init__(render_mode, **shared)
 
-        self._load_physics(reach_names.SCENE, control_dt)
-        self._set_visual_delay(visual_delay_s)
+    def _default_reward_weights(self) -> dict[str, float]:
+        return SPARSE_WEIGHTS if self.reward_mode == "sparse" else SHAPED_WEIGHTS
+
+    def _build(self) -> tuple[ReachSeatedBody, ReachTask]:
         body = ReachSeatedBody(self.model, self.control, self.hand_params, self.dt, hand_action=self.hand_action)
         task = ReachTask(
             self.model, body, reach_radius=self.reach_radius, grasp_closed_fraction=self.grasp_closed_fraction,
             arrival_speed_m_s=self.arrival_speed_m_s, reward_weights=self.reward_weights, dt=self.dt,
             visual_delay_s=self.visual_delay_s,
         )
-        self._assemble_eye(body=body, task=task, obs_mode=obs_mode, width=width, height=height)
         self.hand = body.hand
+        return body, task
 
     @property
     def target_index(self) -> int:
@@ -239,3 +214,24 @@ if ShelfReachEnv.__doc__:
                              .replace("OBSERVATION_TABLE", "\n    ".join(_layout.markdown_table().splitlines()))
                              .replace("ACTION_TABLE", _action_table())
                              .replace("OBS_SIZE", str(_layout.size)))
+
+
+# ---------------------------------------------------------------- the family record (visuomotor_gym.family)
+from visuomotor_gym.family import Family
+
+REACH_MAX_EPISODE_STEPS = 150  # 3 s at 50 Hz: first saccade (~0.2 s), fixation, a ~0.6-1 s reach, slack (modelling choice)
+
+FAMILY = Family(
+    name="reach",
+    prefix="ShelfReach",
+    entry_point="visuomotor_gym.envs.reach:ShelfReachEnv",
+    max_episode_steps=REACH_MAX_EPISODE_STEPS,
+    oracle_sees="object",
+    body="seated",
+    summariser="visuomotor_gym.metrics.reach_realism:reach_summary",
+    miss_distance="visuomotor_gym.metrics.reach_realism:closest_distance",
+    outcome_labels=("success rate", "time to success (s)", "closest distance, failed reaches (m)"),
+    reaction_from_t0=True,  # the object appears at t = 0
+    agents=("faraway",),
+    golden_agent="faraway",
+)

@@ -19,7 +19,7 @@ from visuomotor_gym.core.env import MAX_VISION_NOISE_SCALE, MAX_VISUAL_DELAY_S, 
 from visuomotor_gym.core.eye import EYE_BLOCKS
 from visuomotor_gym.core.head import HEAD_BLOCKS
 from visuomotor_gym.core.observation import ObservationLayout
-from visuomotor_gym.oculomotor.plant import OculomotorParams
+from visuomotor_gym.core.parts import Task
 from visuomotor_gym.tasks.obstacle_walk import (
     DEFAULT_REWARD_WEIGHTS,
     K_SLOTS,
@@ -31,7 +31,7 @@ from visuomotor_gym.tasks.obstacle_walk import (
 )
 from visuomotor_gym.vision.foveation import VisionParams
 
-__all__ = ["OBSTACLE_VIEW_ANGLE_DEG", "WALK_LAYOUT", "WALK_VISION", "ObstacleWalkEnv"]
+__all__ = ["OBSTACLE_VIEW_ANGLE_DEG", "WALK_LAYOUT", "WALK_VISION", "ObstacleWalkEnv", "WalkerEnv"]
 
 RENDER_CAMERAS = ("both", "side", "follow", "scene", "eye")
 # The field in which an obstacle is seen at all: Iwao et al.'s view angle for obstacle recognition
@@ -45,7 +45,36 @@ WALK_VISION = VisionParams(field_of_view_deg=OBSTACLE_VIEW_ANGLE_DEG)
 WALK_LAYOUT = ObservationLayout(PERCEPT_BLOCKS + EYE_BLOCKS + HEAD_BLOCKS + WALKER_BLOCKS + TRAILING_BLOCKS)
 
 
-class ObstacleWalkEnv(VisuomotorEnv):
+class WalkerEnv(VisuomotorEnv):
+    """What the walker families (ObstacleWalk, SteppingStones, ObstacleDodge) share on top of
+    :class:`~visuomotor_gym.core.env.VisuomotorEnv`: the ``gait_params`` argument, the walk vision
+    (:data:`WALK_VISION`: the 20 deg recognition field) and the walker body of ``body_class`` built on
+    it (``env.gait`` is its gait); a family adds its task (:meth:`_build_task`). Not registered."""
+
+    vision_defaults = WALK_VISION  # the walk family's 20 deg recognition field under vision_params
+    body_class: type[WalkerBody] = WalkerBody
+    argument_meanings = {  # noqa: RUF012  (read only: the generated Arguments table)
+        "gait_params": "``GaitParams`` or dict (``visuomotor_gym.body.walker``)",
+        "vision_params": ("``VisionParams`` or a dict of its fields; the default is the walk family's "
+                          "(``field_of_view_deg`` = 20)"),
+    }
+
+    def __init__(self, render_mode: str | None = None, *, gait_params: GaitParams | dict | None = None,
+                 **shared: Any):
+        self.gait_params = args.coerce(GaitParams, gait_params, "gait_params")
+        super().__init__(render_mode, **shared)
+
+    def _build(self) -> tuple[WalkerBody, Task]:
+        body = self.body_class(self.model, self.gait_params)
+        self.gait = body.gait
+        return body, self._build_task(body)
+
+    def _build_task(self, body: WalkerBody) -> Task:
+        """The family's task on ``body`` (called once, after the arguments are checked)."""
+        raise NotImplementedError(f"{type(self).__name__} must define _build_task(body)")
+
+
+class ObstacleWalkEnv(WalkerEnv):
     """
     ## Description
 
@@ -126,23 +155,7 @@ class ObstacleWalkEnv(VisuomotorEnv):
 
     ## Arguments
 
-    | argument | default | meaning |
-    |---|---|---|
-    | ``render_mode`` | None | ``"rgb_array"`` or ``"human"`` |
-    | ``vision`` | ``"foveated"`` | ``"foveated"``, ``"full_view"`` (foveal noise everywhere, no field-of-view limit, no saccadic blindness) or ``"oracle"`` (true corners) |
-    | ``vision_noise_scale`` | 1.0 | multiplies every vision standard deviation (2: the PoorVision rung, 20/40 acuity; 10: the Eyecatch paper's poor vision) |
-    | ``vision_params`` | None | ``VisionParams`` or a dict of its fields; the default is the catch family's except ``field_of_view_deg`` = 20 (see below) |
-    | ``visual_delay_s`` | 0.0 | visual latency, a multiple of the control period |
-    | ``obs_mode`` | ``"flat"`` | ``"flat"`` or ``"dict"`` |
-    | ``reward_weights`` | None | dict overriding term weights (``finish``, ``trip``, ``misstep``, ``off_path``, ``progress``) |
-    | ``oculomotor_params`` | None | ``OculomotorParams`` or dict |
-    | ``gait_params`` | None | ``GaitParams`` or dict (``visuomotor_gym.body.walker``) |
-    | ``course_distribution`` | None | ``CourseDistribution`` or dict |
-    | ``control_dt`` | 0.02 | control period (s); a whole multiple of the 2 ms physics step |
-    | ``gaze_action_range_deg`` | 60.0 | gaze change at action +-1 |
-    | ``render_camera`` | ``"both"`` | ``"both"`` (side view beside the eye view), ``"side"``, ``"follow"``, ``"scene"``, ``"eye"`` |
-    | ``width``, ``height`` | 480, 360 | size of each rendered camera image |
-    | ``record_plant`` | False | keep the 500 Hz gaze trace |
+    ARGUMENTS_TABLE
 
     ## Version History
 
@@ -159,47 +172,32 @@ class ObstacleWalkEnv(VisuomotorEnv):
     }
     eye_camera = names.EYE_CAMERA
 
+    default_reward_weights = DEFAULT_REWARD_WEIGHTS
+    reward_terms = REWARD_TERMS
+    argument_meanings = {  # noqa: RUF012  (read only: the generated Arguments table)
+        "course_distribution": "``CourseDistribution`` or dict",
+        "vision": ('``"foveated"``, ``"full_view"`` (foveal noise everywhere, no field-of-view limit, no saccadic '
+                   'blindness) or ``"oracle"`` (true corners)'),
+        "vision_params": ("``VisionParams`` or a dict of its fields; the default is the catch family's except "
+                          "``field_of_view_deg`` = 20 (see below)"),
+        "render_camera": '``"both"`` (side view beside the eye view), ``"side"``, ``"follow"``, ``"scene"``, ``"eye"``',
+    }
+    scene = wn.WALKER_SCENE
+
     def __init__(
         self,
         render_mode: str | None = None,
         *,
-        vision: str = "foveated",
-        vision_noise_scale: float = 1.0,
-        vision_params: VisionParams | dict | None = None,
-        visual_delay_s: float = 0.0,
-        obs_mode: str = "flat",
-        reward_weights: dict[str, float] | None = None,
-        oculomotor_params: OculomotorParams | dict | None = None,
-        gait_params: GaitParams | dict | None = None,
         course_distribution: CourseDistribution | dict | None = None,
-        control_dt: float = 0.02,
-        gaze_action_range_deg: float = 60.0,
-        render_camera: str = "both",
-        width: int = 480,
-        height: int = 360,
-        record_plant: bool = False,
-        **unknown: Any,
+        **shared: Any,
     ):
-        self._reject_unknown(unknown)
-        control_dt, visual_delay_s = self._check_eye_arguments(
-            render_mode=render_mode, vision=vision, vision_noise_scale=vision_noise_scale,
-            vision_params=vision_params, visual_delay_s=visual_delay_s, oculomotor_params=oculomotor_params,
-            gaze_action_range_deg=gaze_action_range_deg, control_dt=control_dt, obs_mode=obs_mode,
-            render_camera=render_camera, record_plant=record_plant,
-            vision_defaults=WALK_VISION,  # a dict of vision_params fields goes over the 20 deg field
-        )
-        self.gait_params = args.coerce(GaitParams, gait_params, "gait_params")
         self.course_distribution = args.coerce(CourseDistribution, course_distribution, "course_distribution")
-        self.reward_weights = self._reward_weights(DEFAULT_REWARD_WEIGHTS, reward_weights, REWARD_TERMS)
+        super().__init__(render_mode, **shared)
 
-        self._load_physics(wn.WALKER_SCENE, control_dt)
-        self._set_visual_delay(visual_delay_s)
-        body = WalkerBody(self.model, self.gait_params)
-        task = ObstacleWalkTask(self.model, body, course_distribution=self.course_distribution,
+    def _build_task(self, body: WalkerBody) -> ObstacleWalkTask:
+        return ObstacleWalkTask(self.model, body, course_distribution=self.course_distribution,
                                 reward_weights=self.reward_weights, visual_delay_s=self.visual_delay_s,
                                 n_substeps=self.n_substeps)
-        self._assemble_eye(body=body, task=task, obs_mode=obs_mode, width=width, height=height)
-        self.gait = body.gait
 
     @property
     def course(self):
@@ -213,3 +211,24 @@ if ObstacleWalkEnv.__doc__:
     ObstacleWalkEnv.__doc__ = ObstacleWalkEnv.__doc__.replace(
         "OBSERVATION_TABLE", "\n    ".join(WALK_LAYOUT.markdown_table().splitlines())
     ).replace("(N,)", f"({WALK_LAYOUT.size},)").replace("(N in the table)", "")
+
+
+# ---------------------------------------------------------------- the family record (visuomotor_gym.family)
+from visuomotor_gym.family import Family
+
+WALK_MAX_EPISODE_STEPS = 2000  # 40 s at 50 Hz: three times the nominal walk (1.3 m/s) of the longest (20 m) course
+
+FAMILY = Family(
+    name="walk",
+    prefix="ObstacleWalk",
+    entry_point="visuomotor_gym.envs.walk:ObstacleWalkEnv",
+    max_episode_steps=WALK_MAX_EPISODE_STEPS,
+    oracle_sees="obstacle",
+    body="walker",
+    vision_defaults=WALK_VISION,  # Iwao's 20 deg recognition field
+    summariser="visuomotor_gym.metrics.walk_realism:walk_summary",
+    miss_distance="visuomotor_gym.metrics.walk_realism:distance_left",
+    outcome_labels=("success rate", "time to finish (s)", "distance left, failed walks (m)"),
+    agents=("iwao",),
+    golden_agent="iwao",
+)

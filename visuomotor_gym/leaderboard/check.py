@@ -77,6 +77,7 @@ RECOMPUTED_FIELDS = (
     "caught",
     "catch_rate",
     "catch_rate_ci95",
+    "success",
     "success_rate",
     "success_rate_ci95",
     "diverged",
@@ -688,8 +689,8 @@ def summary_problems(lb: Leaderboard, entry: Entry, traces: list) -> list[Proble
     tol = max(SUMMARY_TOLERANCE, p.time_tolerance_s, p.distance_tolerance_m)
     diffs = []
     for key in RECOMPUTED_FIELDS:
-        if key not in r and key.startswith("success_rate"):
-            continue  # results written before success_rate existed: catch_rate (compared) is the success
+        if key not in r and key.startswith("success"):
+            continue  # results written before success(_rate) existed: catch_rate (compared) is the success
         if key == "hand_path" and key not in r:
             continue  # optional (results written before it existed); when claimed it must be what re-scoring gives
         diffs += _differences(key, r.get(key), fresh[key], tol)

@@ -179,25 +179,19 @@ BELIEF_MPC_FORMAT = "belief-mpc-params"
 
 def _belief_mpc_classes(env_id: str) -> tuple[type, type, str | None]:
     """(agent class, params class, how its note names the env's VisionParams, None when the agent takes
-    none) of the belief_mpc agent on ``env_id``'s family: the catch agent, or the stones and dodge agents
-    of issue 13. (The stones note keeps the name committed entries were exported with, ``stones_vision``,
-    an alias of ``registration.env_vision_params``: the check compares re-exported bytes.)"""
+    none) of the belief_mpc agent on ``env_id``'s family, from the family record's ``belief_mpc``
+    (:class:`visuomotor_gym.family.BeliefMPC`; the note's name is fixed by committed entries: the check
+    compares re-exported bytes)."""
     import visuomotor_gym  # noqa: F401  (registers the ids for gym.spec)
-    from visuomotor_gym.registration import family_of
+    from visuomotor_gym.families import family_for
+    from visuomotor_gym.family import resolve
 
-    family = family_of(env_id)
-    if family == "stones":
-        from visuomotor_gym.baselines.belief_mpc.stones import StonesBeliefMPCAgent, StonesBeliefMPCParams
-
-        return StonesBeliefMPCAgent, StonesBeliefMPCParams, "stones_vision"
-    if family == "dodge":
-        from visuomotor_gym.baselines.belief_mpc.dodge import DodgeBeliefMPCAgent, DodgeBeliefMPCParams
-
-        return DodgeBeliefMPCAgent, DodgeBeliefMPCParams, "env_vision_params"
-    from visuomotor_gym.baselines.belief_mpc import BeliefMPCAgent
-    from visuomotor_gym.baselines.belief_mpc.agent import BeliefMPCParams
-
-    return BeliefMPCAgent, BeliefMPCParams, None
+    record = family_for(env_id)
+    if record.belief_mpc is None:
+        raise ValueError(f"the {BELIEF_MPC_FORMAT} format serves families the belief_mpc agent plays, "
+                         f"not {env_id}'s {record.name} family")
+    spec = record.belief_mpc
+    return resolve(spec.agent), resolve(spec.params), spec.vision_note
 
 
 def _belief_mpc_export(spec: str, env_id: str) -> bytes:

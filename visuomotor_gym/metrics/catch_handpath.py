@@ -63,6 +63,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 
 from visuomotor_gym import handpath
+from visuomotor_gym.envs.catch import FAMILY
 from visuomotor_gym.geometry import angles_deg
 from visuomotor_gym.metrics.reach_realism import REACH_REFERENCE
 from visuomotor_gym.metrics.realism import score_component
@@ -146,12 +147,10 @@ def _nan() -> float:
 def measures_hand_path(trace) -> bool:
     """Whether the catch hand path is measured for this trace's env: single-ball catch ids (a two-ball
     episode holds two catches, and its trace records only the first ball's path)."""
-    from visuomotor_gym.registration import ENV_SPECS
-
     env_id = str(getattr(trace, "env_id", "")).removeprefix("visuomotor_gym:")
-    for spec in ENV_SPECS:
+    for spec in FAMILY.env_entries():  # the catch family's ids
         if spec.id == env_id:
-            return spec.family == "catch" and int(spec.kwargs.get("n_balls", 1)) == 1
+            return int(spec.kwargs.get("n_balls", 1)) == 1
     return False
 
 

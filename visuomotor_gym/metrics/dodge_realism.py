@@ -31,6 +31,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from visuomotor_gym.metrics import strategy
+from visuomotor_gym.metrics.common import goal_summary
 from visuomotor_gym.metrics.realism import score_components
 
 # Modelling choice: a pedestrian's upper body (~0.5 m wide) subtends ~6-10 deg at 3-5 m; gaze within
@@ -112,9 +113,7 @@ def distance_left(tr) -> float:
 
 
 def dodge_summary(traces: Sequence) -> dict:
-    """:func:`visuomotor_gym.metrics.summary.summarize` for dodge traces: the same keys (``caught`` counts
+    """:func:`~visuomotor_gym.metrics.common.goal_summary` for dodge traces: the same keys (``caught`` counts
     successes), ``gaze_realism`` from :func:`dodge_gaze_realism`; ``time_to_catch_s`` is the time to the
     goal of the successful walks, ``miss_distance_m`` the distance left to the goal in the failed ones."""
-    from visuomotor_gym.metrics.summary import goal_summary
-
     return goal_summary(traces, dodge_gaze_realism, distance_left)

@@ -33,7 +33,10 @@ import numpy as np
 from visuomotor_gym import handpath
 from visuomotor_gym.geometry import angles_deg
 from visuomotor_gym.metrics import strategy
+from visuomotor_gym.metrics.common import goal_summary
+from visuomotor_gym.metrics.hand import hand_onset_time
 from visuomotor_gym.metrics.realism import score_components
+from visuomotor_gym.metrics.stats import mean_median
 
 GAZE_ON_OBJECT_DEG = 5.0  # "on the object": within 5 deg of the line of sight (as metrics.gaze.FOVEA_DEG, our choice)
 HAND_ONSET_SPEED_M_S = 0.1  # as metrics.hand.HAND_ONSET_SPEED_M_S
@@ -167,49 +170,14 @@ def closest_distance(tr) -> float:
     return float(d.min())
 
 
-def reach_outcomes(traces: Sequence) -> dict:
-    """The evaluator's outcome fields for reach traces: ``miss_distance_m`` (closest catch-site to object
-    distance over the episodes not reached) and ``time_to_catch_s`` (time to success), ``{"mean", "median"}``;
-    ``hand_onset`` and ``first_saccade`` reaction times."""
-    from visuomotor_gym.metrics.gaze import first_saccade_latency
-    from visuomotor_gym.metrics.hand import hand_onset_time
-    from visuomotor_gym.metrics.stats import mean_median
-
-    miss = [closest_distance(tr) for tr in traces if not tr.success]
-    return {
-        "reaction_times_s": {
-            "first_saccade": mean_median([first_saccade_latency(tr) for tr in traces]),
-            "hand_onset": mean_median([hand_onset_time(tr) for tr in traces]),
-        },
-        "miss_distance_m": mean_median(miss),
-        "time_to_catch_s": mean_median([float(tr.t[-1]) for tr in traces if tr.success]),
-    }
-
-
 def reach_summary(traces: Sequence) -> dict:
-    """:func:`visuomotor_gym.metrics.summary.summarize` for reach-family traces: the same keys (``caught`` and
-    ``catch_rate`` count successes, equal to ``success_rate``), with ``gaze_realism`` from
-    :func:`reach_realism` and the outcome fields of :func:`reach_outcomes`. Diverged episodes are left
-    out of the behavioural measures, as for catching."""
-    from visuomotor_gym.metrics.stats import wilson_interval
-    from visuomotor_gym.metrics.summary import latency_summary
-
+    """:func:`~visuomotor_gym.metrics.common.goal_summary` for reach-family traces (``caught`` and
+    ``catch_rate`` count successes, equal to ``success_rate``; ``gaze_realism`` from
+    :func:`reach_realism`; the miss distance :func:`closest_distance`) plus one field, the hand's
+    reaction time ``reaction_times_s["hand_onset"]``. Diverged episodes are left out of the behavioural
+    measures, as for catching."""
     traces = list(traces)
-    n = len(traces)
-    succeeded = sum(bool(tr.success) for tr in traces)
-    diverged = sum(bool(tr.diverged) for tr in traces)
+    out = goal_summary(traces, reach_realism, closest_distance)
     valid = [tr for tr in traces if not tr.diverged]
-    low, high = wilson_interval(succeeded, n)
-    out = {
-        "episodes": n,
-        "caught": succeeded,
-        "catch_rate": succeeded / n if n else float("nan"),
-        "catch_rate_ci95": [low, high],
-        "success_rate": succeeded / n if n else float("nan"),
-        "success_rate_ci95": [low, high],
-        "diverged": diverged,
-        "gaze_realism": reach_realism(valid),
-        "latency_ms": latency_summary(traces),
-    }
-    out.update(reach_outcomes(valid))
+    out["reaction_times_s"]["hand_onset"] = mean_median([hand_onset_time(tr) for tr in valid])
     return out

@@ -35,6 +35,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from visuomotor_gym.metrics import strategy
+from visuomotor_gym.metrics.common import goal_summary
 from visuomotor_gym.metrics.realism import score_components
 
 ON_STONE_M = 0.05  # modelling choice: ~1-2 deg at 1.5-3 m, the accuracy of mobile eye trackers (~1 deg)
@@ -161,10 +162,8 @@ def distance_left(tr) -> float:
 
 
 def stones_summary(traces: Sequence) -> dict:
-    """:func:`visuomotor_gym.metrics.summary.summarize` for stones-family traces: the same keys (``caught``
+    """:func:`~visuomotor_gym.metrics.common.goal_summary` for stones-family traces: the same keys (``caught``
     and ``catch_rate`` count successes), ``gaze_realism`` from :func:`stones_gaze_realism`;
     ``time_to_catch_s`` is the time to the last stone of the successful crossings, ``miss_distance_m``
     the number of stones left in the failed ones (a count, under the shared key), ``hand_onset`` NaN."""
-    from visuomotor_gym.metrics.summary import goal_summary
-
     return goal_summary(traces, stones_gaze_realism, distance_left)

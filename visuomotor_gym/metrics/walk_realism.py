@@ -45,6 +45,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from visuomotor_gym.metrics import strategy
+from visuomotor_gym.metrics.common import goal_summary
 from visuomotor_gym.metrics.realism import score_components
 from visuomotor_gym.metrics.stats import nan_mean
 
@@ -214,11 +215,9 @@ def distance_left(tr) -> float:
 
 
 def walk_summary(traces: Sequence) -> dict:
-    """:func:`visuomotor_gym.metrics.summary.summarize` for walk-family traces: the same keys (``caught``
+    """:func:`~visuomotor_gym.metrics.common.goal_summary` for walk-family traces: the same keys (``caught``
     and ``catch_rate`` count successes, equal to ``success_rate``), ``gaze_realism`` from
     :func:`walk_gaze_realism`; ``time_to_catch_s`` is the time to the finish line of the successful
     walks, ``miss_distance_m`` the distance left to the finish in the failed ones, ``hand_onset`` NaN
     (no hand). Diverged episodes are left out of the behavioural measures, as for catching."""
-    from visuomotor_gym.metrics.summary import goal_summary
-
     return goal_summary(traces, walk_gaze_realism, distance_left)

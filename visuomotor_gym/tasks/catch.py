@@ -12,6 +12,7 @@ import numpy as np
 
 from visuomotor_gym.body import names
 from visuomotor_gym.core.observation import Block
+from visuomotor_gym.core.parts import Task
 from visuomotor_gym.core.retina import FreeBodyTarget
 from visuomotor_gym.tasks.catch_rewards import catch_reward
 from visuomotor_gym.geometry import norm
@@ -84,7 +85,7 @@ def catch_scene(n_balls: int) -> str:
     return "catch.xml" if n_balls == 1 else names.TWO_BALLS_SCENE
 
 
-class CatchTask:
+class CatchTask(Task):
     """Throws, catches, misses and rewards of the catch family.
 
     ``body`` is the :class:`~visuomotor_gym.body.seated.SeatedBody` (catch site, grasp, seat frame).
@@ -283,9 +284,6 @@ class CatchTask:
         d.eq_active[ball.weld] = 1
 
     # --- observation --------------------------------------------------------------------------
-    def before_observe(self, data: mujoco.MjData) -> None:
-        """Nothing to bring up to date before the observation blocks (the core's hook)."""
-
     def observe_leading(self, values: list, samples: list) -> None:
         """The first ball's percept blocks (:data:`BALL_PERCEPT_BLOCKS`)."""
         pos, vel, visible = samples[0]

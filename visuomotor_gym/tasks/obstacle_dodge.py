@@ -42,6 +42,7 @@ from visuomotor_gym.body import walker_names as wn
 from visuomotor_gym.core import args
 from visuomotor_gym.core.args import Num, Pair
 from visuomotor_gym.core.observation import Block
+from visuomotor_gym.core.parts import Task
 from visuomotor_gym.core.retina import VisualTarget
 
 N_PEDESTRIANS = 4
@@ -158,7 +159,7 @@ TRAILING_BLOCKS = (
 )
 
 
-class ObstacleDodgeTask:
+class ObstacleDodgeTask(Task):
     """Crowd, visual targets, collision, rewards and info of ObstacleDodge. ``body`` is a
     :class:`~visuomotor_gym.body.dodge_body.DodgeBody`."""
 
@@ -238,12 +239,6 @@ class ObstacleDodgeTask:
         """Gaze starts level, straight ahead at the goal, at eye height."""
         return np.array([self.crowd.goal, 0.0, 1.6]), (0.0, 0.0)
 
-    def initial_fixation(self, distance: float) -> float:
-        return distance
-
-    def reset_info(self) -> dict:
-        return {"goal_distance": self.crowd.goal, "pedestrians": self.crowd.pedestrians.copy()}
-
     def trace_episode_fields(self) -> dict:
         return {"goal_distance": float(self.crowd.goal), "pedestrians": self.crowd.pedestrians.copy()}
 
@@ -274,16 +269,7 @@ class ObstacleDodgeTask:
             self._write(data, i)
         self._activate(data, t_end)
 
-    def needs_substep_checks(self, data: mujoco.MjData) -> bool:
-        return False
-
-    def check_substep(self, data: mujoco.MjData) -> bool:
-        return False
-
     # --- observation --------------------------------------------------------------------------
-    def before_observe(self, data: mujoco.MjData) -> None:
-        """Nothing to bring up to date before the observation blocks (the core's hook)."""
-
     def observe_leading(self, values: list, samples: list) -> None:
         for k in range(K_SLOTS):
             p, v, visible = samples[k]

@@ -42,7 +42,10 @@ from visuomotor_gym.body import walker_names as wn
 from visuomotor_gym.core import args
 from visuomotor_gym.core.args import Num, Pair, Weights
 from visuomotor_gym.core.observation import Block
+from visuomotor_gym.core.parts import Task
 from visuomotor_gym.core.retina import PointTarget
+from visuomotor_gym.tasks.walk_contacts import LegContacts
+from visuomotor_gym.tasks.walk_scene import ObstaclePool
 
 K_SLOTS = 4
 # The seen points of an obstacle's top face, in the order of the observation (module docstring).
@@ -146,7 +149,7 @@ TRAILING_BLOCKS = (
 )
 
 
-class ObstacleWalkTask:
+class ObstacleWalkTask(Task):
     """Course, visual targets, events, rewards and info of ObstacleWalk. ``body`` is a
     :class:`~visuomotor_gym.body.walker_body.WalkerBody`."""
 
@@ -161,7 +164,8 @@ class ObstacleWalkTask:
         self.n_substeps = int(n_substeps)  # physics substeps per control step (the env's)
         self.body = body
         self.gait = body.gait
-        self.pool = body.gait.pool
+        self.pool = ObstaclePool(model)  # the obstacles of the course (scene state)
+        self.contacts = LegContacts(model, body.gait, self.pool)  # trips and missteps
         self.dist = course_distribution
         self.reward_weights = reward_weights
         self.visual_delay_s = visual_delay_s
@@ -181,6 +185,7 @@ class ObstacleWalkTask:
 
     # --- episode ------------------------------------------------------------------------------
     def reset_state(self) -> None:
+        self.contacts.reset()
         self.success = False
         self.tripped = False
         self.misstepped = False
@@ -214,9 +219,6 @@ class ObstacleWalkTask:
         """Gaze starts level, straight ahead along the path (at the finish line, at eye height)."""
         return np.array([self.course.length, 0.0, 1.6]), (0.0, 0.0)
 
-    def initial_fixation(self, distance: float) -> float:
-        return distance
-
     def reset_info(self) -> dict:
         """The course (true state, scoring only). Fixed shapes whatever the seed, so that Gymnasium's vector
         envs can stack it: ``obstacles`` is (pool size, 6), its first ``n_obstacles`` rows the course's
@@ -236,24 +238,21 @@ class ObstacleWalkTask:
                 "off_path": bool(info["off_path"]), "finished": bool(info["finished"])}
 
     # --- physics ------------------------------------------------------------------------------
-    def before_physics(self, data: mujoco.MjData) -> None:
-        return None
-
     def needs_substep_checks(self, data: mujoco.MjData) -> bool:
         """Contact checks every substep only while an obstacle is within reach of a leg: then the
-        substeps are *watched* (:meth:`WalkerGait.watch_substeps`) and still run as one ``mj_step``
+        substeps are *watched* (:meth:`LegContacts.watch`) and still run as one ``mj_step``
         call (so this returns False); :meth:`check_substep`, called once after them, classifies their
         contacts exactly as checks after every substep would have (replaying them when MuJoCo saw a
         contact)."""
-        if self.pool.near(float(data.qpos[0]), float(data.qpos[1]), self.gait.CONTACT_RADIUS_M):
-            self.gait.watch_substeps(data)
+        if self.contacts.near(data):
+            self.contacts.watch(data)
         return False
 
     def check_substep(self, data: mujoco.MjData) -> bool:
-        """Classify leg-obstacle contacts (:meth:`WalkerGait.check_contacts`): True on a new event.
+        """Classify leg-obstacle contacts (:meth:`LegContacts.check`): True on a new event.
         After watched substeps: as the env's substep loop would have (checks after each substep until
         the first new event, then once more on the final kinematics)."""
-        return self.gait.watched_contacts(data, self.n_substeps)
+        return self.contacts.watched(data, self.n_substeps)
 
     # --- observation --------------------------------------------------------------------------
     def before_observe(self, data: mujoco.MjData) -> None:
@@ -310,7 +309,7 @@ class ObstacleWalkTask:
 
     def evaluate(self, data: mujoco.MjData, fired: bool, a: np.ndarray, eye) -> tuple[float, dict, bool, dict]:
         d = data
-        g = self.gait
+        g = self.contacts
         new_trip = g.tripped and not self.tripped
         events = g.events
         n_events = len(events)
@@ -334,16 +333,16 @@ class ObstacleWalkTask:
 
     def info(self, data: mujoco.MjData, *, diverged: bool = False) -> dict:
         """Step information (the course is true state: for scoring only, never for a policy)."""
-        if diverged and self.gait._watching:
+        if diverged and self.contacts.watching:
             # The physics diverged in watched substeps (the env returns before check_substep): their
             # checks, as the substep loop made them before it noticed (no final check).
-            self.gait.watched_contacts(data, self.n_substeps, final=False, replay=True)
+            self.contacts.watched(data, self.n_substeps, final=False, replay=True)
         return {
             "tripped": self.tripped,
             "misstepped": self.misstepped,
             "off_path": self.off_path,
             "finished": self.finished,
-            "events": len(self.gait.events),
+            "events": len(self.contacts.events),
             "obstacles_passed": self.n_passed,
             "obstacle_seen": False if diverged else any(self.seen),
             "step_phase": (self.gait.tick % self.gait.T) / self.gait.T,  # gait.step_phase()

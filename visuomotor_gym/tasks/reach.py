@@ -24,6 +24,7 @@ from visuomotor_gym.body.reach_body import home_hand_position
 from visuomotor_gym.core import args
 from visuomotor_gym.core.args import Many, Num, Pair
 from visuomotor_gym.core.observation import Block
+from visuomotor_gym.core.parts import Task
 from visuomotor_gym.core.retina import VisualTarget
 from visuomotor_gym.vision import foveation
 
@@ -120,7 +121,7 @@ class ShelfObject(VisualTarget):
         data.mocap_pos[self.mocap] = position
 
 
-class ReachTask:
+class ReachTask(Task):
     """Targets, contacts, success and rewards of the shelf-reach task (``body``: a reach body)."""
 
     trace_step_fields = ()
@@ -168,9 +169,6 @@ class ReachTask:
     def initial_gaze(self) -> tuple[np.ndarray, tuple[float, float]]:
         return self._gaze_point, (float(self.gaze_offset[0]), float(self.gaze_offset[1]))
 
-    def initial_fixation(self, distance: float) -> float:
-        return distance
-
     def reset_info(self) -> dict:
         tower, level, depth = ShelfLayout.describe(self.target_index)
         return {"target_index": self.target_index, "tower": tower, "level": level, "depth": depth,
@@ -209,9 +207,6 @@ class ReachTask:
         return False
 
     # --- observation --------------------------------------------------------------------------
-    def before_observe(self, data: mujoco.MjData) -> None:
-        """Nothing to bring up to date before the observation blocks (the core's hook)."""
-
     def observe_leading(self, values: list, samples: list) -> None:
         pos, _vel, visible = samples[0]
         self.visible = visible

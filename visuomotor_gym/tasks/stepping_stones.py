@@ -43,6 +43,7 @@ from visuomotor_gym.body import walker_names as wn
 from visuomotor_gym.core import args
 from visuomotor_gym.core.args import Int, Num, Pair
 from visuomotor_gym.core.observation import Block
+from visuomotor_gym.core.parts import Task
 from visuomotor_gym.core.retina import PointTarget
 
 STONES_SCENE = "stones.xml"
@@ -165,9 +166,11 @@ TRAILING_BLOCKS = (
 )
 
 
-class SteppingStonesTask:
+class SteppingStonesTask(Task):
     """Course, visual targets, landings, rewards and info of SteppingStones. ``body`` is a
-    :class:`~visuomotor_gym.body.walker_body.WalkerBody` on ``stones.xml``."""
+    :class:`~visuomotor_gym.body.walker_body.WalkerBody` on ``stones.xml``. No substep checks (the
+    :class:`~visuomotor_gym.core.parts.Task` default): landings are checked once per control step, since
+    they fall on control-step boundaries."""
 
     leading_blocks = PERCEPT_BLOCKS
     trailing_blocks = TRAILING_BLOCKS
@@ -179,7 +182,6 @@ class SteppingStonesTask:
         m = self.model = model
         self.body = body
         self.gait = body.gait
-        self.gait._ob_geom = {}  # no obstacle pool in this scene: the gait's trip checks see nothing
         self.dist = course_distribution
         check_steppable(self.dist, self.gait.p)
         self.reward_weights = reward_weights
@@ -233,12 +235,6 @@ class SteppingStonesTask:
         """Gaze starts level, straight ahead along the slab's axis (as in ObstacleWalk)."""
         return np.array([20.0, 0.0, 1.6]), (0.0, 0.0)
 
-    def initial_fixation(self, distance: float) -> float:
-        return distance
-
-    def reset_info(self) -> dict:
-        return {"stones": self.course.stones.copy(), "stone_radius": self.radius}
-
     # --- what the evaluator records ----------------------------------------------------------
     def trace_episode_fields(self) -> dict:
         return {"stones": self.course.stones.copy(), "stone_radius": self.radius}
@@ -248,15 +244,6 @@ class SteppingStonesTask:
         return {"fell": bool(info["fell"]), "finished": bool(info["finished"])}
 
     # --- physics ------------------------------------------------------------------------------
-    def before_physics(self, data: mujoco.MjData) -> None:
-        return None
-
-    def needs_substep_checks(self, data: mujoco.MjData) -> bool:
-        return False  # landings are checked once per control step (they fall on control-step boundaries)
-
-    def check_substep(self, data: mujoco.MjData) -> bool:
-        return False
-
     # --- landings -----------------------------------------------------------------------------
     def support_under(self, data: mujoco.MjData, side: int) -> int | None:
         """The support (-1 slab, else stone index) that foot ``side`` stands on, or None over the gap:
