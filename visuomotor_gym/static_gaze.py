@@ -29,6 +29,7 @@ pinned evaluation seeds (see :func:`search`).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import functools
 import json
 import math
@@ -328,6 +329,31 @@ def make_static_gaze(env_id, action_dim, seed, base=None, **posture_overrides) -
 
 
 # --- the search ----------------------------------------------------------------------------------
+@contextlib.contextmanager
+def registered_kwargs(env_id: str, kwargs: dict | None):
+    """Within the block, ``env_id``'s registered kwargs carry ``kwargs`` (e.g. ``vision_params``,
+    ``course_distribution``) in this process, so that the env and every agent's ``for_env`` (which reads
+    the registered kwargs) agree on them; restored on exit. Empty or None: nothing changes."""
+    import gymnasium as gym
+
+    import visuomotor_gym  # noqa: F401  (registers the ids)
+
+    if not kwargs:
+        yield
+        return
+    if not isinstance(kwargs, dict):
+        raise TypeError(f"env kwargs must be a dict of constructor arguments, got {type(kwargs).__name__}")
+    spec = gym.registry[env_id.removeprefix("visuomotor_gym:")]
+    saved = dict(spec.kwargs)
+    spec.kwargs.update(kwargs)
+    try:
+        gym.make(spec.id).close()  # refuse a bad argument here, naming it, before any search
+        yield
+    finally:
+        spec.kwargs.clear()
+        spec.kwargs.update(saved)
+
+
 def neck_along(az: float, el: float, geometry: EyeGeometry) -> tuple[float, float]:
     """The neck pointing along the line of sight, within its range (the coarse grid's neck)."""
     return (min(max(az, geometry.neck_yaw_deg[0]), geometry.neck_yaw_deg[1]),
@@ -437,7 +463,7 @@ class _Scorer:
 def search(env_id: str, agent: str, *, design_seed: int = DESIGN_SEED, coarse_episodes: int = COARSE_EPISODES,
            final_episodes: int = FINAL_EPISODES, coarse_step: float = 20.0, refine_steps=(10.0, 5.0),
            refine_top: int = 3, finalists: int = 5, neck_step: float = 20.0, postures=None,
-           command: str | None = None, log=None) -> dict:
+           command: str | None = None, log=None, env_kwargs: dict | None = None) -> dict:
     """Search the best static posture of ``agent`` on ``env_id``; returns the results record.
 
     Every posture is played with :func:`visuomotor_gym.bench.evaluate.run_chunk` in ``evaluate()``'s
@@ -461,8 +487,23 @@ def search(env_id: str, agent: str, *, design_seed: int = DESIGN_SEED, coarse_ep
     best complete rate so far (racing: a posture clearly worse than the best is not played out). The chosen
     posture is the best on ``final_episodes`` seeds; ties go to the line of sight nearer straight
     ahead, then the neck nearer straight ahead. ``postures``: an explicit list instead of the grid
-    (each on ``final_episodes`` seeds, no early stop; for tests).
+    (each on ``final_episodes`` seeds, no early stop; for tests). ``env_kwargs``: constructor
+    arguments laid over the registered id's for the whole search (:func:`registered_kwargs`; e.g. the
+    human periphery's ``vision_params`` or ``course_distribution="rough"``), recorded in the result.
     """
+    with registered_kwargs(env_id, env_kwargs):
+        record = _search(env_id, agent, design_seed=design_seed, coarse_episodes=coarse_episodes,
+                         final_episodes=final_episodes, coarse_step=coarse_step, refine_steps=refine_steps,
+                         refine_top=refine_top, finalists=finalists, neck_step=neck_step, postures=postures,
+                         command=command, log=log)
+    if env_kwargs:
+        record["env_kwargs"] = dict(env_kwargs)
+    return record
+
+
+def _search(env_id: str, agent: str, *, design_seed: int, coarse_episodes: int, final_episodes: int,
+            coarse_step: float, refine_steps, refine_top: int, finalists: int, neck_step: float, postures,
+            command: str | None, log) -> dict:
     from visuomotor_gym.bench.evaluate import check_env_id
     from visuomotor_gym.bench.provenance import provenance
 
@@ -573,7 +614,9 @@ def evaluate_pinned(record: dict, episodes: int = 200, seed: int = 0, workers: i
     from visuomotor_gym.bench.evaluate import evaluate
 
     spec = record["chosen"]["spec"]
-    result = evaluate(spec, record["env_id"], episodes, seed, workers=workers, keep_traces=True)
+    with registered_kwargs(record["env_id"], record.get("env_kwargs")):
+        result = evaluate(spec, record["env_id"], episodes, seed, workers=workers if not record.get("env_kwargs") else 1,
+                          keep_traces=True)
     k = sum(tr.success for tr in result.traces)
     record["pinned"] = {"spec": spec, "seed": seed, "episodes": episodes, "successes": k,
                         "success": k / episodes, "wall_time_s": round(result.wall_time_s, 1)}
@@ -662,6 +705,9 @@ def main(argv=None) -> int:
     s.add_argument("--workers", type=int, default=1, help="worker processes of the pinned evaluation")
     s.add_argument("--update-postures", action="store_true",
                    help="write the chosen posture into the package's static_postures.json")
+    s.add_argument("--env-kwargs", type=str, default=None, metavar="JSON",
+                   help="constructor arguments laid over the registered id's for the whole search, as a JSON "
+                        "object, e.g. '{\"course_distribution\": \"rough\", \"vision_params\": {\"crowding\": true}}'")
     s.add_argument("--quiet", action="store_true")
     p = sub.add_parser("pinned", help="add the pinned-seed evaluation to an existing results JSON")
     p.add_argument("results")
@@ -698,11 +744,19 @@ def main(argv=None) -> int:
                 raise SystemExit(f"--postures: {item!r} is not az,el[,neck_yaw,neck_pitch]")
             postures.append(Posture(*values))
     log = None if args.quiet else (lambda line: print(line, flush=True))
+    env_kwargs = None
+    if args.env_kwargs:
+        try:
+            env_kwargs = json.loads(args.env_kwargs)
+        except json.JSONDecodeError as exc:
+            raise SystemExit(f"--env-kwargs: not JSON ({exc})") from None
+        if not isinstance(env_kwargs, dict):
+            raise SystemExit(f"--env-kwargs: must be a JSON object of constructor arguments, got {args.env_kwargs!r}")
     record = search(args.env, args.agent, design_seed=args.design_seed, coarse_episodes=args.coarse_episodes,
                     final_episodes=args.final_episodes, coarse_step=args.coarse_step,
                     refine_steps=tuple(float(x) for x in args.refine_steps.split(",") if x),
                     refine_top=args.refine_top, finalists=args.finalists, neck_step=args.neck_step,
-                    postures=postures, command=command, log=log)
+                    postures=postures, command=command, log=log, env_kwargs=env_kwargs)
     if args.pinned:
         evaluate_pinned(record, episodes=args.pinned, workers=args.workers)
     out = Path(args.out)
@@ -721,5 +775,6 @@ if __name__ == "__main__":
     raise SystemExit(main())
 
 
-__all__ = ["DEAD_BAND_DEG", "Posture", "StaticGaze", "check_posture", "env_geometry", "resolve_spec", "search",
+__all__ = ["DEAD_BAND_DEG", "Posture", "StaticGaze", "check_posture", "env_geometry", "registered_kwargs",
+           "resolve_spec", "search",
            "searched_posture", "static_gaze_spec"]

@@ -24,6 +24,7 @@ from visuomotor_gym.tasks.obstacle_walk import (
     DEFAULT_REWARD_WEIGHTS,
     K_SLOTS,
     PERCEPT_BLOCKS,
+    COURSE_PRESETS,
     REWARD_TERMS,
     TRAILING_BLOCKS,
     CourseDistribution,
@@ -175,7 +176,8 @@ class ObstacleWalkEnv(WalkerEnv):
     default_reward_weights = DEFAULT_REWARD_WEIGHTS
     reward_terms = REWARD_TERMS
     argument_meanings = {  # noqa: RUF012  (read only: the generated Arguments table)
-        "course_distribution": "``CourseDistribution`` or dict",
+        "course_distribution": ('``CourseDistribution``, dict, or a preset name: ``"walkway"`` (the default) or '
+                                '``"rough"`` (``ROUGH_COURSE``: small hazards on most footholds, opt-in)'),
         "vision": ('``"foveated"``, ``"full_view"`` (foveal noise everywhere, no field-of-view limit, no saccadic '
                    'blindness) or ``"oracle"`` (true corners)'),
         "vision_params": ("``VisionParams`` or a dict of its fields; the default is the catch family's except "
@@ -188,9 +190,12 @@ class ObstacleWalkEnv(WalkerEnv):
         self,
         render_mode: str | None = None,
         *,
-        course_distribution: CourseDistribution | dict | None = None,
+        course_distribution: CourseDistribution | dict | str | None = None,
         **shared: Any,
     ):
+        if isinstance(course_distribution, str):
+            course_distribution = COURSE_PRESETS[args.choice(course_distribution, tuple(COURSE_PRESETS),
+                                                             "course_distribution")]
         self.course_distribution = args.coerce(CourseDistribution, course_distribution, "course_distribution")
         super().__init__(render_mode, **shared)
 
