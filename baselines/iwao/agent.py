@@ -44,9 +44,9 @@ _FIXATION = _S["fixation"].start  # the eye's vergence distance (m): propriocept
 _LOG_FIX = tuple(math.log(x) for x in OculomotorParams().fixation_range_m)
 _GAIT_PHASE, _FOOTHOLDS, _TIME = _S["gait_phase"].start, _S["footholds"].start, _S["time"].start
 _SLOTS = tuple(_S[f"obstacle_{k}"].start for k in range(K_SLOTS))
-# With gaze_mode="footholds" the planner leaves out obstacles whose footprint std exceeds this (m): a far,
-# crowded glimpse (its keep-out zone grown by 2 std would close the walkway) is not yet a localised hazard;
-# the gaze fixates it before a foothold near it is chosen (modelling choice).
+# With gaze_mode="footholds" the planner sees an obstacle's footprint std capped at this (m): a far, crowded
+# glimpse (its keep-out zone grown by 2 std would close the walkway) keeps a zone of its estimate's size plus
+# 2 caps; the gaze fixates it before a foothold near it is chosen (modelling choice).
 FOOTHOLDS_PLAN_MAX_SD_M = 0.1
 NECK_PITCH_DOWN_DEG = 50.0  # the head action's -1 (envs_assets/common/head_eye.xml: neck_pitch -50 .. 40)
 
@@ -234,7 +234,9 @@ class IwaoAgent:
         u_last = footholds[-1][0]
         ahead = [o for o in self.memory.known() if o.x1 > footholds[0][0] - 0.3 and o.x0 < u_last + 6.0]
         if self.params.gaze_mode == "footholds":
-            ahead = [o for o in ahead if max(o.sx, o.sy) <= FOOTHOLDS_PLAN_MAX_SD_M]
+            cap = FOOTHOLDS_PLAN_MAX_SD_M
+            ahead = [o if max(o.sx, o.sy, o.sz) <= cap else replace(o, sx=min(o.sx, cap), sy=min(o.sy, cap), sz=min(o.sz, cap))
+                     for o in ahead]
         length, lateral, clearance = self.planner.plan(footholds, ahead)
         return WalkerBody.action_from_footstep(length, lateral, clearance, self.gait)
 

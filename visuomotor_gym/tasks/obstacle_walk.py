@@ -67,10 +67,11 @@ K_SLOTS = 4
 TOP_POINTS = ("near_left", "far_right", "near_mid", "far_mid")
 N_POINTS = len(TOP_POINTS)
 PASSED_M = 0.5  # an obstacle whose far edge is this far behind the pelvis leaves the slots (modelling choice)
-# On the rough course an obstacle leaves the slots as soon as its far edge is behind the pelvis (modelling
-# choice: hazards come every ~0.7 m, so the four slots must reach ahead of the next two footholds; an agent
-# keeps in its own memory what it saw of the hazards under its feet).
-ROUGH_PASSED_M = 0.0
+# On the rough course an obstacle leaves the slots once its far edge is less than 0.3 m ahead of the pelvis
+# (modelling choice: hazards come every ~0.7 m, so the four slots must reach beyond the next two footholds,
+# ~1.3-2 m ahead; the hazard under the feet is behind the leading foot by then, and an agent keeps in its
+# own memory what it saw of it).
+ROUGH_PASSED_M = -0.3
 KINDS = ("bar", "box", "mat")
 BAR, BOX, MAT = 0, 1, 2
 REWARD_TERMS = ("finish", "trip", "misstep", "off_path", "progress")
