@@ -8,6 +8,11 @@ laid over the walk family's. Both are applied by overriding the registered id's 
 
     OPENBLAS_CORETYPE=Haswell MUJOCO_GL=egl nice -n 10 .venv/bin/python docs/reproductions/scripts/rough_walk.py \\
         --episodes 40 --out docs/reproductions/data/terrain/obstacle_walk_rough.json
+
+``--bench CONDITION --static-twin SPEC`` runs ``vmgym bench --gaze-gain`` (the common evaluator: the
+baseline, its held twin and that static twin on the same seeds, the realism score) under the condition,
+writing its results JSON to ``--out`` (the results record the id's name only: the condition is in this
+script's summary, ``--table``).
 """
 
 from __future__ import annotations
@@ -80,8 +85,22 @@ def main(argv=None) -> int:
     ap.add_argument("--episodes", type=int, default=40)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out", required=True)
+    ap.add_argument("--bench", default=None, metavar="CONDITION", help="run vmgym bench --gaze-gain under it")
+    ap.add_argument("--agent", default="iwao", help="with --bench: the agent")
+    ap.add_argument("--static-twin", default=None, help="with --bench: the static twin's spec (its posture)")
     args = ap.parse_args(argv)
     _setup()
+    if args.bench:
+        from visuomotor_gym.cli import main as vmgym
+        from visuomotor_gym.static_gaze import registered_kwargs
+
+        course, vision = CONDITIONS[args.bench]
+        argv = ["bench", "--agent", args.agent, "--env", ENV_ID, "--episodes", str(args.episodes), "--seed",
+                str(args.seed), "--out", args.out, "--gaze-gain", "--no-progress", "--force"]
+        if args.static_twin:
+            argv += ["--static-twin", args.static_twin]
+        with registered_kwargs(ENV_ID, env_kwargs(course, vision)):
+            return vmgym(argv)
     out = Path(args.out)
     record = json.loads(out.read_text()) if out.exists() else {"cells": []}
     record.update(description=__doc__.splitlines()[0], env_id=ENV_ID, command=" ".join(sys.argv))
