@@ -154,6 +154,12 @@ class ObstacleWalkEnv(WalkerEnv):
     padded with NaN rows to the scene's 16 obstacles, of which the first ``n_obstacles`` are the
     course's (a fixed shape, so that ``gymnasium.make_vec`` can stack it).
 
+    **The rough course** (opt-in, ``course_distribution="rough"``; ``ROUGH_COURSE`` in
+    ``visuomotor_gym.tasks.obstacle_walk``): 12-14 m with up to 16 small patches and rocks (15-35 cm,
+    about one per step, anywhere across the walkway), so that nearly every foothold must be chosen. On it
+    an obstacle is sampled only within 5 m of the pelvis, and a slot's id is a label given in the order
+    the eye first saw the obstacle (an obstacle never seen takes no slot; an empty slot reads id -1).
+
     ## Arguments
 
     ARGUMENTS_TABLE
@@ -161,7 +167,8 @@ class ObstacleWalkEnv(WalkerEnv):
     ## Version History
 
     * v0: initial release (issue 12); redefined before release: the 1.5 m walkway (off path ends the
-      episode), bars across it, four seen points per obstacle.
+      episode), bars across it, four seen points per obstacle. Opt-in ``course_distribution="rough"``
+      (issue 23, prototype): the default course and its observations unchanged.
     """
 
     render_cameras = {

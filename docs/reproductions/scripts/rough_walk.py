@@ -79,8 +79,10 @@ def play(spec: str, kwargs: dict, seeds: list[int]) -> tuple[list[int], dict]:
 
 
 def main(argv=None) -> int:
+    global ENV_ID
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--conditions", default=None, help="comma-separated condition names")
+    ap.add_argument("--env", default="ObstacleWalk-v0", help="the rung (an ObstacleWalk id)")
+    ap.add_argument("--conditions", default=None, help="semicolon-separated condition names")
     ap.add_argument("--agents", default="iwao,gaze_blind:iwao", help="comma-separated agent specs")
     ap.add_argument("--episodes", type=int, default=40)
     ap.add_argument("--seed", type=int, default=0)
@@ -89,6 +91,7 @@ def main(argv=None) -> int:
     ap.add_argument("--agent", default="iwao", help="with --bench: the agent")
     ap.add_argument("--static-twin", default=None, help="with --bench: the static twin's spec (its posture)")
     args = ap.parse_args(argv)
+    ENV_ID = args.env
     _setup()
     if args.bench:
         from visuomotor_gym.cli import main as vmgym
@@ -103,21 +106,25 @@ def main(argv=None) -> int:
             return vmgym(argv)
     out = Path(args.out)
     record = json.loads(out.read_text()) if out.exists() else {"cells": []}
-    record.update(description=__doc__.splitlines()[0], env_id=ENV_ID, command=" ".join(sys.argv))
-    names = args.conditions.split(",") if args.conditions else list(CONDITIONS)
+    record.update(description=__doc__.splitlines()[0])
+    record.setdefault("commands", [])
+    if " ".join(sys.argv) not in record["commands"]:
+        record["commands"].append(" ".join(sys.argv))
+    names = args.conditions.split(";") if args.conditions else list(CONDITIONS)
     seeds = list(range(args.seed, args.seed + args.episodes))
     for cond in names:
         course, vision = CONDITIONS[cond]
         for spec in args.agents.split(","):
             t0 = time.perf_counter()
             ok, why = play(spec, env_kwargs(course, vision), seeds)
-            cell = {"condition": cond, "course": course or "walkway", "vision_params": vision, "agent": spec,
+            cell = {"env_id": ENV_ID, "condition": cond, "course": course or "walkway", "vision_params": vision, "agent": spec,
                     "episodes": len(seeds), "seed": args.seed, "success": sum(ok), "rate": sum(ok) / len(ok),
                     "failures": why, "per_seed": ok, "seconds": round(time.perf_counter() - t0, 1)}
-            record["cells"] = [c for c in record["cells"] if (c["condition"], c["agent"]) != (cond, spec)] + [cell]
+            record["cells"] = [c for c in record["cells"]
+                               if (c.get("env_id", ENV_ID), c["condition"], c["agent"]) != (ENV_ID, cond, spec)] + [cell]
             out.parent.mkdir(parents=True, exist_ok=True)
             out.write_text(json.dumps(record, indent=1) + "\n")
-            print(f"{cond:<32} {spec:<40} {100 * cell['rate']:5.1f} %  {why}  {cell['seconds']} s", flush=True)
+            print(f"{ENV_ID:<26} {cond:<32} {spec:<40} {100 * cell['rate']:5.1f} %  {why}  {cell['seconds']} s", flush=True)
     return 0
 
 
