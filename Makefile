@@ -1,6 +1,6 @@
 # visuomotor_gym developer commands. Everything runs inside .venv, created on first use.
 #   make demo   set up, then run the main demo (writes outputs/demo/)
-#   make test   set up, then run the whole test suite
+#   make test   set up, then ruff (pyproject.toml [tool.ruff.lint]) and the whole test suite
 #   make bench  set up, then run the benchmarks in benchmarks/
 #   make leaderboard-check   set up, then run the leaderboard check CI runs (leaderboard/)
 #   make docs   set up, then generate the family pages and build the documentation site (mkdocs --strict)
@@ -44,6 +44,7 @@ demo: setup
 	$(VENV)/bin/vmgym demo
 
 test: setup
+	$(VENV)/bin/ruff check .
 	$(PY) -m pytest -n 2 --durations=15
 
 test-fast: setup

@@ -14,8 +14,8 @@ import math
 
 import numpy as np
 
-from visuomotor_gym.envs.actions import hand_action
 from visuomotor_gym.core.frames import SEAT_ORIGIN
+from visuomotor_gym.envs.actions import hand_action
 from visuomotor_gym.envs.observation import ObservationLayout
 from visuomotor_gym.scenarios.throws import GRAVITY
 

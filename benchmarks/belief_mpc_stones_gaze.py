@@ -67,7 +67,7 @@ def gaze_stats(traces) -> dict:
             per_stone.append(len(runs) / landed)
         durations += [(b - a) * tr.dt for a, b in runs]
     ahead = np.concatenate(ahead_all) if ahead_all else np.zeros(0, int)
-    dist = {int(k): round(float(np.mean(ahead == k)), 3) for k in range(0, 5)} if ahead.size else {}
+    dist = {int(k): round(float(np.mean(ahead == k)), 3) for k in range(5)} if ahead.size else {}
     return {
         "steps_ahead_median": float(np.median(ahead)) if ahead.size else float("nan"),
         "steps_ahead_mean": round(float(np.mean(ahead)), 3) if ahead.size else float("nan"),

@@ -28,7 +28,7 @@ import numpy as np
 
 import visuomotor_gym  # noqa: F401  (registers the ids)
 from visuomotor_gym import _native
-from visuomotor_gym.bench.provenance import provenance, report_benchmark  # noqa: E402
+from visuomotor_gym.bench.provenance import provenance, report_benchmark
 
 
 def env_run(env_id: str, actions: np.ndarray, seed: int, record: bool, compiled: bool = True):

@@ -1,5 +1,5 @@
-"""Periphery sweep: what each opt-in mechanism of human peripheral vision (issue 23;
-``visuomotor_gym.vision.periphery``) does to an agent and its gaze-blind twin.
+"""Periphery sweep: what each opt-in mechanism of human peripheral vision
+(``visuomotor_gym.vision.periphery``) does to an agent and its gaze-blind twin.
 
 Each configuration is a set of ``VisionParams`` fields laid over the env's own (for ObstacleWalk-v0:
 the 20 deg field of the walk family); every agent plays the same pinned courses (episode ``i`` resets
@@ -28,7 +28,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
-from gaze_gain_sweep import _use_checkout_baselines, wilson
+from gaze_gain_sweep import _use_checkout_baselines, wilson  # noqa: E402 (after the sys.path line)
 
 # name -> VisionParams fields over the env's defaults. Values: E2_pos 0.7 deg (middle of the 0.6-0.8 deg
 # often quoted for position tasks, unconfirmed), Bouma b = 0.5, a 10-arcmin disparity pedestal doubling

@@ -1,4 +1,5 @@
-"""Record the episode traces the realism table is measured on (issue 21, "Realism that measures strategy").
+"""Record the episode traces the realism table is measured on (realism version 2,
+docs/gaze_gain.md "Realism a still eye cannot pass").
 
 For one env id and one agent spec, plays pinned seeds ``0..N-1`` and saves the traces with
 :func:`visuomotor_gym.bench.trace.save_traces`. The agent is an ordinary spec (``iwao``,

@@ -6,7 +6,7 @@ contact checks near obstacles, the watched substeps of ``LegContacts.step_physic
 nothing trips); episodes restart at the end of the course. Each control step calls ``set_next_footstep``, ``advance`` and ``step_physics``. The
 reference restores each recorded physics state (``mj_setState``) and calls ``mj_step`` with the same
 substeps, as ``benchmarks/env_throughput.py`` does for the envs (which also times the pure-Python path
-when the compiled kernels are built). Issue 12 wants ObstacleWalk-v0 at
+when the compiled kernels are built). The target for ObstacleWalk-v0 is
 >= 0.5 of raw physics; this is the body's share of that budget. Best of ``--repeats`` interleaved runs.
 
 The same run measures the whole env, ``ObstacleWalk-v0`` (``env.step``: gait, contact checks, eye,

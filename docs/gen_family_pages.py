@@ -9,7 +9,8 @@ Everything on a page comes from the code and the data, never typed by hand:
   table is itself generated from the layout --, rewards, starting state, episode end, arguments,
   version history);
 * the current leaderboard entries on the family's ids (``leaderboard/``), with gaze gains;
-* a picture, where one exists under ``docs/``.
+* the linked pages and a picture, where one exists under ``docs/``: the family record's
+  ``doc_links`` and ``doc_pictures`` (:class:`visuomotor_gym.family.Family`).
 
     python docs/gen_family_pages.py           # write the pages
     python docs/gen_family_pages.py --check   # exit 1 if a committed page differs (tests/test_docs.py)
@@ -30,48 +31,12 @@ DOCS = ROOT / "docs"
 OUT = DOCS / "families"
 LEADERBOARD = ROOT / "leaderboard"
 
-# family -> (page title, foveated id, reproduction pages (title, path relative to docs/), pictures:
-# candidate images relative to docs/, the first that exists is shown, with its caption)
-FAMILIES = {
-    "catch": (
-        "Catch: EyeCatch",
-        "EyeCatch-v0",
-        [("Eyecatch (Yeo et al. 2012)", "reproductions/eyecatch.md"),
-         ("Eom et al. 2019: belief MPC, two balls", "reproductions/eom.md"),
-         ("The default vision: moving-target localisation", "reproductions/gaze_default.md"),
-         ("PPO baselines", "baselines/ppo.md")],
-        [("images/eyecatch_record_frame.png",
-          "The Eyecatch agent catching: scene camera (the green line is its line of sight) beside its eye camera")],
-    ),
-    "reach": (
-        "Reach: ShelfReach",
-        "ShelfReach-v0",
-        [("Faraway et al. 2007: reaches as Bézier curves", "reproductions/faraway.md")],
-        [("images/shelfreach_record_frame.png", "The faraway agent reaching to a shelf target"),
-         ("reproductions/images/faraway_reach_paths.png", "Hand paths of the faraway agent to the shelf targets")],
-    ),
-    "walk": (
-        "Walk: ObstacleWalk",
-        "ObstacleWalk-v0",
-        [("Iwao et al.: gaze while walking over obstacles", "reproductions/iwao.md"),
-         ("PPO baselines (the walk recipe)", "baselines/ppo.md")],
-        [("images/obstaclewalk_iwao_seed0_frame.png",
-          "The iwao agent on ObstacleWalk-v0: side view with the line of sight, and its eye camera")],
-    ),
-    "stones": (
-        "Stones: SteppingStones",
-        "SteppingStones-v0",
-        [("Stepping stones (Eom et al. 2019, section 7; Patla & Vickers 2003)", "reproductions/stones.md")],
-        [("images/steppingstones_record_frame.png", "The lookahead agent on SteppingStones-v0"),
-         ("reproductions/images/stones_turning.png", "The lookahead agent turning through a 60 deg course")],
-    ),
-    "dodge": (
-        "Dodge: ObstacleDodge",
-        "ObstacleDodge-v0",
-        [("Dodging pedestrians (Fajen & Warren 2003; Eom et al. 2019, section 7)", "reproductions/dodge.md")],
-        [("images/obstacledodge_record_frame.png", "The fajen_warren agent among the pedestrians")],
-    ),
-}
+
+def page_facts(record) -> tuple[str, str, tuple, tuple]:
+    """A family's page title, foveated id, linked pages (title, path relative to docs/) and candidate
+    pictures (path relative to docs/, caption; the first that exists is shown), from its record."""
+    return (f"{record.name.capitalize()}: {record.prefix}", f"{record.prefix}-v0", record.doc_links,
+            record.doc_pictures)
 
 
 def _env_class(entry_point: str):
@@ -162,9 +127,10 @@ def _dedent(doc: str) -> str:
 def family_page(family: str) -> str:
     """The Markdown of one family's page."""
     import visuomotor_gym  # noqa: F401  (registers the ids)
+    from visuomotor_gym.families import family as family_record
     from visuomotor_gym.registration import ENV_SPECS
 
-    title, main_id, pages, pictures = FAMILIES[family]
+    title, main_id, pages, pictures = page_facts(family_record(family))
     specs = [s for s in ENV_SPECS if s.family == family]
     cls = _env_class(specs[0].entry_point)
     doc = _dedent(cls.__doc__ or "")
@@ -235,19 +201,15 @@ def family_page(family: str) -> str:
 
 
 def pages() -> dict[Path, str]:
-    return {OUT / f"{family}.md": family_page(family) for family in FAMILIES}
+    from visuomotor_gym.families import families
+
+    return {OUT / f"{record.name}.md": family_page(record.name) for record in families()}
 
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--check", action="store_true", help="exit 1 if a committed page is stale; write nothing")
     args = parser.parse_args(argv)
-    from visuomotor_gym.registration import FAMILIES as REGISTERED
-
-    missing = sorted(set(REGISTERED) - set(FAMILIES))
-    if missing:
-        print(f"families without a page entry in docs/gen_family_pages.py: {missing}", file=sys.stderr)
-        return 1
     stale = []
     for path, text in pages().items():
         current = path.read_text(encoding="utf-8") if path.is_file() else None

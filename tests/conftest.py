@@ -35,10 +35,10 @@ def spawn_rollout(env_id: str, seed: int, actions: list[list[float]]) -> dict:
     import numpy as np
 
     env = gym.make(env_id)
-    obs, info = env.reset(seed=seed)
+    obs, _info = env.reset(seed=seed)
     observations = [np.asarray(obs).tolist()]
     for action in actions:
-        obs, reward, terminated, truncated, info = env.step(np.asarray(action, dtype=np.float32))
+        obs, _reward, terminated, truncated, _info = env.step(np.asarray(action, dtype=np.float32))
         observations.append(np.asarray(obs).tolist())
         if terminated or truncated:
             break

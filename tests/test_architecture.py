@@ -123,8 +123,6 @@ DEFERRED_EDGES = {
         "the agent registry's factory of the static_gaze: wrapper, which is built on agents (make_agent)",
     ("visuomotor_gym.static_gaze", "visuomotor_gym.bench.evaluate"):
         "the posture search plays postures with the evaluator, which resolves static_gaze: specs",
-    ("visuomotor_gym.viz.plots", "visuomotor_gym.viz.family_plots"):
-        "the figure dispatcher hands non-catch traces to the family figures, drawn with plots' helpers",
     ("visuomotor_gym.leaderboard.check", "visuomotor_gym.leaderboard.pages"):
         "check's last rule compares the committed pages with a fresh build, and the pages name check's prefixes",
 }
@@ -196,14 +194,8 @@ def test_the_layer_table_is_not_vacuous():
 # Modules that belong to one family (named for it): they may name their own family. Every other module
 # of the package is shared and may not.
 FAMILY_LAYERS = ("visuomotor_gym.envs.", "visuomotor_gym.tasks.", "visuomotor_gym.body.")
-# Shared modules that still hold a family table, outside the refactor that built the records: the plot,
-# video and figure dispatch of viz/ (a Family field each: figure, video camera and stride, plot summary).
-FAMILY_TABLE_DEBT = {
-    "visuomotor_gym.viz.commands": "the figure description per family",
-    "visuomotor_gym.viz.plots": "the trace field that tells a trace's family, the catch-only panels",
-    "visuomotor_gym.viz.family_plots": "FIGURES, the figure function per family",
-    "visuomotor_gym.viz.video": "the frame stride and camera per family",
-}
+# Shared code outside the package that must read the records too (the family pages' generator).
+SHARED_SCRIPTS = (PACKAGE.parent / "docs" / "gen_family_pages.py",)
 
 
 def _is_family_module(module: str, names: set[str]) -> bool:
@@ -230,17 +222,10 @@ def _family_literals(path: Path, names: set[str]) -> list[int]:
 
 def test_no_shared_module_names_a_family():
     names = {f.name for f in families()}
-    found, cleared = [], []
-    for module, path in modules():
-        if _is_family_module(module, names):
-            continue
-        lines = _family_literals(path, names)
-        if lines and module not in FAMILY_TABLE_DEBT:
-            found.append(f"{module} lines {lines}")
-        if not lines and module in FAMILY_TABLE_DEBT:
-            cleared.append(module)
+    shared = [(module, path) for module, path in modules() if not _is_family_module(module, names)]
+    shared += [(path.relative_to(PACKAGE.parent).as_posix(), path) for path in SHARED_SCRIPTS]
+    found = [f"{module} lines {lines}" for module, path in shared if (lines := _family_literals(path, names))]
     assert not found, ("a shared module names a family (read its Family record instead):\n" + "\n".join(found))
-    assert not cleared, f"no family table left in {cleared}: remove them from FAMILY_TABLE_DEBT"
 
 
 def test_the_family_name_check_can_fail(tmp_path):
@@ -289,7 +274,7 @@ def test_the_records_register_exactly_the_ids_of_before():
     got = tuple((s.id, s.entry_point.removeprefix("visuomotor_gym.envs."), s.kwargs, s.max_episode_steps, s.family)
                 for s in registration.ENV_SPECS)
     assert got == REGISTERED_BEFORE_THE_RECORDS
-    assert registration.ENV_IDS == tuple(row[0] for row in REGISTERED_BEFORE_THE_RECORDS)
+    assert tuple(row[0] for row in REGISTERED_BEFORE_THE_RECORDS) == registration.ENV_IDS
     for env_id, entry_point, kwargs, steps, _ in REGISTERED_BEFORE_THE_RECORDS:
         spec = gym.spec(env_id)
         assert (spec.entry_point, spec.kwargs, spec.max_episode_steps) == (
@@ -310,7 +295,7 @@ def test_the_old_public_names_are_derived_from_the_records():
     with pytest.raises(ValueError, match="unknown family 'swim'; known families: catch, walk"):
         family("swim")
     assert registration.POOR_VISION_SCALE == 2.0 and registration.VISUAL_DELAY_S == 0.1
-    assert registration.PAPER_VISION == {"position_slip_knee_deg_s": math.inf}
+    assert {"position_slip_knee_deg_s": math.inf} == registration.PAPER_VISION
 
 
 def test_each_record_is_declared_at_the_end_of_its_env_module():
@@ -387,11 +372,11 @@ def test_a_bad_record_names_its_field(changes, error, match):
 
 
 def test_bad_extra_env_and_belief_mpc_specs_name_their_field():
-    with pytest.raises(ValueError, match="ExtraEnv.id must be an id like"):
+    with pytest.raises(ValueError, match=r"ExtraEnv\.id must be an id like"):
         ExtraEnv("bounce", {}, "x")
     with pytest.raises(ValueError, match=r"ExtraEnv.max_episode_steps of A-v0 must be a positive int or None"):
         ExtraEnv("A-v0", {}, "x", max_episode_steps=-1)
-    with pytest.raises(ValueError, match="BeliefMPC.params must be a 'visuomotor_gym.module:attribute'"):
+    with pytest.raises(ValueError, match=r"BeliefMPC\.params must be a 'visuomotor_gym\.module:attribute'"):
         BeliefMPC("visuomotor_gym.baselines.belief_mpc:BeliefMPCAgent", "BeliefMPCParams")
 
 

@@ -112,8 +112,8 @@ def test_out_of_range_finite_actions_are_clipped(scale):
     env_big.reset(seed=2)
     env_clip.reset(seed=2)
     for _ in range(10):
-        obs_big, r_big, term_big, _, info_big = env_big.step(big)  # float64, out of range: no error
-        obs_clip, r_clip, term_clip, _, info_clip = env_clip.step(np.sign(base).astype(np.float32))
+        obs_big, _r_big, term_big, _, _info_big = env_big.step(big)  # float64, out of range: no error
+        obs_clip, _r_clip, term_clip, _, _info_clip = env_clip.step(np.sign(base).astype(np.float32))
         np.testing.assert_array_equal(obs_big, obs_clip)
         assert term_big == term_clip
         if term_big:
@@ -246,7 +246,7 @@ def test_reset_with_empty_or_no_options_is_fine(env):
 
 
 # ----------------------------------------------------------------------------------------------
-# constructor arguments that used to be accepted but wrong (issue 16): each refused at construction,
+# constructor arguments that used to be accepted but wrong: each refused at construction,
 # with the argument's name in the message
 # ----------------------------------------------------------------------------------------------
 @pytest.mark.parametrize(

@@ -7,9 +7,6 @@ import math
 import numpy as np
 import pytest
 import scipy.linalg
-
-import visuomotor_gym  # noqa: F401
-from visuomotor_gym.agents import make_agent
 from visuomotor_gym.baselines.belief_mpc import BeliefMPCAgent, BeliefMPCParams, ilqr
 from visuomotor_gym.baselines.belief_mpc.belief import (
     ObservationNoise,
@@ -22,6 +19,9 @@ from visuomotor_gym.baselines.belief_mpc.belief import (
 from visuomotor_gym.baselines.belief_mpc.model import GazeBeliefProblem, HandProblem, Limits
 from visuomotor_gym.baselines.belief_mpc.sequential import SequentialEyecatch
 from visuomotor_gym.baselines.eyecatch import EyecatchAgent
+
+import visuomotor_gym  # noqa: F401
+from visuomotor_gym.agents import make_agent
 from visuomotor_gym.bench.evaluate import evaluate, make_env
 from visuomotor_gym.registration import POOR_VISION_SCALE
 from visuomotor_gym.vision.foveation import DEG, VisionParams
@@ -194,7 +194,7 @@ def test_belief_jacobians_match_finite_differences(offset_deg):
     np.testing.assert_allclose(d_gaze, fd_gaze, rtol=1e-5, atol=1e-9)
     np.testing.assert_allclose(d_mu, fd_mu, rtol=1e-5, atol=1e-5 * np.abs(fd_mu).max())
     # and the observation noise's own gradients
-    r, dr_dg, dr_dp = observation_variance(NOISE, az, el, mu[:3], EYE, with_grad=True)
+    _r, dr_dg, dr_dp = observation_variance(NOISE, az, el, mu[:3], EYE, with_grad=True)
     np.testing.assert_allclose(dr_dg, _fd(lambda g: observation_variance(NOISE, g[0], g[1], mu[:3], EYE),
                                           np.array([az, el])), rtol=1e-5, atol=1e-12)
     np.testing.assert_allclose(dr_dp, _fd(lambda p: observation_variance(NOISE, az, el, p, EYE), mu[:3]),
@@ -203,7 +203,7 @@ def test_belief_jacobians_match_finite_differences(offset_deg):
 
 @pytest.mark.parametrize("slip_deg_s", [0.0, 2.0, 40.0, 200.0])
 def test_slip_term_matches_the_env_and_its_gradients_match_finite_differences(slip_deg_s):
-    """The planner's r with retinal slip (issue 11): the mean of the env's three positional variances
+    """The planner's r with retinal slip: the mean of the env's three positional variances
     with the lateral ones scaled by 1 + slip^2/knee^2 (the env's max(1, slip/knee)^2 far above the
     knee); closed-form gradients against finite differences, slip included."""
     from visuomotor_gym.vision import foveation
@@ -276,8 +276,8 @@ def test_planner_dynamics_and_cost_derivatives_match_finite_differences(gaze_cos
     prob, X, U = _gaze_problem(gaze_cost, active)
     A, B = prob.dynamics_jacobians(X, U)
     for i in range(prob.N):
-        fd_A = _fd(lambda x: prob.step(x[None], U[i][None], i)[0], X[i])
-        fd_B = _fd(lambda u: prob.step(X[i][None], u[None], i)[0], U[i])
+        fd_A = _fd(lambda x, i=i: prob.step(x[None], U[i][None], i)[0], X[i])
+        fd_B = _fd(lambda u, i=i: prob.step(X[i][None], u[None], i)[0], U[i])
         np.testing.assert_allclose(A[i], fd_A, rtol=1e-6, atol=1e-8, err_msg=f"A at node {i}")
         np.testing.assert_allclose(B[i], fd_B, rtol=1e-6, atol=1e-8, err_msg=f"B at node {i}")
     lx, lu, lxx, luu, lux = prob.cost_derivatives(X, U)
@@ -315,7 +315,7 @@ def test_hand_problem_closed_form_is_the_ilqr_optimum():
     hp.configure(ready=np.array([0.44, -0.22, 0.75]), target=np.array([0.32, -0.3, 1.05]),
                  w_task=np.r_[np.full(6, 0.1), np.full(13, 10.0)])
     x0 = np.array([0.44, -0.22, 0.75])
-    X, U = hp.solve_lq(x0)
+    X, _U = hp.solve_lq(x0)
     res = ilqr.solve(hp, x0, np.zeros((18, 3)), iterations=4, reg=0.0, reg_min=0.0)
     np.testing.assert_allclose(X, res.X, atol=1e-8)
     assert np.linalg.norm(X[-1] - hp.target) < 0.02  # the proactive phase brings the hand to the task point
@@ -406,7 +406,7 @@ def test_agent_tracks_both_balls_in_the_two_ball_env():
 
 
 def test_gaze_is_executed_through_the_human_plant():
-    """Issue 11: gaze held for the human first-saccade latency, then the plan's chosen ball is pursued
+    """Gaze held for the human first-saccade latency, then the plan's chosen ball is pursued
     through the plant, with catch-up saccades landing on it (the ball near the fovea most of the time),
     and the throw is caught."""
     env = make_env("EyeCatch-v0")
@@ -426,7 +426,7 @@ def test_gaze_is_executed_through_the_human_plant():
         if prev_sacc and not info["in_saccade"]:
             landed.append(e)
         prev_sacc = bool(info["in_saccade"])
-        if 0.25 <= info["time"] and np.linalg.norm(rel) > 1.0:  # before the hand's reach
+        if info["time"] >= 0.25 and np.linalg.norm(rel) > 1.0:  # before the hand's reach
             ecc.append(e)
     assert info["is_success"]
     assert onsets and onsets[0] >= 0.18 - 1e-9  # human saccadic latency

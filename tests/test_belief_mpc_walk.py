@@ -1,4 +1,4 @@
-"""belief_mpc on SteppingStones-v0 (issue 13): Eom's static-object belief, the gaze plan, a real episode."""
+"""belief_mpc on SteppingStones-v0: Eom's static-object belief, the gaze plan, a real episode."""
 
 from __future__ import annotations
 
@@ -7,12 +7,17 @@ import math
 import gymnasium as gym
 import numpy as np
 import pytest
+from visuomotor_gym.baselines.belief_mpc.belief import covariance_step
+from visuomotor_gym.baselines.belief_mpc.stone_belief import (
+    plan_gaze,
+    plane_variance,
+    schedules,
+    static_sigma_step,
+)
+from visuomotor_gym.baselines.belief_mpc.stones import StonesBeliefMPCAgent, StonesBeliefMPCParams
 
 import visuomotor_gym  # noqa: F401
 from visuomotor_gym.agents import make_agent
-from visuomotor_gym.baselines.belief_mpc.belief import covariance_step
-from visuomotor_gym.baselines.belief_mpc.stone_belief import plan_gaze, plane_variance, schedules, static_sigma_step
-from visuomotor_gym.baselines.belief_mpc.stones import StonesBeliefMPCAgent, StonesBeliefMPCParams
 from visuomotor_gym.vision.foveation import DEG, VisionParams
 
 ENV = "SteppingStones-v0"
@@ -185,7 +190,7 @@ def test_dodge_dispatch_and_a_short_episode():
     for _ in range(120):
         a, _ = agent.predict(obs)
         assert np.all(np.isfinite(a)) and np.all(np.abs(a) <= 1.0)
-        obs, _, term, trunc, info = env.step(a)
+        obs, _, term, trunc, _info = env.step(a)
         if term or trunc:
             break
     env.close()

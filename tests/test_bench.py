@@ -14,7 +14,7 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-import visuomotor_gym  # noqa: F401  (registers the ids)
+import visuomotor_gym  # registers the ids
 from visuomotor_gym import agents
 from visuomotor_gym.bench import commands
 from visuomotor_gym.bench.evaluate import EvalResult, episode_chunks, episode_seeds, evaluate

@@ -10,9 +10,9 @@ from __future__ import annotations
 import gymnasium as gym
 import numpy as np
 import pytest
+from visuomotor_gym.baselines.oracle import InterceptOracle
 
 import visuomotor_gym  # noqa: F401  (registers the ids)
-from visuomotor_gym.baselines.oracle import InterceptOracle
 from visuomotor_gym.body.seated import HAND_WORKSPACE
 from visuomotor_gym.core.frames import SEAT_ORIGIN
 

@@ -119,7 +119,7 @@ def test_bad_input_gives_one_line_and_status_2_before_any_episode(case, tmp_path
     assert not list((tmp_path / "lb" / "results").iterdir())
 
 
-# ------------------------------------ issue 24: every refusal one line and status 2, before any work or allocation
+# ------------------------------------ every refusal one line and status 2, before any work or allocation
 
 PPO_CATCH_NPZ = "leaderboard/agents/ppo-intercept-v2__EyeCatch-v0.npz"
 

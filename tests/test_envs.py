@@ -178,7 +178,7 @@ def test_mutating_returned_observation_does_not_change_env(obs_mode, steps_befor
     env.data.qvel[:] = 1e12
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        fallback, reward, terminated, truncated, info = env.step(zero)
+        fallback, _reward, terminated, _truncated, info = env.step(zero)
     assert info["physics_diverged"] and terminated  # precondition (tested on its own below)
     assert data_equivalence(fallback, expected, exact=True), "the caller's edit leaked into the env"
 

@@ -4,11 +4,11 @@ import gymnasium as gym
 import numpy as np
 import pytest
 from filterpy.kalman import KalmanFilter
+from visuomotor_gym.baselines.eyecatch import BallKalmanFilter, EyecatchAgent, EyecatchParams, KalmanParams
+from visuomotor_gym.baselines.eyecatch.agent import _Superposition
 
 import visuomotor_gym  # noqa: F401
 from visuomotor_gym.agents import make_agent
-from visuomotor_gym.baselines.eyecatch import BallKalmanFilter, EyecatchAgent, EyecatchParams, KalmanParams
-from visuomotor_gym.baselines.eyecatch.agent import _Superposition
 from visuomotor_gym.bench.trace import run_episode
 from visuomotor_gym.registration import POOR_VISION_SCALE
 from visuomotor_gym.vision import foveation
@@ -204,6 +204,7 @@ def test_head_law_on_the_total_angle(gaze_deg, expect_deg):
     destination and the eye's gaze destination, about their common axis (a 25/25 deg shift moves the
     head ~15 deg, not the ~7 deg per axis of a per-axis dead zone)."""
     from visuomotor_gym.baselines.eyecatch.agent import head_law
+
     from visuomotor_gym.oculomotor.plant import direction_from_angles
 
     deg = np.pi / 180

@@ -20,7 +20,7 @@ def to_action(point_world):
 def test_hand_reaches_targets_in_the_catch_region(target):
     env = gym.make("EyeCatchOracle-v0").unwrapped
     env.reset(seed=0)
-    env.throw_distribution  # the ball flies away; we only look at the hand
+    # the ball flies away; we only look at the hand
     action = np.zeros(9, dtype=np.float32)
     action[:3] = to_action(target)
     speeds, pos = [], None

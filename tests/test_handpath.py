@@ -1,9 +1,9 @@
-"""Tests of visuomotor_gym.handpath against independent oracles and seed 002's printed numbers.
+"""Tests of visuomotor_gym.handpath against independent oracles and Faraway et al.'s (2007) printed numbers.
 
 Oracles: ``scipy.interpolate.BPoly`` (an independent Bernstein-polynomial evaluator), a generic
 nonlinear least-squares solver (``scipy.optimize.least_squares``) for the fit, ``scipy.stats.beta`` for the
 timing profiles, hand-computed control points for Faraway's model, and the centimetre offsets that
-seed 002 (Faraway, Reed & Wang 2007, Sec. 4) prints for its median 56.7 cm reach.
+Faraway, Reed & Wang (2007, Sec. 4) print for its median 56.7 cm reach.
 """
 
 from __future__ import annotations
@@ -54,7 +54,7 @@ def test_degree_elevation_keeps_the_curve():
 
 
 # ---------------------------------------------------------------------------------------------------
-# fitting (seed 002 Sec. 3.2)
+# fitting (Faraway et al. 2007, Sec. 3.2)
 # ---------------------------------------------------------------------------------------------------
 @pytest.mark.parametrize("degree", [1, 2, 3, 4, 5])
 def test_fit_recovers_known_control_points_given_their_parameters(degree):
@@ -90,8 +90,9 @@ def test_a_path_that_rests_at_its_end_still_fits():
 
 @pytest.mark.parametrize("degree", [2, 3, 4])
 def test_fit_is_the_least_squares_minimiser(degree):
-    # Oracle: a generic nonlinear least-squares solver on SS = sum_i |Z_i - C(s_i)|^2 (seed 002 Sec. 3.2),
-    # with the curve evaluated by scipy's BPoly and the end control points pinned to the data's ends.
+    # Oracle: a generic nonlinear least-squares solver on SS = sum_i |Z_i - C(s_i)|^2 (Faraway et al. 2007,
+    # Sec. 3.2), with the curve evaluated by scipy's BPoly and the end control points pinned to the
+    # data's ends.
     rng = np.random.default_rng(RNG_SEED + degree)
     z = np.cumsum(rng.normal(size=(40, 3)), axis=0)
     s = H.arc_length_parameter(z)
@@ -105,7 +106,7 @@ def test_fit_is_the_least_squares_minimiser(degree):
     np.testing.assert_allclose(p[0], z[0])
     np.testing.assert_allclose(p[-1], z[-1])
     np.testing.assert_allclose(p[1:-1].ravel(), oracle.x, atol=1e-6)  # path scale ~1-5 units
-    # seed 002's normal equations B^T B P = B^T Y hold at the solution
+    # Faraway et al.'s normal equations B^T B P = B^T Y hold at the solution
     basis = H.bernstein(degree, s[1:-1])
     y = z[1:-1] - np.outer(basis[:, 0], z[0]) - np.outer(basis[:, -1], z[-1])
     b = basis[:, 1:-1]
@@ -140,7 +141,7 @@ def test_fit_is_robust_to_uneven_sampling():
         assert np.abs(f - fits["even"]).max() < 1.5e-3, k
         # and the fitted curve is the known curve's shape (spatially, within 2 mm)
         assert H.path_distance(H.bezier(f, dense), H.bezier(ctrl, dense), reduce="max") < 2e-3, k
-    # evenly spaced parameters (s_i = i / n, which seed 002 rejects) are not robust: centimetres apart
+    # evenly spaced parameters (s_i = i / n, which Faraway et al. reject) are not robust: centimetres apart
     even_s = np.linspace(0.0, 1.0, 50)
     fit_even_s = {k: H.fit_bezier(H.bezier(ctrl, u), s=even_s) for k, u in samplings.items()}
     assert np.abs(fit_even_s["front-loaded"] - fit_even_s["even"]).max() > 0.05
@@ -175,7 +176,7 @@ def test_beta_peak_time():
     peak = H.beta_peak_time(1.63, 1.75)
     assert peak == pytest.approx(numeric, abs=1e-5)
     assert peak == pytest.approx(0.63 / 1.38)
-    # seed 002 reports 0.48 (the median of per-curve peaks); the median-parameter mode is 0.457
+    # Faraway et al. report 0.48 (the median of per-curve peaks); the median-parameter mode is 0.457
     assert abs(peak - 0.48) < 0.03 and peak < 0.5
 
 
@@ -189,7 +190,7 @@ def test_minimum_jerk_progress_closed_form_is_the_beta33_cdf():
     t = np.linspace(0.0, 1.0, 101)
     np.testing.assert_allclose(H.minimum_jerk_progress(t), 10 * t**3 - 15 * t**4 + 6 * t**5, atol=1e-14)
     np.testing.assert_allclose(H.minimum_jerk_progress(t), stats.beta(3, 3).cdf(t), atol=1e-12)
-    # not Beta(2, 2), as seed 002 Sec. 4 says
+    # not Beta(2, 2), as Faraway et al. (2007, Sec. 4) say
     assert np.abs(stats.beta(2, 2).cdf(t) - H.minimum_jerk_progress(t)).max() > 0.05
 
 
@@ -210,12 +211,12 @@ def test_minimum_jerk_path_is_straight_with_bell_speed():
 
 
 # ---------------------------------------------------------------------------------------------------
-# Faraway's chosen model (seed 002 Sec. 4)
+# Faraway's chosen model (Faraway et al. 2007, Sec. 4)
 # ---------------------------------------------------------------------------------------------------
 def test_faraway_offsets_reproduce_the_papers_centimetres():
-    # Seed 002: "For the median reach distance of 56.7 cm, this gives offsets of (-1.4, -8.4, 4.3) cm
-    # and (-0.8, -7.9, -0.1) cm." The printed means have 3 decimals (+-0.0005 * 56.7 = 0.03 cm) and the
-    # cm values 1 decimal (+-0.05 cm), so agreement within 0.08 cm is all the print allows.
+    # Faraway et al. (2007): "For the median reach distance of 56.7 cm, this gives offsets of (-1.4, -8.4,
+    # 4.3) cm and (-0.8, -7.9, -0.1) cm." The printed means have 3 decimals (+-0.0005 * 56.7 = 0.03 cm) and
+    # the cm values 1 decimal (+-0.05 cm), so agreement within 0.08 cm is all the print allows.
     start = np.array([0.1, -0.2, 1.0])
     direction = np.array([0.6, -0.5, -0.2])
     end = start + 0.567 * direction / np.linalg.norm(direction)

@@ -663,7 +663,7 @@ def test_page_renders_in_a_headless_browser(tmp_path):
     # union of every family's components)
     components = {c for e in board.valid_entries if e.superseded is None for c in e.results["gaze_realism"]["components"]}
     assert probe["cells"] == n * (1 + len(components)) and probe["bars"] == n
-    # The page fits the viewport (issue 26): no element past its edges, no page-wide horizontal scroll,
+    # The page fits the viewport: no element past its edges, no page-wide horizontal scroll,
     # no plot label or legend entry clipped by its plot.
     assert probe["viewport"] == 1200
     assert probe["outside"] == [], probe["outside"][:10]
@@ -863,7 +863,7 @@ def test_belief_mpc_params_reject_a_malformed_tuple():
     obj = json.loads(fmt.export("belief_mpc", "ObstacleDodge-v0"))
     for bad in (["fast", 1.3], [True, 1.3], 1.3):
         obj["params"]["speeds"] = bad
-        with pytest.raises(ValueError, match="params.speeds"):
+        with pytest.raises(ValueError, match=r"params\.speeds"):
             fmt.load(json.dumps(obj).encode(), "ObstacleDodge-v0")
 
 

@@ -1,4 +1,4 @@
-"""The leaderboard against a deliberate attacker (issue 16): every attack a pull request can make is refused.
+"""The leaderboard against a deliberate attacker: every attack a pull request can make is refused.
 
 Each test builds a small leaderboard in a temporary git repository (two env ids of 6 episodes, with
 honest ``eyecatch`` and ``oracle`` entries committed on ``main``), applies one attack as a pull
@@ -7,8 +7,8 @@ request would (new files, edited files), and runs ``vmgym leaderboard check`` as
 submissions made in the tests stand in for a clean checkout by recording the temporary repository's
 own commit as their ``git_sha`` (``git_state`` is the only thing replaced, for the submitter).
 
-The first eleven attacks were accepted before issue 16; the rest were refused already and stay so.
-Tests 26-43 are the second round (issue 24): links, the ppo-npz budget and headers, Markdown
+The first eleven attacks were accepted by the first version of the check; the rest were refused already and
+stay so. Tests 26-43 are the second round: links, the ppo-npz budget and headers, Markdown
 injection, latency shown rather than ruled, names, provenance claims and new protocol rows.
 """
 
@@ -150,13 +150,13 @@ def test_the_base_and_an_honest_new_entry_pass(monkeypatch, pr):
     assert report.rescored_episodes == 3 * EPISODES + EPISODES  # existing: sample >= 6 seeds; new: all
 
 
-# ---------------------------------------------------------------- attacks accepted before issue 16
+# ---------------------------------------------------------------- attacks the first check accepted
 
 
 def test_01_fabricated_results_for_a_worse_agent(monkeypatch, pr):
     """The zero agent (0/6) claims 4 catches: records, counts, rates and intervals forged together."""
     key = honest_new_entry(monkeypatch, pr)
-    res_path, rec_path = paths(pr, key)
+    _res_path, rec_path = paths(pr, key)
     rec = read(rec_path)
     for ep in rec["episodes"][:4]:
         ep.update(caught=True, catch_time_s=1.0)
@@ -237,7 +237,7 @@ def test_07_09_fake_provenance(monkeypatch, pr, field, value, fragment):
 
 
 def test_10_fake_latency(monkeypatch, pr):
-    """Latency is self-reported and shown beside CI's own figure (issue 24: a pass/fail rule refused honest
+    """Latency is self-reported and shown beside CI's own figure (a pass/fail rule once refused honest
     entries on a loaded machine): a claim of 0.002 ms is kept, and the check reports what it measured."""
     key = honest_new_entry(monkeypatch, pr, agent="eyecatch", name="fast")
     edit_results(pr, key, lambda o: (o["latency_ms"].update(p50=0.001, p95=0.002, max=0.003),
@@ -455,11 +455,11 @@ def test_25_zip_bomb_and_foreign_members_in_a_policy_file():
     with zipfile.ZipFile(buf, "w") as zf:
         zf.writestr("policy.json", "{}")
         zf.writestr("run.py", "print(1)")
-    with pytest.raises(PolicyFileError, match="unexpected member 'run.py'"):
+    with pytest.raises(PolicyFileError, match=r"unexpected member 'run\.py'"):
         read_npz(buf.getvalue())
 
 
-# ---------------------------------------------------------------- second round (issue 24)
+# ---------------------------------------------------------------- second round
 
 
 def _commit_all(repo: Path, message: str) -> str:
@@ -574,7 +574,7 @@ def test_30_ppo_npz_network_budget():
     with pytest.raises(PolicyFileError, match="referenced more than once"):
         PPOAgent.from_npz(data, FOVEATED)  # ...refused before any layer is built
     rec["network"]["layers"] = [{"weight": "w", "bias": "b", "activation": "tanh"}]
-    with pytest.raises(PolicyFileError, match="4000000 allowed|FLOPs per action"):
+    with pytest.raises(PolicyFileError, match=r"4000000 allowed|FLOPs per action"):
         PPOAgent.from_npz(_write_npz(rec, {"w": np.zeros((1999, 2048), np.float32),
                                            "b": np.zeros(1999, np.float32)}), FOVEATED)
     many = {}

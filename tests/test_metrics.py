@@ -7,6 +7,7 @@ moved by chosen profiles (minimum-jerk submovements, Eyecatch Eq. 15-16).
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
 
@@ -123,16 +124,16 @@ def make_trace(
         success=caught and not diverged,
         diverged=diverged,
         truncated=False,
-        task=dict(
-            ball_pos=ball,
-            ball_vel=ball_vel,
-            hand_pos=np.tile([0.2, -0.25, 0.9], (n, 1)) if hand is None else np.asarray(hand, dtype=float),
-            ball_visible=~in_sacc,
-            missed=not caught and not diverged,
-            release_pos=RELEASE.copy(),
-            arrival_pos=ARRIVAL.copy(),
-            flight_time=FLIGHT,
-        ),
+        task={
+            "ball_pos": ball,
+            "ball_vel": ball_vel,
+            "hand_pos": np.tile([0.2, -0.25, 0.9], (n, 1)) if hand is None else np.asarray(hand, dtype=float),
+            "ball_visible": ~in_sacc,
+            "missed": not caught and not diverged,
+            "release_pos": RELEASE.copy(),
+            "arrival_pos": ARRIVAL.copy(),
+            "flight_time": FLIGHT,
+        },
     )
 
 
@@ -386,7 +387,7 @@ def test_score_is_one_inside_the_range_and_falls_outside(name):
     above = [M.score_component(name, high + d, ref) for d in (0.25 * tol, tol, 2 * tol, 4 * tol)]
     for scores in (below, above):
         assert all(0.0 <= s < 1.0 for s in scores)
-        assert all(a > b for a, b in zip(scores, scores[1:]))
+        assert all(a > b for a, b in itertools.pairwise(scores))
         assert scores[1] == pytest.approx(math.exp(-0.5))
         assert scores[-1] < 1e-3
     assert math.isnan(M.score_component(name, float("nan"), ref))

@@ -44,7 +44,7 @@ def test_every_rung_runs_from_the_registry_on_the_same_course(env_id):
     _, ref_info = ref.reset(seed=7)
     np.testing.assert_array_equal(info["obstacles"], ref_info["obstacles"])  # same course on every rung
     for _ in range(5):
-        obs, r, term, trunc, info = env.step(env.action_space.sample())
+        obs, _r, _term, _trunc, info = env.step(env.action_space.sample())
         assert env.observation_space.contains(obs) and np.isfinite(obs).all()
 
 
@@ -64,7 +64,7 @@ def _look_up(n):
 def _move_obstacles(env):
     """Change the true course after reset (other places, heights): what a leak would reveal."""
     task = env.task
-    for i, (x, y, depth, width, height, kind) in enumerate(task.course.obstacles.tolist()):
+    for i, (x, y, depth, width, height, _kind) in enumerate(task.course.obstacles.tolist()):
         x, height = x + 0.7, min(height + 0.1, 0.4)
         task.pool.place(env.model, env.data, i, x, y, depth, width, height)
         for t, point in zip(task.targets[N_POINTS * i: N_POINTS * (i + 1)], top_points(x, y, depth, width, height)):
@@ -143,7 +143,7 @@ def _walk_sideways(env, lateral):
     a[1] = lateral  # the lateral offset block: every step this far beside the nominal step width
     a[2] = 1.0  # high toe clearance
     for _ in range(1000):
-        obs, r, term, trunc, info = env.step(a)
+        _obs, r, term, trunc, info = env.step(a)
         if term or trunc:
             return r, term, info
     raise AssertionError("the episode did not end")
@@ -152,7 +152,7 @@ def _walk_sideways(env, lateral):
 def test_leaving_the_walkway_ends_the_episode_as_a_failure():
     env = ObstacleWalkEnv(course_distribution={"first_m": (8.0, 8.0)})  # nothing to trip on for 8 m
     env.reset(seed=0)
-    r, term, info = _walk_sideways(env, 1.0)
+    _r, term, info = _walk_sideways(env, 1.0)
     assert term and info["off_path"] and not info["is_success"] and not info["tripped"]
     assert info["reward_terms"]["off_path"] == -1.0
     feet_y = env.gait.feet_world(env.data)[:, 1]
@@ -163,7 +163,7 @@ def test_leaving_the_walkway_ends_the_episode_as_a_failure():
     a = np.zeros(8, np.float32)
     a[1], a[2] = 1.0, 1.0
     for _ in range(150):
-        *_, term, trunc, info = wide.step(a)
+        *_, term, _trunc, info = wide.step(a)
     assert not info["off_path"] and not term
 
 
@@ -183,7 +183,7 @@ def test_a_trip_ends_the_episode_and_scores_nothing():
     a = np.zeros(8, np.float32)
     a[0], a[2] = 0.1, -1.0  # 0.65 m steps, 2 cm clearance: walks into the first bar
     for _ in range(1000):
-        obs, r, term, trunc, info = env.step(a)
+        _obs, r, term, _trunc, info = env.step(a)
         if term:
             break
     assert info["tripped"] and term and not info["is_success"]

@@ -1,4 +1,4 @@
-"""Every field of every parameter dataclass the envs accept is checked at construction (issue 24, point 6).
+"""Every field of every parameter dataclass the envs accept is checked at construction.
 
 Each field is walked with NaN, +-inf, a negative (or, where the field's rule allows negatives, a value
 below its lower bound), a value above its upper bound, a wrong type and, for ranges, an inverted pair:
@@ -18,7 +18,7 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-import visuomotor_gym  # noqa: F401  (registers the ids)
+import visuomotor_gym  # registers the ids
 from visuomotor_gym.body.walker import GAIT_RULES, GaitParams
 from visuomotor_gym.control.hand import HAND_RULES, HandControlParams
 from visuomotor_gym.core.args import Choice, Flag, Int, Many, Num, Optional, Pair, Weights, field_rule

@@ -1,4 +1,4 @@
-"""Tests of the opt-in human peripheral vision (issue 23; visuomotor_gym.vision.periphery): the human
+"""Tests of the opt-in human peripheral vision (visuomotor_gym.vision.periphery): the human
 field of view, the position law, crowding and the depth law, each against a case computed by hand
 here, and their wiring into the retina of a real environment (pure-Python path when on, today's eye,
 compiled kernel included, when off).

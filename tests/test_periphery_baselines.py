@@ -1,4 +1,4 @@
-"""The walker baselines model the eye they see with, the human periphery included (issue 23).
+"""The walker baselines model the eye they see with, the human periphery included.
 
 iwao's obstacle memory and lookahead's stone memory weight every sample with the env's own
 ``VisionParams`` (``agents.match_vision``, called by ``make_agent``, reaches them); the belief-MPC
@@ -13,11 +13,11 @@ import math
 import gymnasium as gym
 import numpy as np
 import pytest
+from visuomotor_gym.baselines.belief_mpc.field import field_limit, field_limit_eye, position_e2_rad
+from visuomotor_gym.baselines.belief_mpc.stone_belief import plane_variance
 
 import visuomotor_gym  # noqa: F401
 from visuomotor_gym.agents import make_agent, match_vision
-from visuomotor_gym.baselines.belief_mpc.field import field_limit, field_limit_eye, position_e2_rad
-from visuomotor_gym.baselines.belief_mpc.stone_belief import plane_variance
 from visuomotor_gym.vision import periphery
 from visuomotor_gym.vision.foveation import ARCMIN, DEG, VisionParams
 

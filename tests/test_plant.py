@@ -11,6 +11,7 @@ saccades never executed as pursuit.
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import gymnasium as gym
@@ -312,7 +313,7 @@ def test_pursuit_onset_latency(latency):
     plant = new_plant(params)
     start = 0.1  # the request at step k = 6 (t = 0.12 s) is the first that moved
     target = ramp(10.0, start_s=start)
-    run(plant, [target(k) for k in range(0, 30)])
+    run(plant, [target(k) for k in range(30)])
     revealed = 6 * DT
     t, g = plant.trace()
     moved = np.array([ang(X, x) for x in g])
@@ -350,7 +351,7 @@ def test_refused_saccade_waits_static_target_not_reached_by_pursuit():
     run(plant, [first] * 3)  # a 5 deg saccade at t = 0 (32 ms), refractory until 200 ms
     landing = plant.gaze.copy()
     far = direction_from_angles(17.0 * DEG, 0.0)  # 12 deg from the landing point, static
-    for k in range(3, 10):  # steps starting at 60 ... 180 ms
+    for _k in range(3, 10):  # steps starting at 60 ... 180 ms
         s = plant.step(far, DT, N_SUB)
         assert s.saccade_deferred and not s.saccade_started and not s.saccading
         assert ang(landing, plant.gaze) < 1e-12  # not moved: no pursuit of a static target
@@ -383,7 +384,7 @@ def test_refused_saccades_never_move_the_eye_faster_than_pursuit():
     rng = np.random.default_rng(3)
     plant = new_plant()
     az = el = 0.0
-    for k in range(300):
+    for _k in range(300):
         r = rng.random()
         if r < 0.15:
             az, el = az + rng.normal(0, 20) * DEG, el + rng.normal(0, 10) * DEG  # jump
@@ -404,7 +405,7 @@ def test_pursuit_velocity_persists_through_a_catch_up_saccade():
     target = ramp(60.0)
     run(plant, [target(k) for k in range(1, 60)])
     t, vel, _ = horizontal_kinematics(plant)
-    sac = [s for s in plant.saccades if s.onset > 0.5][0]
+    sac = next(s for s in plant.saccades if s.onset > 0.5)
     before = vel[(t[1:] > sac.onset - 4 * H) & (t[1:] <= sac.onset)]
     after = vel[(t[1:] > sac.onset + sac.duration + H) & (t[1:] < sac.onset + sac.duration + 5 * H)]
     np.testing.assert_allclose(before / DEG, 45.0, rtol=1e-6)
@@ -589,7 +590,7 @@ def test_vor_holds_gaze_while_head_turns(seed, yaw):
 def test_vor_range_clamp_carries_gaze_with_head(seed, head):
     rows = _run_head(seed, [_head_action(*head)] * 30)
     clamped_seen = False
-    for prev, cur in zip(rows[:-1], rows[1:]):
+    for prev, cur in itertools.pairwise(rows):
         g_prev, g, e, rot = prev[0], cur[0], cur[1], cur[2]
         az, el = e
         assert -AZ_LIM - 1e-6 <= az <= AZ_LIM + 1e-6

@@ -5,9 +5,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from visuomotor_gym.baselines.ppo import train
 
 from visuomotor_gym.agents import make_agent
-from visuomotor_gym.baselines.ppo import train
 from visuomotor_gym.bench.evaluate import evaluate
 from visuomotor_gym.envs.walk import WALK_LAYOUT
 
@@ -78,7 +78,7 @@ def test_ppo_entry_is_submitted_and_rescored_from_its_packed_file(tiny_run, tmp_
     (root / "protocol.json").write_text(json.dumps(proto, indent=2))
     assert main(["leaderboard", "submit", "--agent", f"ppo:{tiny_run}", "--name", "ppo-tiny", "--env", "EyeCatch-v0",
                  "--dir", str(root), "--workers", "1", "--no-progress"]) == 0
-    policy = root / "agents" / "ppo-tiny__EyeCatch-v0.npz"  # pickle-free (issue 16), converted at submit
+    policy = root / "agents" / "ppo-tiny__EyeCatch-v0.npz"  # pickle-free, converted at submit
     assert policy.is_file()
     record = json.loads((root / "results" / "ppo-tiny__EyeCatch-v0.entry.json").read_text())
     assert record["policy"]["format"] == "ppo-npz"
@@ -109,7 +109,7 @@ def test_hyperparameters_resolve_default_then_env_then_overrides():
 
 
 def test_walk_id_trains_without_the_catch_features_and_its_npz_walks(tmp_path):
-    """ObstacleWalk-v0 (issue 15): its hyperparameters replace the catch family's shaped reward (only the
+    """ObstacleWalk-v0: its hyperparameters replace the catch family's shaped reward (only the
     env's own progress term is shaped), no belief features; a tiny run packs to ppo-npz and is scored."""
     config = train.load_config(train.parse_args(["--env", "ObstacleWalk-v0"]))
     assert config["belief"] is False and config["hand_action"] == "absolute" and config["intercept_shaping"] == 0.0
@@ -143,8 +143,8 @@ def test_belief_intercept_base_catches_with_exact_vision_and_maps_residuals():
     assert result.summary["caught"] >= 3
 
     import gymnasium as gym
-
     from visuomotor_gym.baselines.ppo.belief import BeliefFeatures
+
     from visuomotor_gym.body.seated import HAND_WORKSPACE
 
     env = gym.make("EyeCatchOracle-v0")
@@ -165,7 +165,7 @@ def test_belief_intercept_base_catches_with_exact_vision_and_maps_residuals():
         BeliefFeatures("EyeCatch-v0", "relative")
 
 
-# ---------------------------------------------------------------- the gated gaze action (issue 15)
+# ---------------------------------------------------------------- the gated gaze action
 
 
 def test_gated_gaze_maps_the_look_gate_to_the_belief_request_and_zero_to_held_gaze():
@@ -174,7 +174,6 @@ def test_gated_gaze_maps_the_look_gate_to_the_belief_request_and_zero_to_held_ga
     residual alone around the line of sight (0: gaze held); before the filter's first sample the gate
     does nothing. The hand block stays the intercept residual."""
     import gymnasium as gym
-
     from visuomotor_gym.baselines.ppo.belief import BeliefFeatures
 
     env = gym.make("EyeCatch-v0")
@@ -219,7 +218,6 @@ def test_frozen_gaze_action_sees_what_gated_sees_and_holds_gaze_and_head():
     """gaze_action="frozen" (a policy *trained* with its gaze held): the gated mode's inputs, the env's
     9 action values, gaze and head held at 0 whatever the policy says; hand, grasp, fixation its own."""
     import gymnasium as gym
-
     from visuomotor_gym.baselines.ppo.belief import BeliefFeatures
 
     env = gym.make("EyeCatch-v0")
@@ -301,9 +299,9 @@ def test_frozen_holds_the_blocks_the_gaze_blind_twin_holds():
     """belief.GAZE_HEAD (the frozen mode's held slices) are the env's 'gaze' and 'head' blocks, as
     ``GazeBlind`` reads them from its action_structure."""
     import gymnasium as gym
+    from visuomotor_gym.baselines.ppo.belief import ENV_ACTION_DIM, GAZE_HEAD
 
     from visuomotor_gym.agents import GazeBlind
-    from visuomotor_gym.baselines.ppo.belief import ENV_ACTION_DIM, GAZE_HEAD
 
     structure = gym.make("EyeCatch-v0").unwrapped.action_structure
     twin = GazeBlind(None, structure)

@@ -17,11 +17,11 @@ import numpy as np
 import pytest
 
 if os.environ.get("VMGYM_REQUIRE_RAY") == "1":
-    import ray  # noqa: F401  (must be importable where CI asks for it)
+    import ray  # must be importable where CI asks for it
 else:
     ray = pytest.importorskip("ray")
 
-from visuomotor_gym.bench.evaluate import evaluate  # noqa: E402
+from visuomotor_gym.bench.evaluate import evaluate
 
 pytestmark = pytest.mark.ray
 AGENT, ENV, EPISODES, SEED = "eyecatch", "EyeCatch-v0", 8, 5

@@ -261,7 +261,7 @@ def test_bezier_mode_follows_its_curve():
     a[9] = 2.0 * (0.8 - 0.2) / (2.0 - 0.2) - 1.0  # 0.8 s
     a[10] = 1.0
     refs, hands = [], []
-    for k in range(40):
+    for _k in range(40):
         env.step(a)
         refs.append(body.hand.reference.copy())
         hands.append(env.data.site_xpos[body.catch_site].copy())

@@ -1,5 +1,5 @@
-"""Realism that measures strategy (issue 21): on every family a still eye and a random eye score <= 0.5 and a
-human-like eye scores high; the moving-eye measures against hand-computed cases; undefined scores 0.
+"""Realism that measures strategy (realism version 2): on every family a still eye and a random eye score <=
+0.5 and a human-like eye scores high; the moving-eye measures against hand-computed cases; undefined scores 0.
 
 The traces are synthetic :class:`EpisodeTrace` objects (no simulation) built per family: a *human-like* eye
 saccades about 3 times a second onto the task's targets (the obstacles and the walkway ahead, the next

@@ -12,7 +12,7 @@ import gymnasium as gym
 import pytest
 import yaml
 
-import visuomotor_gym  # noqa: F401
+import visuomotor_gym
 
 ZOO_FILE = Path(__file__).resolve().parents[1] / "baselines" / "ppo" / "rl_zoo3.yml"
 # Keys rl_zoo3's ExperimentManager reads itself (rl_zoo3/exp_manager.py, 2.x); the rest go to the algorithm.

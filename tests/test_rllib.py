@@ -16,7 +16,7 @@ if os.environ.get("VMGYM_REQUIRE_RAY") == "1":
 else:
     pytest.importorskip("ray.rllib")
 
-from visuomotor_gym.baselines.ppo.rllib_train import build_config, main, train  # noqa: E402
+from visuomotor_gym.baselines.ppo.rllib_train import build_config, main, train
 
 pytestmark = pytest.mark.ray
 

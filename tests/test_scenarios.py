@@ -62,7 +62,7 @@ def test_bounce_env_ball_really_bounces_and_comes_back(seed):
     """The invisible wall reverses the lateral velocity mid-flight; the ball still arrives near the
     sampled arrival point (soft contact: within 12 cm)."""
     env = gym.make("EyeCatchBounce-v0")
-    obs, info = env.reset(seed=seed)
+    _obs, info = env.reset(seed=seed)
     arrival, flight = info["arrival_pos"], info["flight_time"]
     action = np.zeros(9, dtype=np.float32)
     action[:3] = (-1, 1, -1)  # hand out of the way
@@ -70,7 +70,7 @@ def test_bounce_env_ball_really_bounces_and_comes_back(seed):
     vy, best = [], np.inf
     done = False
     while not done:
-        obs, _, terminated, truncated, info = env.step(action)
+        _obs, _, terminated, truncated, info = env.step(action)
         done = terminated or truncated
         vy.append(info["ball_vel"][1])
         if abs(info["time"] - flight) < 0.011:

@@ -10,6 +10,7 @@ import gymnasium as gym
 import numpy as np
 import pytest
 import tomllib
+from setuptools import find_packages
 
 import visuomotor_gym  # noqa: F401
 from visuomotor_gym.agents import GazeBlind, is_deterministic, make_agent, match_vision, parse_agent_spec
@@ -212,7 +213,8 @@ def test_committed_postures_build_agents():
 
 def test_postures_file_is_package_data():
     project = tomllib.loads((REPO / "pyproject.toml").read_text())["tool"]["setuptools"]
-    assert "visuomotor_gym.data" in project["packages"]
+    # setup.py finds the packages (find_packages under visuomotor_gym/): data/ must be one of them
+    assert "visuomotor_gym.data" in find_packages(str(REPO), include=["visuomotor_gym", "visuomotor_gym.*"])
     assert "*.json" in project["package-data"]["visuomotor_gym.data"]
     assert (REPO / "visuomotor_gym" / "data" / "static_postures.json").exists()
 

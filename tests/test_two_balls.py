@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-
 import gymnasium as gym
 import mujoco
 import numpy as np
@@ -113,7 +112,7 @@ def test_second_throw_distribution(seed):
 @pytest.mark.parametrize("seed", [0, 5])
 def test_second_ball_waits_then_flies_on_its_exact_path(seed):
     env = gym.make(ENV_ID)
-    obs, info = env.reset(seed=seed)
+    _obs, info = env.reset(seed=seed)
     throw2, dt = env.unwrapped.throw2, 0.002
     assert throw2.release_time == info["release2_time"] > 0
     # the launch velocity lands exactly on the arrival point after flight2_time (semi-implicit Euler)
@@ -177,7 +176,7 @@ def test_one_catch_is_not_a_success():
             break
     else:
         pytest.fail("the scripted catcher never caught the first ball in 12 throws")
-    obs, reward, terminated, truncated, info = records[-1]
+    _obs, _reward, terminated, _truncated, info = records[-1]
     assert terminated and info["missed"] and not info["is_success"]
     assert info["time"] > records[0][4]["flight_time"]  # it ended on the second ball's miss
 
@@ -185,7 +184,7 @@ def test_one_catch_is_not_a_success():
 def test_the_first_miss_ends_the_episode():
     env = gym.make(ENV_ID)
     records = play_scripted(env, 1, skip_first=True)
-    obs, reward, terminated, truncated, info = records[-1]
+    _obs, _reward, terminated, _truncated, info = records[-1]
     assert terminated and info["missed"] and info["balls_caught"] == 0 and not info["is_success"]
     assert info["time"] < records[0][4]["release2_time"] + records[0][4]["flight2_time"]
 

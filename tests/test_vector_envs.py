@@ -11,7 +11,7 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-import visuomotor_gym  # noqa: F401  (registers the ids)
+import visuomotor_gym  # registers the ids
 
 SEEDS = [10, 11]  # ObstacleWalk courses of 6 and 4 obstacles
 IDS = sorted(i for i, spec in gym.registry.items()

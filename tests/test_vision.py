@@ -182,7 +182,7 @@ def test_velocity_lateral_std_weber_plus_floor(retinal_speed):
 
 
 # ------------------------------------------------------------------------------------------------
-# Moving-target localisation: lateral position std x max(1, slip / knee) (issue 11)
+# Moving-target localisation: lateral position std x max(1, slip / knee)
 # ------------------------------------------------------------------------------------------------
 @pytest.mark.parametrize("slip_deg_s", [0.0, 1.0, 2.5, 2.6, 5.0, 25.0, 100.0, -40.0])
 @pytest.mark.parametrize("ecc_deg", [0.0, 10.0])
@@ -366,9 +366,9 @@ def test_sample_statistics_independent_of_covariance(ecc_deg, d):
     np.testing.assert_allclose((err_v @ b).std(axis=0), sig[3:], rtol=0.04)
     np.testing.assert_allclose(fov.standard_deviations(d, ecc, rs, p), sig, rtol=1e-12)
     # empirical depth axis (largest position spread) is parallel to the position vector
-    w, v = np.linalg.eigh(np.cov(err_p, rowvar=False))
+    _w, v = np.linalg.eigh(np.cov(err_p, rowvar=False))
     assert abs(v[:, -1] @ pos / d) > 1.0 - 1e-4
-    w, v = np.linalg.eigh(np.cov(err_v, rowvar=False))
+    _w, v = np.linalg.eigh(np.cov(err_v, rowvar=False))
     assert abs(v[:, -1] @ pos / d) > 0.999
 
 
@@ -611,7 +611,7 @@ def test_full_view_sees_during_saccades_and_everywhere():
     obs, info = env.reset(seed=1)
     seen_far = 0
     for k in range(40):
-        obs, _, term, trunc, info = env.step(_action(gaze=(1.0 if k == 0 else 0.0, 0.0), head=(1.0, 0.0)))
+        obs, _, _term, _trunc, info = env.step(_action(gaze=(1.0 if k == 0 else 0.0, 0.0), head=(1.0, 0.0)))
         if k == 0:
             assert info["saccade_onset"]
         assert obs[s["ball_visible"]][0] == 1.0
@@ -674,7 +674,7 @@ def test_env_position_noise_matches_model():
     seeds = range(4)
     offset = (0.4, -0.1)  # look ~25 deg away from the ball after the first step
     ecc_f, d_f, depth_f, lat_f = _position_errors("EyeCatchPaper-v0", seeds, offset)
-    ecc_u, d_u, depth_u, lat_u = _position_errors("EyeCatchFullView-v0", seeds, offset)
+    _ecc_u, d_u, depth_u, lat_u = _position_errors("EyeCatchFullView-v0", seeds, offset)
     assert len(d_f) > 100 and len(d_u) > 100
 
     # FullView: foveal noise whatever the eccentricity (1 arcmin lateral, 5 % depth)
@@ -737,7 +737,7 @@ def test_env_lateral_noise_grows_with_retinal_slip():
 
 
 # ----------------------------------------------------------------------------------------------
-# No leak of the ball's true state into the observation (issue 11)
+# No leak of the ball's true state into the observation
 # ----------------------------------------------------------------------------------------------
 def _non_ball_blocks(layout, obs, exclude=("ball_pos", "ball_vel", "ball_visible", "eye_rot", "eye_in_head")):
     return {name: obs[s].copy() for name, s in layout.slices.items() if name not in exclude}
@@ -783,7 +783,7 @@ def test_ball_blocks_carry_nothing_during_saccades_or_out_of_view():
         obs, _ = env.reset(seed=seed)
         for _ in range(60):
             action = rng.uniform(-1, 1, env.action_space.shape).astype(np.float32)
-            obs, _, terminated, truncated, info = env.step(action)
+            obs, _, terminated, truncated, _info = env.step(action)
             if obs[s["ball_visible"]][0] == 0.0:
                 blind_steps += 1
                 assert not obs[s["ball_pos"]].any() and not obs[s["ball_vel"]].any()

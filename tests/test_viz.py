@@ -35,13 +35,14 @@ def synthetic_trace(n=51, gaze=None, hand=None, ball=None, ball_vel=None, eye=No
         saccade_onset=np.zeros(n, bool) if onset is None else np.asarray(onset, bool),
         action=np.full((n, 9), np.nan), latency_s=np.full(n, np.nan),
         success=caught, diverged=False, truncated=False,
-        task=dict(
-            ball_pos=np.tile([3.0, 0.0, 1.2], (n, 1)) if ball is None else np.asarray(ball, float),
-            ball_vel=np.zeros((n, 3)) if ball_vel is None else np.asarray(ball_vel, float),
-            hand_pos=np.tile([0.3, -0.2, 0.9], (n, 1)) if hand is None else np.asarray(hand, float),
-            ball_visible=np.ones(n, bool), missed=not caught,
-            release_pos=np.array([3.0, 0.0, 1.2]), arrival_pos=np.array([0.3, -0.2, 0.9]), flight_time=1.0,
-        ),
+        task={
+            "ball_pos": np.tile([3.0, 0.0, 1.2], (n, 1)) if ball is None else np.asarray(ball, float),
+            "ball_vel": np.zeros((n, 3)) if ball_vel is None else np.asarray(ball_vel, float),
+            "hand_pos": np.tile([0.3, -0.2, 0.9], (n, 1)) if hand is None else np.asarray(hand, float),
+            "ball_visible": np.ones(n, bool), "missed": not caught,
+            "release_pos": np.array([3.0, 0.0, 1.2]), "arrival_pos": np.array([0.3, -0.2, 0.9]),
+            "flight_time": 1.0,
+        },
     )
 
 
@@ -240,6 +241,14 @@ def test_every_family_is_plotted_from_a_real_episode(family, tmp_path):
     env_id, agent, steps, titles = FAMILY_EPISODES[family]
     trace = short_episode(env_id, agent, steps)
     assert plots.trace_family(trace) == family
+    # The record's trace field tells the family of the same trace under an unregistered id, and no
+    # other family's trace field is in it.
+    from visuomotor_gym.families import families
+
+    marker = {f.name: f.viz.trace_field for f in families()}
+    assert [name for name, field in marker.items() if field in trace.task] == [family]
+    renamed = EpisodeTrace(**{**trace.__dict__, "env_id": "Unregistered-v0"})
+    assert plots.trace_family(renamed) == family
     assert trace.steps <= steps and np.count_nonzero(trace.saccade_onset) >= 1
     fig = plots.episode_figure(trace)
     got = [ax.get_title() for ax in fig.axes]
@@ -350,7 +359,9 @@ def _walker_share(env, views, info):
     from visuomotor_gym.viz.video import FrameRenderer
 
     m = env.unwrapped.model
-    renderer = FrameRenderer(env, views, 160, 120)
+    # Without the line of sight: the translucent gaze line blends with what lies behind it, and a blended
+    # pixel decodes to no segment at all (MuJoCo's renderer then raises IndexError: ~1 run in 6).
+    renderer = FrameRenderer(env, views, 160, 120, line_of_sight=False)
     try:
         renderer.renderer.enable_segmentation_rendering()
         seg = renderer.render(info)
@@ -490,8 +501,11 @@ def test_plot_help_says_what_it_draws_for_every_family(capsys):
     with pytest.raises(SystemExit):
         _parser().parse_args(["plot", "--help"])
     text = capsys.readouterr().out
-    for family in plots.FAMILIES:
-        assert f"  {family}: " in text
+    from visuomotor_gym.families import families
+
+    for record in families():
+        assert f"  {record.name}: {record.viz.contents[:40]}" in text
+    assert tuple(f.name for f in families()) == plots.FAMILIES  # the old name, derived from the records
     assert "footholds" in text and "pedestrian" in text and "shelf" in text
 
 
@@ -531,3 +545,121 @@ def test_record_refuses_a_camera_the_env_does_not_have(tmp_path):
     assert proc.returncode == 2 and "camera='over_shoulder' is not one of" in proc.stderr
     assert "'follow'" in proc.stderr and "'scene'" in proc.stderr
     assert "Traceback" not in proc.stderr and not (tmp_path / "w.mp4").exists()
+
+
+# ----------------------------------------------------------------------------------------------
+# The records' viz fields (visuomotor_gym.family.Viz): the one place plot, video and page facts live
+# ----------------------------------------------------------------------------------------------
+def test_every_record_says_how_its_episodes_are_shown():
+    import inspect
+
+    from visuomotor_gym.families import families
+    from visuomotor_gym.family import FollowView, resolve
+    from visuomotor_gym.viz import family_plots, video
+
+    records = families()
+    assert set(FAMILY_EPISODES) == {f.name for f in records}  # every family's figure is drawn from an episode
+    assert all(f.viz is not None for f in records), [f.name for f in records if f.viz is None]
+    fields = [f.viz.trace_field for f in records]
+    assert len(set(fields)) == len(fields), fields  # a trace field tells one family only
+    for record in records:
+        figure = resolve(record.viz.figure)
+        assert callable(figure) and next(iter(inspect.signature(figure).parameters)) == "trace", record.name
+        assert family_plots.FIGURES[record.name] is figure
+        assert video.scene_view(f"{record.prefix}-v0") == record.viz.scene_view == video.SCENE_VIEWS[record.name]
+        assert video.default_stride(f"{record.prefix}Oracle-v0") == record.viz.video_stride
+        assert commands.plot_contents()[record.name] == record.viz.contents
+    # The walker families follow the pelvis; the seated ones film from their scene's camera.
+    assert {f.name for f in records if isinstance(f.viz.scene_view, FollowView)} == {
+        f.name for f in records if f.body == "walker"}
+    assert video.scene_view("Unregistered-v0") is None and video.default_stride("Unregistered-v0") == 1
+
+
+def _viz(**changes):
+    from dataclasses import replace
+
+    from visuomotor_gym.families import family
+
+    return replace(family("walk").viz, **changes)
+
+
+@pytest.mark.parametrize("changes, error, match", [
+    ({"figure": "walk_figure"}, ValueError, r"Viz.figure must be a 'visuomotor_gym.module:attribute' string"),
+    ({"contents": ""}, ValueError, r"Viz.contents must be a non-empty string"),
+    ({"trace_field": None}, ValueError, r"Viz.trace_field must be a non-empty string"),
+    ({"scene_view": ("side",)}, TypeError, r"Viz.scene_view must be an MJCF camera name or a FollowView"),
+    ({"video_stride": 0}, ValueError, r"Viz.video_stride must be a positive int, got 0"),
+    ({"dpi": 5}, ValueError, r"Viz.dpi must be an int in \[20, 600\], got 5"),
+    ({"outcome_words": ("caught",)}, ValueError, r"Viz.outcome_words must be 2 non-empty strings"),
+    ({"failure_field": ""}, ValueError, r"Viz.failure_field must be None or a trace field name"),
+])
+def test_a_bad_viz_field_is_named(changes, error, match):
+    with pytest.raises(error, match=match):
+        _viz(**changes)
+
+
+@pytest.mark.parametrize("changes, match", [
+    ({"distance": 0.0}, r"FollowView.distance and heading_tau_s must be > 0"),
+    ({"azimuth": math.nan}, r"FollowView.azimuth must be a finite number"),
+    ({"fovy": 180.0}, r"FollowView.fovy must be in \(0, 180\) degrees"),
+    ({"offset": (1.0, 0.0)}, r"FollowView.offset must be a tuple of 3 finite numbers"),
+])
+def test_a_bad_follow_view_is_named(changes, match):
+    from dataclasses import replace
+
+    from visuomotor_gym.families import family
+
+    with pytest.raises(ValueError, match=match):
+        replace(family("dodge").viz.scene_view, **changes)
+
+
+@pytest.mark.parametrize("changes, error, match", [
+    ({"viz": "plots"}, TypeError, r"Family 'reach': viz must be a Viz or None"),
+    ({"rate_aliases": ("success_rate",)}, ValueError, r"rate_aliases must be a tuple of result keys other than"),
+    ({"doc_links": (("Faraway", "/abs/faraway.md"),)}, ValueError, r"doc_links must be a tuple of \(title, page"),
+    ({"doc_pictures": (("images/x.md", "a page, not a picture"),)}, ValueError, r"doc_pictures must be a tuple"),
+])
+def test_a_bad_family_display_field_is_named(changes, error, match):
+    from dataclasses import replace
+
+    from visuomotor_gym.families import family
+
+    with pytest.raises(error, match=match):
+        replace(family("reach"), **changes)
+
+
+def test_a_family_without_viz_is_refused_by_plot_and_filmed_from_its_own_scene(monkeypatch):
+    """viz=None (a new family before its figure): the figure is refused with the reason; the video
+    falls back to the env's own scene camera, every control step."""
+    from dataclasses import replace
+
+    import visuomotor_gym.families as registry
+    from visuomotor_gym.viz import video
+
+    bare = tuple(replace(f, viz=None) if f.name == "reach" else f for f in registry.families())
+    monkeypatch.setattr(registry, "families", lambda: bare)
+    registry._by_id.cache_clear()
+    try:
+        trace = synthetic_trace(5)
+        trace.env_id, trace.task = "ShelfReach-v0", {"object_pos": np.zeros((5, 3))}
+        with pytest.raises(ValueError, match="the reach family declares no figure"):
+            plots.episode_figure(trace)
+        assert video.scene_view("ShelfReach-v0") is None and video.default_stride("ShelfReach-v0") == 1
+        assert "reach" not in commands.plot_contents() and "reach" not in plots.FAMILIES
+    finally:
+        monkeypatch.undo()
+        registry._by_id.cache_clear()
+
+
+def test_results_hold_a_familys_own_rate_name_equal_to_the_success_rate():
+    """``rate_aliases``: on a catch id ``catch_rate`` is the success rate (a results file whose two
+    differ is refused); on a family without the alias the check does not apply."""
+    from visuomotor_gym.bench.results import _success_problems
+
+    obj = {"success_rate": 0.5, "success": 3, "catch_rate": 0.25}
+    (problem,) = _success_problems(obj, 6, "EyeCatch-v0")
+    assert problem[0] == "$.success_rate" and "differs from catch_rate = 0.25" in problem[1]
+    assert "catch env id (EyeCatch-v0)" in problem[1]
+    assert _success_problems(obj, 6, "ShelfReach-v0") == []
+    assert _success_problems(obj, 6, "Unregistered-v0") == []
+    assert _success_problems({**obj, "catch_rate": 0.5}, 6, "EyeCatch-v0") == []

@@ -1,4 +1,4 @@
-"""ObstacleWalk-v0's opt-in rough course (``course_distribution="rough"``, issue 23): the preset is
+"""ObstacleWalk-v0's opt-in rough course (``course_distribution="rough"``): the preset is
 reproducible and follows its geometry (a hand-computed overlap case), the default course is untouched,
 its slots carry no hidden truth (an obstacle passed unseen changes no slot id), the iwao baseline picks
 its foothold gaze on it, and the static posture search takes the env's arguments."""
@@ -43,7 +43,7 @@ def test_the_preset_is_opt_in_and_the_default_course_unchanged():
     assert ObstacleWalkEnv(course_distribution={"layout": "rough"}).course_distribution.rough
     with pytest.raises(ValueError, match="course_distribution"):
         ObstacleWalkEnv(course_distribution="bumpy")
-    with pytest.raises(ValueError, match="course_distribution.layout"):
+    with pytest.raises(ValueError, match=r"course_distribution\.layout"):
         ObstacleWalkEnv(course_distribution={"layout": "bumpy"})
 
 
@@ -180,13 +180,12 @@ def test_iwao_looks_at_footholds_on_the_rough_course():
 
 def test_registered_kwargs_restores_and_refuses():
     before = dict(gym.spec("ObstacleWalk-v0").kwargs)
-    with pytest.raises(ValueError, match="course_distribution"):
-        with registered_kwargs("ObstacleWalk-v0", {"course_distribution": "bumpy"}):
-            pass
+    with pytest.raises(ValueError, match="course_distribution"), \
+            registered_kwargs("ObstacleWalk-v0", {"course_distribution": "bumpy"}):
+        pass
     assert dict(gym.spec("ObstacleWalk-v0").kwargs) == before
-    with pytest.raises(TypeError, match="env kwargs"):
-        with registered_kwargs("ObstacleWalk-v0", ["rough"]):
-            pass
+    with pytest.raises(TypeError, match="env kwargs"), registered_kwargs("ObstacleWalk-v0", ["rough"]):
+        pass
 
 
 def test_static_search_takes_env_kwargs(tmp_path):

@@ -165,7 +165,7 @@ def test_flat_15m_walk_nominal_footsteps(model):
     x = np.array([r[2] for r in rows])
     steady = t >= 1.0
     speed = (x[steady][-1] - x[steady][0]) / (t[steady][-1] - t[steady][0])
-    assert 1.2 <= speed <= 1.4, speed  # issue 12: ~1.2-1.4 m/s (Bohannon 1997: 1.27-1.46 comfortable)
+    assert 1.2 <= speed <= 1.4, speed  # ~1.2-1.4 m/s (Bohannon 1997: 1.27-1.46 comfortable)
     touch = sorted(_touchdowns(rows, 0) + _touchdowns(rows, 1))
     step_s = np.diff(touch)
     assert len(touch) >= 20 and 0.45 <= step_s.mean() <= 0.55 and step_s.std() < 0.01  # ~0.5 s per step
@@ -352,7 +352,7 @@ def test_watched_substeps_classify_contacts_as_checks_after_every_substep(model,
     that trip, misstep and step over (bars of random heights, random footsteps)."""
     rng = np.random.default_rng(3)
     n_events = 0
-    for trial in range(3):
+    for _trial in range(3):
         bars = [(2.0 + 1.3 * i + rng.uniform(-0.3, 0.3), rng.uniform(-0.2, 0.2), rng.uniform(0.03, 0.4),
                  rng.uniform(0.3, 1.2), rng.uniform(0.05, 0.3)) for i in range(6)]
         steps = [(rng.uniform(0.3, 0.9), rng.uniform(-0.2, 0.2), rng.uniform(0.0, 0.4)) for _ in range(300)]
@@ -467,7 +467,7 @@ def _reference_targets(gait, tick):
         hy = g.hip_y if side == 0 else -g.hip_y
         du, dv = foot[0] - pu, foot[1] - (pv + hy)
         zmax = foot[2] + math.sqrt(max(g.d_max * g.d_max - du * du - dv * dv, 0.0))
-        if zmax < z:  # noqa: PLR1730 (the original's form)
+        if zmax < z:  # the original's form
             z = zmax
         hips.append((du, dv))
     pc, ps = g.path_cos, g.path_sin

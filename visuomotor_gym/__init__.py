@@ -17,6 +17,6 @@ _pin_kernels()
 from visuomotor_gym.registration import CATCH_ENV_IDS, ENV_IDS, ENV_SPECS, FAMILIES, register_envs  # noqa: E402
 
 __version__ = "0.1.0"
-__all__ = ["CATCH_ENV_IDS", "ENV_IDS", "ENV_SPECS", "FAMILIES", "register_envs", "__version__"]
+__all__ = ["CATCH_ENV_IDS", "ENV_IDS", "ENV_SPECS", "FAMILIES", "__version__", "register_envs"]
 
 register_envs()

@@ -19,7 +19,7 @@ Agent names (``make_agent``):
 * ``gaze_blind:<agent spec>``: any agent with its gaze and head held (:class:`GazeBlind`): the gaze
   action is 0 (gaze held fixed in the world, where reset put it: on the thrower) and the head action
   0 (the reset pose, straight ahead); everything else is the base agent's. The *gaze-blind twin* of
-  DESIGN section 4: the agent's success minus its twin's on the same seeds is the gaze gain.
+  (docs/gaze_gain.md): the agent's success minus its twin's on the same seeds is the gaze gain.
 * ``static_gaze:[<posture>:]<agent spec>``: any agent with its gaze, fixation and head held at one
   constant posture in the body frame (:mod:`visuomotor_gym.static_gaze`): its best static twin when
   the posture is the searched one (``static_gaze:<agent>``).
@@ -32,8 +32,8 @@ Further names register with :func:`register_agent`.
 from __future__ import annotations
 
 import functools
-
-from typing import Any, Callable, Protocol, runtime_checkable
+from collections.abc import Callable
+from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
@@ -159,7 +159,7 @@ def _agent_families() -> dict[str, tuple[str, ...]]:
     out: dict[str, tuple[str, ...]] = {}
     for record in families():
         for agent in record.agents:
-            out[agent] = out.get(agent, ()) + (record.name,)
+            out[agent] = (*out.get(agent, ()), record.name)
     return out
 
 
@@ -253,7 +253,7 @@ def match_vision(policy, vision) -> None:
 
 
 class GazeBlind:
-    """Any agent with its gaze and head held: the *gaze-blind twin* of DESIGN section 4.
+    """Any agent with its gaze and head held: the *gaze-blind twin* (docs/gaze_gain.md).
 
     Every action of the base agent passes through unchanged except two blocks, overwritten with 0:
     the **gaze** change (0 holds gaze fixed in the world, so the eye stays where reset put it, on the
@@ -306,7 +306,7 @@ class GazeBlind:
         return getattr(self.base, name)
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _registered_action_structure(env_id: str) -> tuple[tuple[str, int], ...]:
     import gymnasium as gym
 
@@ -429,7 +429,7 @@ def _iwao(env_id, action_dim, seed, **kw):
     return IwaoAgent.for_env(env_id, **kw)
 
 
-register_agent("iwao", _iwao, "Iwao et al. (seed 003): head/eye pitch Gaussians per gait cycle toward the next "
+register_agent("iwao", _iwao, "Iwao et al.: head/eye pitch Gaussians per gait cycle toward the next "
                "obstacle, fused percepts, footstep planner (ObstacleWalk); iwao:gaze_blind=true is its gaze-blind twin")
 
 
@@ -439,7 +439,7 @@ def _faraway(env_id, action_dim, seed, **kw):
     return FarawayAgent.for_env(env_id, **kw)
 
 
-# Reach family (issue 14). Its gaze-blind twin is ``faraway:gaze_blind=true`` (gaze, vergence and head held).
+# Reach family. Its gaze-blind twin is ``faraway:gaze_blind=true`` (gaze, vergence and head held).
 register_agent("faraway", _faraway,
                "reach family: saccade to the object, then a reach along Faraway et al.'s (2007) Bézier path")
 
@@ -450,7 +450,7 @@ def _fajen_warren(env_id, action_dim, seed, **kw):
     return FajenWarrenAgent.for_env(env_id, **kw)
 
 
-# Dodge family (issue 13). Its gaze-blind twin is ``fajen_warren:gaze_blind=true`` (gaze and head held).
+# Dodge family. Its gaze-blind twin is ``fajen_warren:gaze_blind=true`` (gaze and head held).
 register_agent("fajen_warren", _fajen_warren,
                "dodge family: Fajen & Warren (2003) steering dynamics on filtered pedestrian percepts, gaze to the "
                "highest collision risk (Olivier et al. 2012); fajen_warren:gaze_blind=true is its gaze-blind twin")
@@ -462,7 +462,7 @@ def _lookahead(env_id, action_dim, seed, **kw):
     return LookaheadAgent.for_env(env_id, **kw)
 
 
-# Stones family (issue 13). Its gaze-blind twin is ``lookahead:gaze_blind=true`` (gaze and head held).
+# Stones family. Its gaze-blind twin is ``lookahead:gaze_blind=true`` (gaze and head held).
 register_agent("lookahead", _lookahead,
                "stones family: fixates the stone two steps ahead from the swing start (Patla & Vickers 2003, "
                "Eom 7), fused percepts, footsteps onto the believed stones")

@@ -16,7 +16,6 @@ import os
 import sys
 from pathlib import Path
 
-
 # Bounds of the counts every subcommand takes, checked before any work or allocation (modelling choices:
 # 500 x the leaderboard protocol's 200 episodes; 256 worker processes; seeds of 31 bits, as every
 # seeding API takes them). ``--episodes 10**12`` allocated its seed list until the OS killed it.
@@ -74,12 +73,10 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     os.environ.setdefault("MUJOCO_GL", "egl")
     import visuomotor_gym  # noqa: F401
     from visuomotor_gym.bench.commands import print_summary
-    from visuomotor_gym.bench.evaluate import evaluate
+    from visuomotor_gym.bench.evaluate import evaluate, validate_inputs
     from visuomotor_gym.bench.results import build_results, dumps_results
     from visuomotor_gym.viz.plots import plot_episode
     from visuomotor_gym.viz.video import record_episode
-
-    from visuomotor_gym.bench.evaluate import validate_inputs
 
     try:  # the agent and the env before anything is written or run
         validate_inputs(args.agent, args.env, args.episodes, args.seed)

@@ -3,13 +3,14 @@
 A family (catch, reach, walk, ...) is one env class, its five-rung observability ladder and a few
 extra ids, its metrics and its baselines. Its :class:`Family` record is declared once, at the end of
 its env module ``visuomotor_gym/envs/<family>.py``, and :mod:`visuomotor_gym.families` lists those
-modules: registration, the metrics dispatcher, the bench table, the agent factory, the leaderboard's
-policy formats and the golden digests read the records and hold no family table of their own.
+modules: registration, the metrics dispatcher, the bench table and results check, the agent factory,
+the leaderboard's policy formats, the golden digests, the plots and videos of ``visuomotor_gym.viz``
+and the family pages' generator read the records and hold no family table of their own.
 
-References to code above the env layer (the family's summariser, miss distance, belief-MPC classes)
-are ``"module:attribute"`` strings, resolved by :func:`resolve` when first used: an env module may not
-import metrics or baselines (``tests/test_architecture.py``: they sit above it and import it), so a
-direct reference would be an import cycle. Everything else (vision defaults, numbers, labels) is a
+References to code above the env layer (the family's summariser, miss distance, belief-MPC classes,
+figure) are ``"module:attribute"`` strings, resolved by :func:`resolve` when first used: an env module
+may not import metrics, baselines or viz (``tests/test_architecture.py``: they sit above it and import
+it), so a direct reference would be an import cycle. Everything else (vision defaults, numbers, labels) is a
 plain value. This module imports nothing of the package at module level, so any layer may import it,
 and importing a record builds no MuJoCo model.
 """
@@ -17,6 +18,7 @@ and importing a record builds no MuJoCo model.
 from __future__ import annotations
 
 import importlib
+import math
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -33,6 +35,9 @@ _NAME = re.compile(r"[a-z][a-z0-9_]*\Z")
 _PREFIX = re.compile(r"[A-Z][A-Za-z0-9]*\Z")
 _REF = re.compile(r"visuomotor_gym(\.[A-Za-z_][A-Za-z0-9_]*)+:[A-Za-z_][A-Za-z0-9_]*\Z")
 _ENV_ID = re.compile(r"[A-Za-z][A-Za-z0-9]*-v\d+\Z")
+_KEY = re.compile(r"[a-z][a-z0-9_]*\Z")
+_DOC_PAGE = re.compile(r"(?!/)(?!.*\.\.)[A-Za-z0-9_./-]+\.md\Z")  # a page under docs/
+_DOC_IMAGE = re.compile(r"(?!/)(?!.*\.\.)[A-Za-z0-9_./-]+\.(png|jpg|jpeg|gif|svg)\Z")
 
 
 @dataclass(frozen=True)
@@ -93,6 +98,95 @@ class BeliefMPC:
 
 
 @dataclass(frozen=True)
+class FollowView:
+    """A video camera that follows a walker (``vmgym record``'s scene view of a walker family): a free
+    camera looking at the pelvis plus ``offset`` (world frame, m) from ``distance`` m away, ``azimuth``
+    deg about z (0: looking along +x, the path's direction; 90: along +y) and ``elevation`` deg
+    (negative: from above), with a vertical field of view of ``fovy`` deg. With ``follow_heading`` the
+    azimuth and offset turn with the pelvis's heading, smoothed by a first-order filter of time
+    constant ``heading_tau_s`` s. The camera is not in the MJCF, so the compiled models (and their
+    golden digests) do not change. Values are modelling choices, checked by eye on a frame of each
+    family; :class:`visuomotor_gym.viz.video.FrameRenderer` renders it."""
+
+    distance: float
+    azimuth: float
+    elevation: float
+    offset: tuple[float, float, float]
+    fovy: float = 45.0
+    follow_heading: bool = False
+    # 1 s (modelling choice) averages out the gait's sway of the pelvis (~2 steps) and still turns
+    # with the path within a few steps.
+    heading_tau_s: float = 1.0
+
+    def __post_init__(self):
+        for name in ("distance", "azimuth", "elevation", "fovy", "heading_tau_s"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+                raise ValueError(f"FollowView.{name} must be a finite number, got {value!r}")
+        if self.distance <= 0 or self.heading_tau_s <= 0:
+            raise ValueError(f"FollowView.distance and heading_tau_s must be > 0, got {self.distance!r} and "
+                             f"{self.heading_tau_s!r}")
+        if not 0 < self.fovy < 180:
+            raise ValueError(f"FollowView.fovy must be in (0, 180) degrees, got {self.fovy!r}")
+        offset = self.offset
+        if not (isinstance(offset, tuple) and len(offset) == 3 and all(
+                isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in offset)):
+            raise ValueError(f"FollowView.offset must be a tuple of 3 finite numbers (x, y, z in m), got {offset!r}")
+        if not isinstance(self.follow_heading, bool):
+            raise TypeError(f"FollowView.follow_heading must be a bool, got {self.follow_heading!r}")
+
+
+@dataclass(frozen=True)
+class Viz:
+    """How ``vmgym plot`` and ``vmgym record`` (:mod:`visuomotor_gym.viz`) show one episode of a family:
+
+    * ``figure`` -- ``"module:function"``, ``function(trace) -> matplotlib Figure``: the episode's
+      figure (:func:`visuomotor_gym.viz.plots.episode_figure` dispatches to it);
+    * ``contents`` -- what that figure shows, one sentence (``vmgym plot --help`` lists it per family);
+    * ``trace_field`` -- a task field of the family's traces that no other family's traces hold
+      (``"ball_pos"``): it tells a trace's family when its env id is not a registered one (a synthetic
+      or older trace; :func:`visuomotor_gym.viz.plots.trace_family`);
+    * ``scene_view`` -- the video's scene view: an MJCF camera name of the scene (``"scene_camera"``)
+      or a :class:`FollowView`;
+    * ``video_stride`` -- the default frames per control step: a frame after every ``video_stride``-th
+      20 ms step (1 for short episodes, where a 40-60 ms saccade then spans 2-3 frames; 2 for 10-20 s
+      walker episodes, which would otherwise take twice as long to render and to watch: a modelling
+      choice); ``fps = 50 / video_stride`` is real time;
+    * ``dpi`` -- the resolution of the written PNG;
+    * ``outcome_words`` -- how the figure title and ``vmgym record`` call a success and a failure
+      (``("caught", "missed")``);
+    * ``failure_field`` -- the trace field that marks a failed episode (``"missed"``); None: an episode
+      that ended without success, divergence or the time limit failed.
+    """
+
+    figure: str
+    contents: str
+    trace_field: str
+    scene_view: str | FollowView
+    video_stride: int = 1
+    dpi: int = 100
+    outcome_words: tuple[str, str] = ("succeeded", "failed")
+    failure_field: str | None = None
+
+    def __post_init__(self):
+        _check_ref(self.figure, "Viz.figure")
+        for name in ("contents", "trace_field"):
+            value = getattr(self, name)
+            if not isinstance(value, str) or not value:
+                raise ValueError(f"Viz.{name} must be a non-empty string, got {value!r}")
+        if not (isinstance(self.scene_view, FollowView) or (isinstance(self.scene_view, str) and self.scene_view)):
+            raise TypeError(f"Viz.scene_view must be an MJCF camera name or a FollowView, got {self.scene_view!r}")
+        _check_steps(self.video_stride, "Viz.video_stride")
+        if isinstance(self.dpi, bool) or not isinstance(self.dpi, int) or not 20 <= self.dpi <= 600:
+            raise ValueError(f"Viz.dpi must be an int in [20, 600], got {self.dpi!r}")
+        words = self.outcome_words
+        if not (isinstance(words, tuple) and len(words) == 2 and all(isinstance(w, str) and w for w in words)):
+            raise ValueError(f"Viz.outcome_words must be 2 non-empty strings (success, failure), got {words!r}")
+        if self.failure_field is not None and not (isinstance(self.failure_field, str) and self.failure_field):
+            raise ValueError(f"Viz.failure_field must be None or a trace field name, got {self.failure_field!r}")
+
+
+@dataclass(frozen=True)
 class Family:
     """Everything a shared module knows about one task family. Fields:
 
@@ -120,7 +214,16 @@ class Family:
     * ``golden_agent`` -- the scripted agent the golden digests run on each of the family's ids (None:
       the family is not pinned yet); ``golden_extra`` -- more ``(agent, env id)`` golden cases;
     * ``belief_mpc`` -- how the ``belief_mpc`` agent plays the family (:class:`BeliefMPC`), None if it
-      does not.
+      does not;
+    * ``rate_aliases`` -- result keys the family's summary keeps as its own name of ``success_rate``
+      (catch: ``"catch_rate"``): the results check (:mod:`visuomotor_gym.bench.results`) holds each
+      equal to ``success_rate`` on the family's ids;
+    * ``viz`` -- how ``vmgym plot`` and ``vmgym record`` show an episode (:class:`Viz`); None: no
+      figure (``vmgym plot`` refuses the family) and videos from the env's own ``render_cameras``
+      scene view, every control step;
+    * ``doc_links`` -- ``(title, path relative to docs/)`` of the pages the family's generated page
+      links to (reproductions, baselines); ``doc_pictures`` -- ``(image path relative to docs/,
+      caption)`` candidates, the first that exists is shown (``docs/gen_family_pages.py``).
     """
 
     name: str
@@ -139,6 +242,10 @@ class Family:
     golden_agent: str | None = None
     golden_extra: tuple[tuple[str, str], ...] = ()
     belief_mpc: BeliefMPC | None = None
+    rate_aliases: tuple[str, ...] = ()
+    viz: Viz | None = None
+    doc_links: tuple[tuple[str, str], ...] = ()
+    doc_pictures: tuple[tuple[str, str], ...] = ()
 
     def __post_init__(self):
         if not isinstance(self.name, str) or not _NAME.match(self.name):
@@ -183,6 +290,21 @@ class Family:
                              f"got {self.golden_extra!r}")
         if self.belief_mpc is not None and not isinstance(self.belief_mpc, BeliefMPC):
             raise TypeError(f"{where}: belief_mpc must be a BeliefMPC or None, got {type(self.belief_mpc).__name__}")
+        if not isinstance(self.rate_aliases, tuple) or not all(
+                isinstance(k, str) and _KEY.match(k) and k != "success_rate" for k in self.rate_aliases):
+            raise ValueError(f"{where}: rate_aliases must be a tuple of result keys other than 'success_rate' "
+                             f"(like 'catch_rate'), got {self.rate_aliases!r}")
+        if self.viz is not None and not isinstance(self.viz, Viz):
+            raise TypeError(f"{where}: viz must be a Viz or None, got {type(self.viz).__name__}")
+        for name, kind, pattern in (("doc_links", "(title, page path relative to docs/)", _DOC_PAGE),
+                                    ("doc_pictures", "(image path relative to docs/, caption)", _DOC_IMAGE)):
+            value = getattr(self, name)
+            path_at = 1 if name == "doc_links" else 0
+            if not isinstance(value, tuple) or not all(
+                    isinstance(p, tuple) and len(p) == 2 and all(isinstance(x, str) and x for x in p)
+                    and pattern.match(p[path_at]) for p in value):
+                raise ValueError(f"{where}: {name} must be a tuple of {kind} pairs of non-empty strings, "
+                                 f"got {value!r}")
 
     def env_entries(self) -> tuple[EnvEntry, ...]:
         """Every id of the family, in registration order: the five rungs (same physics and scenario

@@ -1,7 +1,7 @@
-"""Hand-path toolkit: Bézier fitting and the Faraway, Reed & Wang (2007) reach model (seed 002).
+"""Hand-path toolkit: Bézier fitting and the Faraway, Reed & Wang (2007) reach model.
 
-Seed 002 (Faraway, Reed & Wang, *Modelling three-dimensional trajectories by using Bézier curves with
-application to hand motion*, JRSS C 2007) describes a wrist path from a home shelf to a target shelf as
+Faraway, Reed & Wang (*Modelling three-dimensional trajectories by using Bézier curves with
+application to hand motion*, JRSS C 2007) describe a wrist path from a home shelf to a target shelf as
 a cubic Bézier curve, fitted by least squares with an arc-length parameterisation (Sec. 3.2), and
 predicts new reaches with a "null axis model with distance scaling" (Sec. 4): the two interior control
 points sit at fixed offsets, proportional to the reach length, from the points one third and two thirds
@@ -10,7 +10,8 @@ relative-speed profile.
 
 What is here
 ------------
-- :func:`bernstein`, :func:`bezier`: the curve, seed 002 Sec. 3.1 (Eq. for ``B_i^d`` and ``C(t)``).
+- :func:`bernstein`, :func:`bezier`: the curve, Faraway et al. (2007) Sec. 3.1 (Eq. for ``B_i^d``
+  and ``C(t)``).
 - :func:`arc_length_parameter`, :func:`fit_bezier`, :func:`fit_error`: the fit of Sec. 3.2 and the
   "maximum error" of Sec. 4 (Table 1).
 - :func:`beta_progress`, :func:`beta_peak_time`, :func:`minimum_jerk_progress`: timing profiles.
@@ -41,7 +42,7 @@ close to straight, so ``d`` is read as the start-end distance ``|P_3 - P_0|`` (P
 
 Timing (which quantity follows the Beta CDF)
 --------------------------------------------
-Seed 002 fits each curve with its parameter set to the relative arc length of the data (Sec. 3.2,
+Faraway et al. (2007) fit each curve with its parameter set to the relative arc length of the data (Sec. 3.2,
 ``s_i``) and fits a Beta distribution to those ``s_i`` as "the relative speed profile" (Sec. 4): the Beta
 CDF of relative time is the fraction of the *path length* covered. :func:`faraway_path` keeps that
 meaning by default (``progress="arc_length"``): the point at relative time ``tau`` is where the relative
@@ -53,7 +54,8 @@ data's arc length). The geometric path is the same; the timing is not: the Bézi
 model's curve is far from its arc length, so the two place the hand up to 3 cm (56.7 cm reach to the
 right-front) to 6 cm (straight-forward reach) apart at the same time, and under ``"parameter"`` the
 speed peak moves with the target direction (0.37 to 0.61 of the reach in our checks), which
-contradicts the measured near-symmetric profile. Seed 002 Sec. 5 weighs spatial error above timing.
+contradicts the measured near-symmetric profile. Faraway et al. (2007, Sec. 5) weigh spatial error
+above timing.
 """
 
 from __future__ import annotations
@@ -67,18 +69,18 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy import special
 
-# Seed 002, Sec. 4 ("The observed means for the distance-scaled control points offset from the axis
-# points"), dimensionless (metres of offset per metre of reach), rows (lateral, forward, up).
+# Faraway et al. (2007), Sec. 4 ("The observed means for the distance-scaled control points offset from the
+# axis points"), dimensionless (metres of offset per metre of reach), rows (lateral, forward, up).
 FARAWAY_Y1 = (-0.025, -0.148, 0.077)
 FARAWAY_Y2 = (-0.015, -0.139, -0.002)
-# Seed 002, Sec. 4: median ML estimates of the Beta relative-speed profile.
+# Faraway et al. (2007), Sec. 4: median ML estimates of the Beta relative-speed profile.
 FARAWAY_ALPHA = 1.63
 FARAWAY_BETA = 1.75
-# Seed 002, Sec. 4: the median reach distance, at which the offsets are quoted in cm.
+# Faraway et al. (2007), Sec. 4: the median reach distance, at which the offsets are quoted in cm.
 FARAWAY_MEDIAN_REACH_M = 0.567
 # Flash & Hogan (1985) minimum-jerk progress 10t^3 - 15t^4 + 6t^5 has speed 30 t^2 (1 - t)^2, the
-# Beta(3, 3) density. (Seed 002 Sec. 4 calls it "a beta density with alpha = 2 and beta = 2"; that is a
-# slip: Beta(2, 2) has density 6 t (1 - t).)
+# Beta(3, 3) density. (Faraway et al. 2007, Sec. 4, call it "a beta density with alpha = 2 and beta = 2"; that
+# is a slip: Beta(2, 2) has density 6 t (1 - t).)
 MINIMUM_JERK_ALPHA = 3.0
 MINIMUM_JERK_BETA = 3.0
 
@@ -148,10 +150,11 @@ def _reach(start: ArrayLike, end: ArrayLike) -> tuple[np.ndarray, np.ndarray, fl
 
 
 # ---------------------------------------------------------------------------------------------------
-# Bézier curves (seed 002, Sec. 3.1)
+# Bézier curves (Faraway et al. 2007, Sec. 3.1)
 # ---------------------------------------------------------------------------------------------------
 def bernstein(degree: int, t: ArrayLike) -> np.ndarray:
-    """Bernstein basis ``B_i^d(t) = C(d, i) t^i (1 - t)^(d - i)`` (seed 002 Sec. 3.1), shape (len(t), d + 1).
+    """Bernstein basis ``B_i^d(t) = C(d, i) t^i (1 - t)^(d - i)`` (Faraway et al. 2007, Sec. 3.1),
+    shape (len(t), d + 1).
 
     Parameters
     ----------
@@ -168,7 +171,7 @@ def bernstein(degree: int, t: ArrayLike) -> np.ndarray:
 
 
 def bezier(control_points: ArrayLike, t: ArrayLike) -> np.ndarray:
-    """Points of the Bézier curve ``C(t) = sum_i P_i B_i^d(t)`` (seed 002 Sec. 3.1).
+    """Points of the Bézier curve ``C(t) = sum_i P_i B_i^d(t)`` (Faraway et al. 2007, Sec. 3.1).
 
     Parameters
     ----------
@@ -198,10 +201,11 @@ def elevate_degree(control_points: ArrayLike) -> np.ndarray:
 
 
 # ---------------------------------------------------------------------------------------------------
-# fitting (seed 002, Sec. 3.2) and the fit error (Sec. 4, Table 1)
+# fitting (Faraway et al. 2007, Sec. 3.2) and the fit error (Sec. 4, Table 1)
 # ---------------------------------------------------------------------------------------------------
 def arc_length_parameter(points: ArrayLike) -> np.ndarray:
-    """Relative arc length ``s_i = sum_{j<=i} a_j / sum_j a_j``, ``a_j = |Z_j - Z_{j-1}|`` (seed 002 Sec. 3.2).
+    """Relative arc length ``s_i = sum_{j<=i} a_j / sum_j a_j``, ``a_j = |Z_j - Z_{j-1}|``
+    (Faraway et al. 2007, Sec. 3.2).
 
     Parameters
     ----------
@@ -223,7 +227,7 @@ def arc_length_parameter(points: ArrayLike) -> np.ndarray:
 
 
 def fit_bezier(points: ArrayLike, degree: int = 3, s: ArrayLike | None = None) -> np.ndarray:
-    """Least-squares Bézier fit with the end points fixed to the path's ends (seed 002 Sec. 3.2).
+    """Least-squares Bézier fit with the end points fixed to the path's ends (Faraway et al. 2007, Sec. 3.2).
 
     With the default arc-length parameter the fit recovers a curve's *shape*, not its control points:
     a cubic's parameter is not its arc length, so points sampled on a known cubic give back a curve
@@ -231,7 +235,7 @@ def fit_bezier(points: ArrayLike, degree: int = 3, s: ArrayLike | None = None) -
     reach). Pass the known parameters as ``s`` to recover control points exactly.
 
     Minimises ``SS = sum_{i=1}^{n-1} |Z_i - C(s_i)|^2`` over the interior control points with
-    ``P_0 = Z_0`` and ``P_d = Z_n``. Seed 002 solves the normal equations ``B^T B P = B^T Y`` with
+    ``P_0 = Z_0`` and ``P_d = Z_n``. Faraway et al. solve the normal equations ``B^T B P = B^T Y`` with
     ``B_ij = B_j^d(s_i)`` (j = 1 .. d-1) and ``Y_i = Z_i - B_0^d(s_i) Z_0 - B_d^d(s_i) Z_n``; the same
     minimiser is computed here by ``numpy.linalg.lstsq``, which is better conditioned.
 
@@ -240,10 +244,10 @@ def fit_bezier(points: ArrayLike, degree: int = 3, s: ArrayLike | None = None) -
     points : array_like, shape (n, 3)
         The observed path, in time order; ``n >= degree + 1`` and a positive length.
     degree : int
-        Curve degree ``d >= 1`` (seed 002 chooses 3). Degree 1 is the straight line between the ends.
+        Curve degree ``d >= 1`` (Faraway et al. choose 3). Degree 1 is the straight line between the ends.
     s : array_like, shape (n,), optional
         Curve parameter of each point, non-decreasing from 0 to 1. Default: the relative arc length
-        :func:`arc_length_parameter` (seed 002's choice). Pass e.g. a Beta CDF of relative time for the
+        :func:`arc_length_parameter` (Faraway et al.'s choice). Pass e.g. a Beta CDF of relative time for the
         paper's speed-profile variants, or the known parameters to recover a known curve exactly.
 
     Returns
@@ -280,7 +284,8 @@ def fit_bezier(points: ArrayLike, degree: int = 3, s: ArrayLike | None = None) -
 
 
 def fit_error(points: ArrayLike, control_points: ArrayLike, s: ArrayLike | None = None) -> float:
-    """Maximum error ``max_i |Z_i - C(s_i)|`` of a fitted curve (seed 002 Sec. 4, the Table 1 measure).
+    """Maximum error ``max_i |Z_i - C(s_i)|`` of a fitted curve (Faraway et al. 2007, Sec. 4, the
+    Table 1 measure).
 
     ``s`` defaults to the relative arc length of ``points`` (as in :func:`fit_bezier`).
     """
@@ -295,7 +300,7 @@ def fit_error(points: ArrayLike, control_points: ArrayLike, s: ArrayLike | None 
 # timing profiles
 # ---------------------------------------------------------------------------------------------------
 def beta_progress(tau: ArrayLike, alpha: float = FARAWAY_ALPHA, beta: float = FARAWAY_BETA) -> np.ndarray:
-    """Relative progress at relative time ``tau``: the Beta(alpha, beta) CDF (seed 002 Sec. 4).
+    """Relative progress at relative time ``tau``: the Beta(alpha, beta) CDF (Faraway et al. 2007, Sec. 4).
 
     The relative speed is the Beta density; Faraway's median fit is Beta(1.63, 1.75).
     """
@@ -306,7 +311,7 @@ def beta_progress(tau: ArrayLike, alpha: float = FARAWAY_ALPHA, beta: float = FA
 def beta_peak_time(alpha: float = FARAWAY_ALPHA, beta: float = FARAWAY_BETA) -> float:
     """Relative time of peak speed: the Beta mode ``(alpha - 1) / (alpha + beta - 2)`` (alpha, beta > 1).
 
-    For Beta(1.63, 1.75) this is 0.457. Seed 002 reports 0.48 as the *median over curves* of each
+    For Beta(1.63, 1.75) this is 0.457. Faraway et al. report 0.48 as the *median over curves* of each
     curve's peak, which need not equal the mode of the median parameters.
     """
     a, b = _shape_params(alpha, beta)
@@ -383,9 +388,9 @@ def faraway_control_points(
 ) -> np.ndarray:
     """Control points of Faraway's chosen model, the null axis model with distance scaling, shape (4, 3).
 
-    ``P_0 = start``, ``P_3 = end``, axis points ``A_i = P_0 + (i/3)(P_3 - P_0)`` (seed 002 Sec. 3.3,
-    Fig. 5) and ``P_i = A_i + d * Y_i`` with ``d = |P_3 - P_0|`` and ``Y_i`` in the body frame of
-    :func:`body_frame` (seed 002 Sec. 4; see the module docstring for the axis convention).
+    ``P_0 = start``, ``P_3 = end``, axis points ``A_i = P_0 + (i/3)(P_3 - P_0)`` (Faraway et al. 2007, Sec.
+    3.3, Fig. 5) and ``P_i = A_i + d * Y_i`` with ``d = |P_3 - P_0|`` and ``Y_i`` in the body frame of
+    :func:`body_frame` (Faraway et al. 2007, Sec. 4; see the module docstring for the axis convention).
     """
     p0, p3, d = _reach(start, end)
     frame = body_frame(forward, up, hand)
@@ -428,8 +433,8 @@ def faraway_path(
 
     The curve is :func:`faraway_control_points`; the point at relative time ``tau_k = k / (n - 1)`` is at
     relative arc length ``F(tau_k)`` (``progress="arc_length"``, default) or curve parameter ``F(tau_k)``
-    (``progress="parameter"``), ``F`` the Beta(alpha, beta) CDF (seed 002 Sec. 4). Units follow the
-    inputs (the model is scale-free).
+    (``progress="parameter"``), ``F`` the Beta(alpha, beta) CDF (Faraway et al. 2007, Sec. 4). Units follow
+    the inputs (the model is scale-free).
 
     Parameters
     ----------
@@ -488,7 +493,7 @@ def path_distance(
     """Distance between two paths compared point by point at equal relative arc length (or time).
 
     Both are resampled by :func:`resample` to ``n`` points and the Euclidean distances are averaged
-    (``reduce="mean"``) or maximised (``"max"``). ``align="time", reduce="max"`` is seed 002's
+    (``reduce="mean"``) or maximised (``"max"``). ``align="time", reduce="max"`` is Faraway et al.'s
     prediction and replicate error ("maximum distance ... over relative time", Sec. 4); its tables
     report the median of this over reaches. Symmetric in ``a`` and ``b``; 0 for identical paths.
     """
@@ -531,7 +536,7 @@ class HandPathRealism:
     straight_max : float
         Max distance to the straight segment at equal relative arc length.
     faraway_max_at_median_reach : float
-        ``faraway_max`` scaled to seed 002's median 56.7 cm reach (``* 0.567 m / reach_length``, with
+        ``faraway_max`` scaled to Faraway et al.'s median 56.7 cm reach (``* 0.567 m / reach_length``, with
         lengths in metres), comparable with the paper's cm figures.
     curvature_index : float
         Least-squares coefficient ``k`` of the path's deviation from the straight segment on the Faraway
@@ -563,9 +568,9 @@ def hand_path_realism(
 ) -> HandPathRealism:
     """Spatial realism measures of a recorded reach from ``path[0]`` to ``path[-1]`` (lengths in metres).
 
-    The comparison is spatial (equal relative arc length), as seed 002 Sec. 5 weighs spatial error above
-    timing; the timing enters only through ``peak_speed``/``peak_time``. Reading: seed 002's 8.0 cm
-    (chosen model) and 12.6 cm (Flash-Hogan) are errors *against human reaches*, not distances to the
+    The comparison is spatial (equal relative arc length), as Faraway et al. (2007, Sec. 5) weigh spatial
+    error above timing; the timing enters only through ``peak_speed``/``peak_time``. Reading: Faraway et al.'s
+    8.0 cm (chosen model) and 12.6 cm (Flash-Hogan) are errors *against human reaches*, not distances to the
     model's path - a straight reach of 56.7 cm is only ~6 cm from Faraway's path. Use
     ``curvature_index`` (and ``faraway_max`` over many reaches) to tell straight from human-like paths;
     ``docs/reproductions/faraway.md`` gives their spread on synthetic human-like reaches.

@@ -193,8 +193,8 @@ def posture_from_overrides(overrides: dict) -> Posture:
         raise ValueError(f"static_gaze posture: {missing} missing; a posture is "
                          "az=<deg>,el=<deg>[,neck_yaw=<deg>,neck_pitch=<deg>,fix=<m>]")
     for key, value in overrides.items():
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise ValueError(f"static_gaze posture: {key} must be a number, got {value!r}")  # noqa: TRY004 (a spec's text)
+        if isinstance(value, bool) or not isinstance(value, (int, float)):  # ValueError: a spec's text
+            raise ValueError(f"static_gaze posture: {key} must be a number, got {value!r}")
     return Posture(**{k: float(v) for k, v in overrides.items()})
 
 

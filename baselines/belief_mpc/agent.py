@@ -51,10 +51,10 @@ import numpy as np
 from visuomotor_gym.baselines.eyecatch import EyecatchAgent, KalmanParams
 from visuomotor_gym.baselines.eyecatch.agent import SHOULDER_WORLD
 
-from visuomotor_gym.envs.actions import hand_action
 from visuomotor_gym.core.frames import SEAT_ORIGIN
-from visuomotor_gym.geometry import angle_between
+from visuomotor_gym.envs.actions import hand_action
 from visuomotor_gym.envs.observation import ObservationLayout, catch_observation
+from visuomotor_gym.geometry import angle_between
 from visuomotor_gym.registration import env_vision
 from visuomotor_gym.vision.foveation import VisionParams
 
@@ -78,7 +78,7 @@ class BeliefMPCParams:
     alpha: float = 0.2  # process noise Q = alpha I per 20 ms (Eom's alpha; 0.2 "realistic")
     fovea_smoothing_deg: float = 0.2  # eps of the smoothed eccentricity
     angular_uncertainty: bool = False  # r without its d^2 factor: uncertainty relative to distance
-    planner_slip: bool = True  # r grows with retinal slip, as the env's lateral noise (belief.py; issue 11)
+    planner_slip: bool = True  # r grows with retinal slip, as the env's lateral noise (belief.py)
     alpha_in_filter: bool = False  # also scale the real update's process noise by alpha / 0.2 (Eom's own
     # model uses one Q in planning and in the actual estimate; ours keeps the calibrated filter by default)
     prior_position_var: float = 1.0  # compact covariance of an object before its first observation (m^2)
@@ -125,7 +125,7 @@ class BeliefMPCParams:
     visual_delay_s: float = 0.0
     gaze_action_range_deg: float = 60.0
     reset_mahalanobis: float = KalmanParams().reset_mahalanobis  # real filter's adaptive reset: the one
-    # threshold of the Eyecatch filter (KalmanParams, chi^2 6 dof; issue 11: one threshold)
+    # threshold of the Eyecatch filter (KalmanParams, chi^2 6 dof: one threshold)
 
     def __post_init__(self) -> None:
         if self.gaze_cost not in GAZE_COSTS:
@@ -478,7 +478,7 @@ class BeliefMPCAgent:
         human plant is not one (saccades, pursuit with latency and gain), so what is executed is the
         plan's *choice* of what to look at, not its first nodes: executing those (the request a step
         along the plan) left the request stream moving with the eye itself, so the plant's pursuit
-        decayed and the eye fell 10-15 deg behind a fast ball (the miss rate doubled, issue 11). The
+        decayed and the eye fell 10-15 deg behind a fast ball (the miss rate doubled). The
         fixated object is the one nearest the plan's gaze ``fixation_lookahead_s`` ahead, where the
         plan has reached it."""
         p, plan, h = self.params, self.plan, self.h

@@ -20,7 +20,7 @@ what keeps Eom's covariance compact, so ``r`` is the mean of the three positiona
 
 with ``s`` the vision noise scale, ``depth_frac`` = 5 %, ``sigma_q`` = 1 arcmin and ``E2`` = 2 deg.
 
-**Retinal slip** (issue 11): the environment's lateral std grows with the image's speed on the retina,
+**Retinal slip**: the environment's lateral std grows with the image's speed on the retina,
 ``sigma_q max(1, slip / knee)`` (``VisionParams.position_slip_knee_deg_s`` = 2.5 deg/s, Westheimer &
 McKee 1975). The planner keeps the mean of the three variances with the two lateral ones scaled by a
 smooth ``1 + slip^2 / knee^2`` (modelling choice: differentiable, equal to the environment's

@@ -14,6 +14,7 @@ registered agents the recorder's catch rate is checked against the evaluator's.
 from __future__ import annotations
 
 import argparse
+import itertools
 import json
 import math
 import multiprocessing
@@ -125,7 +126,7 @@ def two_ball_gaze(ep) -> dict:
     live = (t >= ep["release2_time"]) & ~caught1  # both balls in flight
     label = np.where((e1 <= FOVEA_DEG) & (e1 <= e2), 1, np.where(e2 <= FOVEA_DEG, 2, 0))
     seq = [x for x in label[live] if x]
-    switches = sum(1 for a, b in zip(seq, seq[1:]) if a != b)
+    switches = sum(1 for a, b in itertools.pairwise(seq) if a != b)
     after2 = t >= ep["release2_time"]
     first_look2 = t[after2 & (label == 2)]
     return {
@@ -218,7 +219,7 @@ def plot_two_balls(out: Path, examples: dict) -> None:
         def az_el(v):
             return np.degrees(np.arctan2(v[:, 1], v[:, 0])), np.degrees(np.arctan2(v[:, 2], np.hypot(v[:, 0], v[:, 1])))
 
-        gaz, gel = az_el(ep["gaze_dir"])
+        gaz, _gel = az_el(ep["gaze_dir"])
         b1az, _ = az_el(ep["ball_pos"] - eye)
         b2az, _ = az_el(ep["ball2_pos"] - eye)
         caught1 = np.flatnonzero(ep["balls_caught"] >= 1)

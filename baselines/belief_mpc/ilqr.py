@@ -165,7 +165,7 @@ def solve(problem, x0: np.ndarray, U0: np.ndarray, iterations: int = 3, reg: flo
     k = np.zeros((problem.N, problem.m))
     accepted = 0
     it = 0
-    for it in range(1, iterations + 1):
+    for it in range(1, iterations + 1):  # noqa: B007 (returned below: the iterations run)
         A, B = problem.dynamics_jacobians(X, U)
         lx, lu, lxx, luu, lux = problem.cost_derivatives(X, U)
         lap("derivatives")

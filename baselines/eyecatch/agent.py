@@ -46,8 +46,8 @@ from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
-from visuomotor_gym.envs.actions import NECK_RANGE_DEG, hand_action
 from visuomotor_gym.core.frames import SEAT_ORIGIN
+from visuomotor_gym.envs.actions import NECK_RANGE_DEG, hand_action
 from visuomotor_gym.envs.observation import ObservationLayout
 from visuomotor_gym.oculomotor.plant import angles_from_direction, direction_from_angles, minimum_jerk
 from visuomotor_gym.registration import env_vision
@@ -279,7 +279,7 @@ class EyecatchAgent:
             return self._action(hand, obs, gaze=(0.0, 0.0), head=obs[_S["head_qpos"]])
         # The filter runs at the sample time; the present is delay_steps ahead of it.
         delay = self.delay_steps * self.dt
-        ball_now, ball_vel_now = self.filter.extrapolate(delay)
+        ball_now, _ball_vel_now = self.filter.extrapolate(delay)
 
         # --- gaze (Eyecatch 4.1) ------------------------------------------------------------------
         # The eye is sent to the ball predicted at the next step (pursuit, v = (p_target - p) / dt);
@@ -448,7 +448,7 @@ class EyecatchAgent:
             return math.inf
         P, h = self.filter.P, horizon_s
         C = P[:3, :3] + h * (P[:3, 3:] + P[3:, :3]) + h * h * P[3:, 3:]
-        rot, eye = self.pose_history[-1]
+        _rot, eye = self.pose_history[-1]
         los = self.filter.extrapolate(h)[0] - eye
         d = max(float(np.linalg.norm(los)), 0.1)
         u = los / d

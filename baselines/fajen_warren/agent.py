@@ -53,7 +53,7 @@ saccade that brought it (modelling choice; shorter than a typical human fixation
 an urgency that grows with the time since it was last scanned.
 
 ``gaze_blind=True`` holds gaze and head (gaze action 0: gaze stays level at the goal; head straight):
-the gaze-blind twin of DESIGN section 2, the same filter and steering.
+the gaze-blind twin (docs/gaze_gain.md), the same filter and steering.
 """
 
 from __future__ import annotations

@@ -21,7 +21,7 @@ The agent sees observations only (the object's position only as the eye's sample
    1999, gaze reaches an object ~0.56 s before the hand acts on it), longer when the peak speed would
    exceed ``max_peak_speed_m_s``. The fingers close from ``grasp_at_tau`` of the reach on.
 
-``gaze_blind=True`` is the gaze-blind twin (DESIGN.md Sec. 2): the same agent with gaze, vergence and
+``gaze_blind=True`` is the gaze-blind twin (docs/gaze_gain.md): the same agent with gaze, vergence and
 head held (zero actions), reaching to whatever its peripheral samples tell it, when they tell it anything.
 """
 

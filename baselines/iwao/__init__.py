@@ -1,4 +1,4 @@
-"""The iwao baseline for ObstacleWalk (Iwao et al., seed 003): see :mod:`.agent`, :mod:`.gaze`,
+"""The iwao baseline for ObstacleWalk (Iwao et al.): see :mod:`.agent`, :mod:`.gaze`,
 :mod:`.perception` and :mod:`.planner`."""
 
 from .agent import IwaoAgent, IwaoParams

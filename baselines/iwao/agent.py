@@ -1,5 +1,5 @@
-"""The ``iwao`` agent for ObstacleWalk: Iwao et al.'s head and eye pitch per gait cycle (seed 003,
-Eq. 1-10; :mod:`.gaze`) aimed at the next obstacle, its own memory of what it has seen
+"""The ``iwao`` agent for ObstacleWalk: Iwao et al.'s head and eye pitch per gait cycle
+(Eq. 1-10; :mod:`.gaze`) aimed at the next obstacle, its own memory of what it has seen
 (:mod:`.perception`) and a footstep planner on that memory (:mod:`.planner`).
 
 Each step (one gait cycle of the head's bob, heel strike to heel strike) the agent picks its *target*:
@@ -13,7 +13,7 @@ for the gaze pitch ``theta_H(t) + theta_E(t)`` (toward the target's azimuth) and
 plans the next foothold from its memory.
 
 ``gaze_blind=True`` holds gaze and head (gaze action 0: gaze stays level along the path where the
-episode put it; head straight): the gaze-blind twin of DESIGN section 4, the same perception and planner.
+episode put it; head straight): the gaze-blind twin (docs/gaze_gain.md), the same perception and planner.
 """
 
 from __future__ import annotations
@@ -22,8 +22,8 @@ import math
 from dataclasses import dataclass, fields, replace
 
 import numpy as np
-
 from visuomotor_gym.baselines.crowding import crowded
+
 from visuomotor_gym.body.walker import GaitParams
 from visuomotor_gym.body.walker_body import WalkerBody
 from visuomotor_gym.envs.walk import WALK_LAYOUT
@@ -308,7 +308,7 @@ class IwaoAgent:
         the plant's pursuit stabilises it while walking: Matthis, Yates & Hayhoe 2018); the head pitched
         down by Iwao's share ``alpha / (1 + alpha)`` of the gaze's depression (Eq. 6), the eye the rest;
         vergence on the target under the depth law."""
-        eye_pos, rot, odo = pose
+        _, rot, odo = pose
         p = self.params
         self.fix_steps += 1
         held = self.fix_steps * p.control_dt

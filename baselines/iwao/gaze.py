@@ -1,7 +1,7 @@
-"""Iwao et al.'s visuomotor coordination model (seed 003, Eq. 1-10): head and eye pitch per gait cycle.
+"""Iwao et al.'s visuomotor coordination model (Eq. 1-10): head and eye pitch per gait cycle.
 
 Per cycle of length ``T_F`` (here one step, heel strike to heel strike: the cycle of the head's vertical
-translation, seed 003 Fig. 4), head and eye pitch are Gaussians peaking at ``mu = T_F / 2``::
+translation, Iwao et al. Fig. 4), head and eye pitch are Gaussians peaking at ``mu = T_F / 2``::
 
     theta_H(t) = theta_Hmax exp(-(t - mu)^2 / (2 sigma_H^2))                              (Eq. 1)
     theta_E(t) = theta_Emax exp(-(t - (mu + t_E))^2 / (2 sigma_E^2))                      (Eq. 2)
@@ -28,7 +28,7 @@ DEG = math.pi / 180.0
 
 @dataclass(frozen=True)
 class IwaoGazeParams:
-    # The view angle while walking (seed 003 section 4.2.3: 20 deg walking, 30 deg running).
+    # The view angle while walking (Iwao et al., Sec. 4.2.3: 20 deg walking, 30 deg running).
     view_angle_max_deg: float = 20.0
     # beta in theta_V = theta_Vmax - l / beta (metres per degree). The paper gives no value: modelling
     # choice, the view angle is 0 (the obstacle foveated) from 2 m away and 10 deg at 1 m.
@@ -45,7 +45,7 @@ class IwaoGazeParams:
     body_pitch_deg: float = 0.0
 
 
-def peak_angles(theta_g: float, l: float, p: IwaoGazeParams) -> tuple[float, float]:
+def peak_angles(theta_g: float, l: float, p: IwaoGazeParams) -> tuple[float, float]:  # noqa: E741 (Eq. 5's l)
     """(theta_Hmax, theta_Emax) in radians (downward positive) for an obstacle at angle ``theta_g`` and
     horizontal distance ``l`` (m) at the cycle's middle: Eq. 8-10 (Eq. 6's alpha). The view angle is
     kept in [0, theta_Vmax] (beyond ``beta * theta_Vmax`` metres the obstacle is looked at directly)."""

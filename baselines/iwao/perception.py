@@ -17,8 +17,8 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-
 from visuomotor_gym.baselines.crowding import crowd_std
+
 from visuomotor_gym.tasks.obstacle_walk import N_POINTS, CourseDistribution
 from visuomotor_gym.vision.foveation import VisionParams, _sigmas
 
@@ -67,7 +67,7 @@ class Corner:
         a = 1.0 / (s_lat * s_lat)
         b = 1.0 / (s_depth * s_depth) - a
         ux, uy, uz = u
-        I = self.info
+        I = self.info  # noqa: E741 (the information matrix)
         I[0] += a + b * ux * ux
         I[1] += b * ux * uy
         I[2] += b * ux * uz

@@ -113,7 +113,7 @@ class FootstepPlanner:
         """The pelvis's lateral target: 0 (the path's centre line) unless an obstacle ahead is too long
         to step over; then beside it, on the side nearer the pelvis's lateral position ``y_now``."""
         p = self.p
-        for o, zone, gf, gb in zip(obstacles, arr.tolist(), gap[0].tolist(), gap[1].tolist()):
+        for _o, zone, gf, gb in zip(obstacles, arr.tolist(), gap[0].tolist(), gap[1].tolist()):
             if zone[1] < u_last - p.corridor_release_m or zone[0] > u_last + p.look_ahead_m:
                 continue
             if (zone[1] - zone[0]) + TOE_M + HEEL_M + gf + gb <= p.max_step_over_m:

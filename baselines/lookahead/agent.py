@@ -24,7 +24,7 @@ before it; beyond the longest step (still on the slab) the distance is split int
 along the current heading.
 
 ``gaze_blind=True`` holds gaze and head (gaze action 0: gaze stays level along the slab where the
-episode put it; head straight): the gaze-blind twin of DESIGN section 2, the same belief and planner.
+episode put it; head straight): the gaze-blind twin (docs/gaze_gain.md), the same belief and planner.
 """
 
 from __future__ import annotations
@@ -33,8 +33,8 @@ import math
 from dataclasses import dataclass, fields, replace
 
 import numpy as np
-
 from visuomotor_gym.baselines.crowding import crowded
+
 from visuomotor_gym.body.walker import GaitParams
 from visuomotor_gym.body.walker_body import TurningWalkerBody as WalkerBody
 from visuomotor_gym.envs.stones import STONES_LAYOUT

@@ -19,6 +19,7 @@ from __future__ import annotations
 import math
 
 from visuomotor_gym.baselines.crowding import crowd_std
+
 from visuomotor_gym.tasks.stepping_stones import STONE_TOP_Z
 from visuomotor_gym.vision.foveation import VisionParams, _sigmas
 
@@ -128,7 +129,7 @@ class StoneMemory:
         ixx = a_info * ux * ux + c_info * uy * uy
         ixy = (a_info - c_info) * ux * uy
         iyy = a_info * uy * uy + c_info * ux * ux
-        I, v = stone.info, stone.vec
+        I, v = stone.info, stone.vec  # noqa: E741 (the information matrix)
         I[0] += ixx
         I[1] += ixy
         I[2] += iyy

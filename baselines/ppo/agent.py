@@ -344,7 +344,7 @@ def _check_record(record: dict, arrays: dict[str, np.ndarray]) -> None:
     """Every field the loader uses is present and consistent with the arrays (shapes chain)."""
     def need(obj, key, kind, where):
         value = obj.get(key) if isinstance(obj, dict) else None
-        if not isinstance(value, kind) or isinstance(value, bool) and kind is not bool:
+        if not isinstance(value, kind) or (isinstance(value, bool) and kind is not bool):
             raise PolicyFileError(f"{where}.{key} must be {getattr(kind, '__name__', kind)}, got {value!r}")
         return value
 

@@ -15,7 +15,7 @@ target in the workspace. Gaze, fixation, head and grasp stay the policy's own. T
 policy learning (Silver et al. 2018, Johannink et al. 2019): the belief does the ballistic
 extrapolation, the policy learns where to look, when to grasp and how to correct the hand.
 
-With ``gaze_action="gated"`` (issue 15) it also appends where the belief's ball is on the retina
+With ``gaze_action="gated"`` (docs/baselines/ppo.md) it also appends where the belief's ball is on the retina
 (azimuth, elevation, rad) and the log angular std of that estimate (3 values), and the policy gets a
 tenth action value, the **look gate**, and a gaze block that is a *residual* (± ``gaze_residual_deg``):
 
@@ -46,8 +46,8 @@ import gymnasium as gym
 import numpy as np
 from visuomotor_gym.baselines.eyecatch.agent import EyecatchAgent
 
-from visuomotor_gym.envs.actions import hand_target_action
 from visuomotor_gym.core.frames import SEAT_ORIGIN
+from visuomotor_gym.envs.actions import hand_target_action
 from visuomotor_gym.envs.observation import ObservationLayout
 
 N_BELIEF = 10

@@ -18,6 +18,7 @@ TensorBoard events, ``checkpoints/`` and ``eval/``.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import copy
 import json
 import shlex
@@ -170,7 +171,9 @@ def load_config(args: Args) -> dict:
         try:
             table = yaml.safe_load(Path(args.hyperparams).read_text())
         except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
-            raise TrainArgumentError(f"--hyperparams {args.hyperparams}: cannot read it ({exc})".replace("\n", " "))
+            raise TrainArgumentError(
+                f"--hyperparams {args.hyperparams}: cannot read it ({exc})".replace("\n", " ")
+            ) from exc
         if not isinstance(table, dict) or not isinstance(table.get("default"), dict):
             raise TrainArgumentError(f"--hyperparams {args.hyperparams}: a YAML mapping with a 'default' entry expected")
     else:
@@ -189,10 +192,8 @@ def load_config(args: Args) -> dict:
             raise TrainArgumentError(f"--set {item!r}: expected key=value with key in {sorted(config)}")
         parsed = yaml.safe_load(value)
         if isinstance(parsed, str):  # YAML 1.1 reads "1e-4" as a string
-            try:
+            with contextlib.suppress(ValueError):
                 parsed = float(parsed)
-            except ValueError:
-                pass
         config[key] = parsed
     if args.recurrent:
         config["algo"] = "RecurrentPPO"
@@ -325,14 +326,17 @@ def main(argv=None) -> Path:
         eval_env = VecNormalize(eval_env, norm_obs=config["normalize_obs"], norm_reward=False, training=False)
 
     # 2. The algorithm.
-    common = dict(
-        n_steps=int(config["n_steps"]), batch_size=int(config["batch_size"]), n_epochs=int(config["n_epochs"]),
-        learning_rate=float(config["learning_rate"]), gamma=float(config["gamma"]),
-        gae_lambda=float(config["gae_lambda"]), clip_range=float(config["clip_range"]),
-        ent_coef=float(config["ent_coef"]), vf_coef=float(config["vf_coef"]),
-        max_grad_norm=float(config["max_grad_norm"]), seed=args.seed, device=args.device, verbose=0,
-        policy_kwargs=dict(net_arch=list(config["net_arch"]), log_std_init=float(config["log_std_init"])),
-    )
+    common = {
+        "n_steps": int(config["n_steps"]), "batch_size": int(config["batch_size"]),
+        "n_epochs": int(config["n_epochs"]),
+        "learning_rate": float(config["learning_rate"]), "gamma": float(config["gamma"]),
+        "gae_lambda": float(config["gae_lambda"]), "clip_range": float(config["clip_range"]),
+        "ent_coef": float(config["ent_coef"]), "vf_coef": float(config["vf_coef"]),
+        "max_grad_norm": float(config["max_grad_norm"]), "seed": args.seed, "device": args.device,
+        "verbose": 0,
+        "policy_kwargs": {"net_arch": list(config["net_arch"]),
+                          "log_std_init": float(config["log_std_init"])},
+    }
     if config["algo"] == "RecurrentPPO":
         from sb3_contrib import RecurrentPPO
 

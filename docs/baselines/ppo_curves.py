@@ -68,7 +68,7 @@ def main(argv=None) -> None:
                          label=f"belief_intercept on EyeCatch-v0, nothing learned: {args.base:.0%} (200 throws)")
     for k, item in enumerate(args.line):
         rate, _, text = item.partition("=")
-        style = dict(color=f"C{k + 5}", lw=1.0, ls="-.")
+        style = {"color": f"C{k + 5}", "lw": 1.0, "ls": "-."}
         ax_min.axhline(float(rate), **style)
         ax_steps.axhline(float(rate), label=text, **style)
     fig.legend(*ax_steps.get_legend_handles_labels(), loc="outside lower center", ncols=2, fontsize=7)

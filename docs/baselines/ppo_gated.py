@@ -1,5 +1,5 @@
-"""What a gated-gaze PPO policy learned (issue 15): catch, where the eye looks, and how often the look
-gate is on, beside its frozen-gaze twin, the structure's fixed bases and Eyecatch.
+"""What a gated-gaze PPO policy learned (docs/baselines/ppo.md): catch, where the eye looks, and how often the
+look gate is on, beside its frozen-gaze twin, the structure's fixed bases and Eyecatch.
 
 Each agent plays the pinned throws (episode i: seed i) through the evaluator's own ``run_episode``
 on the registered env, so catch rates equal ``vmgym bench``'s. Per agent: catch rate with its Wilson
@@ -29,7 +29,7 @@ from visuomotor_gym.bench.trace import run_episode
 from visuomotor_gym.metrics.summary import summarize
 
 sys.path.insert(0, str(Path(__file__).parent))
-from ppo_gaze import gaze_error_deg  # noqa: E402
+from ppo_gaze import gaze_error_deg
 
 
 class _Recorder:

@@ -1,5 +1,5 @@
-"""PPO on ObstacleWalk-v0 (issue 15): the table of outcomes and gaze statistics from bench traces,
-and the learning curve against wall time.
+"""PPO on ObstacleWalk-v0 (docs/baselines/ppo.md): the table of outcomes and gaze statistics from bench
+traces, and the learning curve against wall time.
 
     vmgym bench --agent AGENT --env ObstacleWalk-v0 --episodes 200 --seed 0 --out A.json --traces A.npz
     python docs/baselines/ppo_walk.py table A.npz [B.npz ...] --out rows.json
@@ -23,7 +23,6 @@ import math
 from pathlib import Path
 
 import numpy as np
-
 
 BESIDE_M = 0.3  # modelling choice: a foot lands at most ~0.3 m beside the pelvis (step width 0.12 m + offset)
 

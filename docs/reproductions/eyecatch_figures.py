@@ -19,6 +19,7 @@ and prints the numbers quoted on the page.
 from __future__ import annotations
 
 import argparse
+import itertools
 import os
 from pathlib import Path
 
@@ -26,10 +27,10 @@ import numpy as np
 
 os.environ.setdefault("MUJOCO_GL", "egl")
 
-from visuomotor_gym.bench.evaluate import evaluate  # noqa: E402
-from visuomotor_gym.metrics import gaze as gaze_metrics  # noqa: E402
-from visuomotor_gym.metrics import hand as hand_metrics  # noqa: E402
-from visuomotor_gym.viz.plots import _new_figure, plot_episode  # noqa: E402
+from visuomotor_gym.bench.evaluate import evaluate
+from visuomotor_gym.metrics import gaze as gaze_metrics
+from visuomotor_gym.metrics import hand as hand_metrics
+from visuomotor_gym.viz.plots import _new_figure, plot_episode
 
 OUT = Path(__file__).resolve().parent / "images"
 
@@ -125,7 +126,7 @@ def main(argv=None) -> None:
     fig = _new_figure((6.0, 3.6))
     ax = fig.add_subplot()
     centres, rates, counts = [], [], []
-    for lo, hi in zip(edges[:-1], edges[1:]):
+    for lo, hi in itertools.pairwise(edges):
         m = (left >= lo) & (left < hi)
         if m.sum():
             centres.append(0.5 * (lo + hi))

@@ -1,4 +1,4 @@
-"""Regenerate the numbers and figures of docs/reproductions/faraway.md (seed 002, Faraway et al. 2007).
+"""Regenerate the numbers and figures of docs/reproductions/faraway.md (Faraway et al. 2007).
 
     python docs/reproductions/faraway_figures.py [--subjects 20] [--seed 0]
 
@@ -31,9 +31,9 @@ HERE = Path(__file__).resolve().parent
 OUT = HERE / "images"
 NUMBERS = HERE / "faraway_numbers.json"
 
-# ---- layout (modelling choice; seed 002 Sec. 2 gives only "three towers (in front of the subject, to
-# the right-hand side and 45 deg to the right), at five levels ranging from eye to ankle level and two
-# depths (near and far)" and a median reach of 56.7 cm). Body coordinates in metres: x to the subject's
+# ---- layout (modelling choice; Faraway et al. 2007, Sec. 2, give only "three towers (in front of the
+# subject, to the right-hand side and 45 deg to the right), at five levels ranging from eye to ankle level and
+# two depths (near and far)" and a median reach of 56.7 cm). Body coordinates in metres: x to the subject's
 # right, y forward, z up, origin between the feet on the floor.
 HOME_M = np.array([0.15, 0.25, 1.00])  # home shelf in front of the right hip (our choice)
 TOWER_AZIMUTH_DEG = (0.0, 45.0, 90.0)  # front, 45 deg right, right (sourced)
@@ -43,10 +43,11 @@ LEVEL_M = np.linspace(0.10, 1.55, 5)  # ankle to eye height of a ~1.70 m adult, 
 FORWARD, UP = (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)  # so the paper's lateral axis (forward x up) is +x = right
 
 # ---- synthetic reaches
-SAMPLE_HZ = 25.0  # seed 002 Sec. 2: motion capture at 25 Hz
+SAMPLE_HZ = 25.0  # Faraway et al. (2007), Sec. 2: motion capture at 25 Hz
 DURATION_S = (0.8, 1.4)  # reach durations, uniform (our choice; only sets the number of samples)
 SPEED_SHAPE_SD = 0.2  # log-normal spread of alpha and beta per subject and target (our choice; see page)
-# calibration targets (seed 002 Sec. 4, Tables 1-2): replicate and between-subject variation, cubic fit error
+# calibration targets (Faraway et al. 2007, Sec. 4, Tables 1-2): replicate and between-subject
+# variation, cubic fit error
 TARGETS = {"within_cm": 6.7, "between_cm": 7.6, "cubic_cm": 1.7}
 
 
@@ -132,8 +133,8 @@ def cm_median(values) -> float:
 
 
 def natural_variation(reaches) -> tuple[float, float]:
-    """(within, between) in cm: seed 002 Sec. 4's median of maximum distances over relative time between
-    replicate pairs, and from each group's (target's) pointwise median trajectory over subjects."""
+    """(within, between) in cm: Faraway et al.'s (2007, Sec. 4) median of maximum distances over relative time
+    between replicate pairs, and from each group's (target's) pointwise median trajectory over subjects."""
     within = [H.path_distance(rs[0], rs[1], align="time", reduce="max") for per in reaches for rs in per]
     between = []
     for k in range(len(reaches[0])):
@@ -203,7 +204,7 @@ def evaluate(reaches, targets: np.ndarray) -> dict:
             errs.append(H.fit_error(z, H.fit_bezier(z, 3, s=s), s=s))
         res[name] = errs
 
-    # null models from the fitted cubics (seed 002 Sec. 4), refitted on these synthetic data
+    # null models from the fitted cubics (Faraway et al. 2007, Sec. 4), refitted on these synthetic data
     cubics = fits[3]
     lengths = np.array([np.linalg.norm(p[3] - p[0]) for p in cubics])
     axis = np.stack([axis_offsets(p, frame) for p in cubics])  # (N, 2, 3), metres, body frame
@@ -272,7 +273,7 @@ VIEWS = (
 
 
 def figure_layout(targets: np.ndarray) -> None:
-    """Predicted reaches to the 30 targets (seed 002 Fig. 7 style), straight lines dashed."""
+    """Predicted reaches to the 30 targets (Faraway et al. 2007, Fig. 7 style), straight lines dashed."""
     fig, axes = plt.subplots(1, 3, figsize=(13, 4.4))
     for ax, (title, i, j, xl, yl) in zip(axes, VIEWS):
         for t in targets:
@@ -294,7 +295,8 @@ def figure_layout(targets: np.ndarray) -> None:
 
 
 def figure_group(reaches, targets: np.ndarray, k: int) -> None:
-    """20 synthetic subjects to one target (seed 002 Fig. 2 style) with the model and the straight line."""
+    """20 synthetic subjects to one target (Faraway et al. 2007, Fig. 2 style) with the model and the
+    straight line."""
     fig, axes = plt.subplots(1, 3, figsize=(13, 4.4))
     t = targets[k]
     model = H.faraway_path(HOME_M, t, 60, forward=FORWARD, up=UP) * 100
@@ -344,8 +346,8 @@ def figure_fit(z: np.ndarray) -> None:
         ax.set(title=title, xlabel=xl, ylabel=yl, aspect="equal")
     axes[0].legend(loc="best", fontsize=8)
     fig.suptitle(
-        "Arc-length least-squares fit (seed 002 Sec. 3.2) of one synthetic reach; circles: cubic control "
-        "points; legend: maximum error"
+        "Arc-length least-squares fit (Faraway et al. 2007, Sec. 3.2) of one synthetic reach; circles: "
+        "cubic control points; legend: maximum error"
     )
     fig.tight_layout()
     fig.savefig(OUT / "faraway_fit_example.png", dpi=110)

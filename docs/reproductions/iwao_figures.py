@@ -1,5 +1,5 @@
 """Figures and numbers of docs/reproductions/iwao.md: head and eye pitch per gait cycle of the ``iwao``
-agent on ObstacleWalk-v0 (Iwao et al., seed 003, Fig. 6-8 and Eq. 1-10) and its gaze on the ground
+agent on ObstacleWalk-v0 (Iwao et al., Fig. 6-8 and Eq. 1-10) and its gaze on the ground
 plane over one course.
 
     MUJOCO_GL=egl python docs/reproductions/iwao_figures.py [--episodes 10]

@@ -32,7 +32,7 @@ from pathlib import Path
 # The digests were made with OpenBLAS's Haswell kernels (visuomotor_gym._blas): choose them before numpy loads.
 os.environ.setdefault("OPENBLAS_CORETYPE", "Haswell")
 
-import numpy as np  # noqa: E402
+import numpy as np
 
 GOLDEN_FILE = Path(__file__).with_name("digests.json")
 STEPS_FILE = Path(__file__).with_name("steps.json.gz")

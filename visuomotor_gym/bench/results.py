@@ -190,7 +190,7 @@ def _semantic_problems(obj: dict) -> list[tuple[str, str]]:
 
     out = []
     env_id = obj.get("env_id")
-    if isinstance(env_id, str) and env_id not in ENV_IDS:  # any family (issue 10), not only catch
+    if isinstance(env_id, str) and env_id not in ENV_IDS:  # any family, not only catch
         out.append(("$.env_id", f"{env_id!r} is not a registered environment id "
                                  f"(known: {', '.join(ENV_IDS)})"))
 
@@ -219,7 +219,7 @@ def _semantic_problems(obj: dict) -> list[tuple[str, str]]:
             out.append(("$.catch_rate_ci95", f"interval [{low}, {high}] is not the 95 % Wilson interval of "
                                               f"{caught}/{episodes}, [{expected[0]}, {expected[1]}]"))
 
-    out += _success_problems(obj, episodes if episodes_ok else None, rate, env_id)
+    out += _success_problems(obj, episodes if episodes_ok else None, env_id)
     out += _gaze_gain_problems(obj, episodes if episodes_ok else None)
 
     seeds = obj.get("seeds")
@@ -255,11 +255,12 @@ def _semantic_problems(obj: dict) -> list[tuple[str, str]]:
     return out
 
 
-def _success_problems(obj: dict, episodes: int | None, catch_rate, env_id) -> list[tuple[str, str]]:
+def _success_problems(obj: dict, episodes: int | None, env_id) -> list[tuple[str, str]]:
     """``success_rate`` (optional: results written before it lack the pair) is k / episodes for an
     integer k, ``success`` (optional, newer still) is k, the interval is the Wilson interval of k, and
-    on a catch env id success is the catch."""
-    from visuomotor_gym.registration import CATCH_ENV_IDS
+    each of the family's own names of the success rate (its record's ``rate_aliases``: ``catch_rate``
+    on a catch env id, where success is the catch) equals it."""
+    from visuomotor_gym.families import family_for
 
     rate, ci = obj.get("success_rate"), obj.get("success_rate_ci95")
     if not _is_num(rate) or episodes is None:
@@ -277,9 +278,15 @@ def _success_problems(obj: dict, episodes: int | None, catch_rate, env_id) -> li
         if expected is not None and any(abs(a - b) > TOLERANCE for a, b in zip(ci, expected)):
             out.append(("$.success_rate_ci95", f"interval [{ci[0]}, {ci[1]}] is not the 95 % Wilson interval "
                                                 f"of {k}/{episodes}, [{expected[0]}, {expected[1]}]"))
-    if env_id in CATCH_ENV_IDS and _is_num(catch_rate) and abs(rate - catch_rate) > TOLERANCE:
-        out.append(("$.success_rate", f"success_rate = {rate} differs from catch_rate = {catch_rate}: on a "
-                                       f"catch env id ({env_id}) success is the catch"))
+    try:
+        record = family_for(env_id) if isinstance(env_id, str) else None
+    except ValueError:  # an unknown id, reported on its own
+        record = None
+    for key in record.rate_aliases if record is not None else ():
+        alias = obj.get(key)
+        if _is_num(alias) and abs(rate - alias) > TOLERANCE:
+            out.append(("$.success_rate", f"success_rate = {rate} differs from {key} = {alias}: on a "
+                                           f"{record.name} env id ({env_id}) {key} is the success rate"))
     return out
 
 

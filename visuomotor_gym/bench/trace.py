@@ -93,7 +93,7 @@ class EpisodeTrace:
             kwargs[f.name] = kind(value) if kind is not None else value
         task_prefix = f"{prefix}task/"
         task = {}
-        for key in arrays.keys():
+        for key in arrays:
             if key.startswith(task_prefix):
                 value = arrays[key]
                 task[key[len(task_prefix):]] = value.item() if value.ndim == 0 else value

@@ -1,4 +1,4 @@
-"""The walker with a heading-and-speed action (ObstacleDodge, issue 13): a subclass of
+"""The walker with a heading-and-speed action (ObstacleDodge): a subclass of
 :class:`~visuomotor_gym.body.walker_body.WalkerBody` whose action block ``locomotion`` replaces the
 footstep block; ObstacleWalk's body is unchanged.
 
@@ -19,7 +19,7 @@ the path's +x, + = left), linear onto [-30, 30] deg; speed, piecewise linear ont
 gait's step lengths allow at its fixed 0.5 s per step (``GaitParams.step_range_m`` 0.25-0.95 m): humans
 slow right down when a pedestrian cuts in (Olivier et al. 2012 report speed as well as course
 adaptations), so the body offers the gait's whole range; it cannot stop (the gait's cadence is fixed).
-Until issue 13's second pass the floor was 0.7 m/s (a modelling choice with no source; the sweep is in
+In the first definition of v0 the floor was 0.7 m/s (a modelling choice with no source; the sweep is in
 docs/reproductions/dodge.md). Toe clearance stays at the gait's nominal 5 cm (the floor is flat).
 """
 
@@ -39,7 +39,7 @@ NOMINAL_SPEED_M_S = 1.3  # the gait's nominal 0.65 m step per 0.5 s: the action'
 class DodgeBody(WalkerBody):
     """:class:`WalkerBody` with the ``locomotion`` (heading, speed) action block."""
 
-    action_structure = {"locomotion": 2}
+    action_structure = {"locomotion": 2}  # noqa: RUF012 (a body replaces it, never mutates it)
     n_action = 2
 
     def footstep_from_locomotion(self, a0: float, a1: float) -> tuple[float, float, float]:

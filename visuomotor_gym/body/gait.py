@@ -1,4 +1,4 @@
-# ruff: noqa: PLR1730, FURB136  (the per-step path writes min/max as the builtins' comparisons, on purpose)
+# The per-step path writes min/max as the builtins' comparisons, on purpose.
 """The walker's scripted gait: a footstep-level interface on a kinematic gait that physics servos track.
 
 The gait only: the footstep plan, the pelvis and foot trajectories, the legs' inverse kinematics and the
@@ -580,11 +580,11 @@ class WalkerGait:
         # Lower the pelvis where a leg would otherwise over-reach (long steps).
         d_max2 = self._d_max2
         r = d_max2 - du0 * du0 - dv0 * dv0
-        zmax = left[2] + sqrt(0.0 if 0.0 > r else r)  # max(r, 0.0)
+        zmax = left[2] + sqrt(0.0 if r < 0.0 else r)  # max(r, 0.0)
         if zmax < z:
             z = zmax
         r = d_max2 - du1 * du1 - dv1 * dv1
-        zmax = right[2] + sqrt(0.0 if 0.0 > r else r)
+        zmax = right[2] + sqrt(0.0 if r < 0.0 else r)
         if zmax < z:
             z = zmax
         c, s = self.path_cos, self.path_sin
@@ -662,9 +662,9 @@ class WalkerGait:
         if d_max2 < d2:  # min(d2, d_max^2)
             d2 = d_max2
         cos_k = (d2 - self._L1sq - self._L2sq) / self._L12x2
-        if -1.0 > cos_k:  # min(max(cos_k, -1), 1)
+        if cos_k < -1.0:  # min(max(cos_k, -1), 1)
             cos_k = -1.0
-        if 1.0 < cos_k:
+        if cos_k > 1.0:
             cos_k = 1.0
         knee = acos(cos_k)
         L2 = self.L2

@@ -5,7 +5,7 @@ The catch family's body is unchanged: this subclass only sets another reset post
 mode, another way of producing the hand reference that the same damped-least-squares controller
 follows (:mod:`visuomotor_gym.control.hand`).
 
-Bézier hand action (seed 002, Faraway, Reed & Wang 2007)
+Bézier hand action (Faraway, Reed & Wang 2007)
 ---------------------------------------------------------
 The body's action blocks are ``hand_target`` (3, the reach's end point, mapped onto the hand workspace as
 in ``control="hand"``), ``bezier_y1`` and ``bezier_y2`` (3 each: the two interior control points' offsets
@@ -15,9 +15,9 @@ forward, up) of :func:`visuomotor_gym.handpath.body_frame`; -1..1 maps onto -0.5
 ``grasp``. A reach starts at the hand reference and ends at ``hand_target``; the two offsets and the
 duration are latched at its start, the end point follows ``hand_target`` while it runs (on-line
 correction). At relative time tau the reference sits at relative arc length F(tau) of the curve, F the
-Beta(1.63, 1.75) CDF (seed 002 Sec. 4; :func:`visuomotor_gym.handpath.faraway_path`'s default timing).
-Zero offsets give a straight reach; ``bezier_y1 = FARAWAY_Y1 / 0.5`` and ``bezier_y2 = FARAWAY_Y2 / 0.5``
-give Faraway's mean path. Between reaches the reference holds the last reach's end.
+Beta(1.63, 1.75) CDF (Faraway et al. 2007, Sec. 4; :func:`visuomotor_gym.handpath.faraway_path`'s default
+timing). Zero offsets give a straight reach; ``bezier_y1 = FARAWAY_Y1 / 0.5`` and ``bezier_y2 = FARAWAY_Y2 /
+0.5`` give Faraway's mean path. Between reaches the reference holds the last reach's end.
 """
 
 from __future__ import annotations
@@ -34,7 +34,7 @@ from visuomotor_gym.oculomotor.plant import DEG
 
 HAND_ACTIONS = ("target", "bezier")
 # Reset posture of the reaching body (degrees): the catch site rests ~0.32 m in front of the pelvis at
-# belly height near the midline, (0.32, -0.05, 0.74) m in the world: the seated analogue of seed 002's
+# belly height near the midline, (0.32, -0.05, 0.74) m in the world: the seated analogue of Faraway et al.'s
 # "small home shelf in front of the subject" (Sec. 2). Modelling choice (joint values picked so that the
 # hand starts clear of the towers and every target is reached by Faraway's path without touching them).
 HOME_POSTURE_DEG = {
@@ -47,7 +47,7 @@ HOME_POSTURE_DEG = {
     "wrist_dev": 0.0,
 }
 # Bézier action ranges (modelling choice): offsets up to half the reach length (Faraway's means are
-# <= 0.15 of it), durations 0.2-2 s (seed 002's reaches, sampled at 25 Hz, last about a second).
+# <= 0.15 of it), durations 0.2-2 s (Faraway et al.'s reaches, sampled at 25 Hz, last about a second).
 BEZIER_OFFSET_RANGE = 0.5
 REACH_DURATION_RANGE_S = (0.2, 2.0)
 _ARC_SAMPLES = 65  # samples of the curve for its arc-length table (chord error < 0.1 mm on these reaches)
@@ -92,7 +92,7 @@ class ReachSeatedBody(SeatedBody):
             self.action_structure = {"hand_target": 3, "bezier_y1": 3, "bezier_y2": 3, "reach_duration": 1,
                                      "reach_start": 1, "grasp": 1}
             self.n_action = sum(self.action_structure.values())
-            self.observation_blocks = tuple(self.observation_blocks) + (REACH_PROGRESS_BLOCK,)
+            self.observation_blocks = (*self.observation_blocks, REACH_PROGRESS_BLOCK)
         self._reset_reach()
 
     def _reset_reach(self) -> None:

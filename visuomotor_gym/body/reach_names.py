@@ -8,7 +8,7 @@ from __future__ import annotations
 
 SCENE = "reach.xml"
 
-# The three towers of seed 002's layout (Faraway, Reed & Wang 2007, Sec. 2: "in front of the subject,
+# The three towers of Faraway, Reed & Wang's layout (2007, Sec. 2: "in front of the subject,
 # to the right-hand side and 45 deg to the right"), in target order.
 TOWER_KEYS = ("front", "right45", "right90")
 TOWERS = tuple(f"tower_{k}" for k in TOWER_KEYS)
@@ -30,7 +30,7 @@ TOP_CAMERA = "top_camera"
 CAMERAS = (SCENE_CAMERA, OVER_SHOULDER_CAMERA, TOP_CAMERA)
 
 ALL_NAMES = {
-    "body": TOWERS + (OBJECT,),
+    "body": (*TOWERS, OBJECT),
     "geom": BOARDS + PANELS + (OBJECT_GEOM,),
     "camera": CAMERAS,
 }

@@ -51,7 +51,7 @@ class WalkerBody(Body):
 
     observation_blocks = WALKER_BLOCKS
     trace_step_fields = ("pelvis_pos", "feet_pos")
-    action_structure = {"footstep": 3}
+    action_structure = {"footstep": 3}  # noqa: RUF012 (a body replaces it, never mutates it)
     n_action = 3
     gait_class = WalkerGait
 
@@ -140,7 +140,8 @@ class WalkerBody(Body):
         }
 
 
-TURNING_WALKER_BLOCKS = WALKER_BLOCKS + (
+TURNING_WALKER_BLOCKS = (
+    *WALKER_BLOCKS,
     Block("foothold_headings", N_FOOTHOLDS_OBSERVED, "rad",
           "heading of each of the three footholds of the footholds block (the direction its foot points "
           "when flat on it and the frame of the next footstep), relative to the pelvis heading, + = left"),

@@ -27,7 +27,6 @@ from visuomotor_gym.core import args
 from visuomotor_gym.core.args import Num
 from visuomotor_gym.geometry import solve3
 
-
 # What each HandControlParams field accepts (visuomotor_gym.core.args.check_fields): non-negative, and
 # bounded by modelling choices (5x the human hand's 2 m/s, a setpoint step of at most half a turn).
 HAND_RULES = {

@@ -11,9 +11,8 @@ from typing import Any
 
 def choice(value: Any, allowed, arg_name: str):
     """``value`` if it is one of ``allowed``, else ``ValueError`` listing the allowed values."""
-    if isinstance(value, str) or value is None:
-        if value in allowed:
-            return value
+    if (isinstance(value, str) or value is None) and value in allowed:
+        return value
     raise ValueError(f"{arg_name}={value!r} is not one of {list(allowed)}")
 
 

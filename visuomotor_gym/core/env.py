@@ -25,7 +25,7 @@ import math
 import os
 import warnings
 from dataclasses import asdict
-from typing import Any
+from typing import Any, ClassVar
 
 import gymnasium as gym
 import mujoco
@@ -79,9 +79,10 @@ def _doc_default(value) -> str:
 class VisuomotorEnv(gym.Env):
     """The shared skeleton (see the module docstring). Not registered itself."""
 
-    metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 50}
+    # Replaced per instance (render_fps from the step length, _load_physics), never mutated in place.
+    metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 50}  # noqa: RUF012
     # Camera sets of ``render_camera``; a family may override (names from its scene).
-    render_cameras: dict[str, tuple[str, ...]] = {}
+    render_cameras: ClassVar[dict[str, tuple[str, ...]]] = {}
     eye_camera: str = ""
 
     # --- construction -------------------------------------------------------------------------

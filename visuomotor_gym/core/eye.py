@@ -266,4 +266,4 @@ class Eye:
         scene.ngeom += 1
 
 
-__all__ = ["EYE_ACTION_STRUCTURE", "EYE_BLOCKS", "Eye", "GAZE_AGE_CAP_S", "OculomotorParams"]
+__all__ = ["EYE_ACTION_STRUCTURE", "EYE_BLOCKS", "GAZE_AGE_CAP_S", "Eye", "OculomotorParams"]

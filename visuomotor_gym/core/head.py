@@ -27,7 +27,7 @@ HEAD_ACTION_STRUCTURE = {"head": 2}
 HEAD_FRAGMENT = "common/head_eye.xml"
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def neck_range_deg() -> tuple[tuple[float, float], ...]:
     """(yaw, pitch) joint ranges in degrees, read from the head+eye fragment's neck joints."""
     root = ET.parse(asset_path(HEAD_FRAGMENT)).getroot()

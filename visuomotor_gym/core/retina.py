@@ -110,7 +110,7 @@ class Retina:
         self._cos_fov = math.cos(min(params.field_of_view_deg * foveation.DEG + 1e-9, math.pi))
         # The compiled _see_all (visuomotor_gym._native, _kernels.c: retina_see_all), when built; its
         # constants in the order of its VisionConsts struct.
-        # Issue 23's peripheral mechanisms (params.periphery_on) run on the pure-Python path only.
+        # The periphery's mechanisms (params.periphery_on) run on the pure-Python path only.
         self._native = _native.enabled() and not params.periphery_on
         deg = foveation.DEG
         self._native_constants = np.array([

@@ -9,7 +9,7 @@ documentation.
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, ClassVar
 
 from visuomotor_gym.body import names
 from visuomotor_gym.body.seated import CONTROL_MODES, HAND_WORKSPACE, SEAT_ORIGIN, SeatedBody
@@ -17,11 +17,11 @@ from visuomotor_gym.control.hand import HandControlParams
 from visuomotor_gym.core import args
 from visuomotor_gym.core.env import VisuomotorEnv
 from visuomotor_gym.envs.observation import SECOND_BALL_OBSERVATION, ObservationLayout, catch_observation
-from visuomotor_gym.tasks.catch_rewards import REWARD_TERMS, SHAPED_WEIGHTS, SPARSE_WEIGHTS
 from visuomotor_gym.scenarios.throws import ThrowDistribution
 from visuomotor_gym.tasks.catch import CatchTask, catch_scene
+from visuomotor_gym.tasks.catch_rewards import REWARD_TERMS, SHAPED_WEIGHTS, SPARSE_WEIGHTS
 
-__all__ = ["EyeCatchEnv", "HAND_WORKSPACE", "SEAT_ORIGIN"]
+__all__ = ["HAND_WORKSPACE", "SEAT_ORIGIN", "EyeCatchEnv"]
 
 REWARD_MODES = ("sparse", "shaped")
 
@@ -131,7 +131,7 @@ class EyeCatchEnv(VisuomotorEnv):
 
     ## Version History
 
-    * v0: initial release. Before the first release (issue 11) the default vision gained the retinal-slip
+    * v0: initial release. Before the first release the default vision gained the retinal-slip
       term of moving-target localisation (``VisionParams.position_slip_knee_deg_s`` = 2.5), so that where
       the eye looks decides the catch; the Eyecatch paper's static acuity is ``EyeCatchPaper-v0`` and
       ``EyeCatchPaperPoorVision-v0`` (x10). The oculomotor plant pursues like a human (150 ms latency,
@@ -140,7 +140,7 @@ class EyeCatchEnv(VisuomotorEnv):
       The leaderboard entries made before are superseded.
     """
 
-    render_cameras = {
+    render_cameras: ClassVar[dict[str, tuple[str, ...]]] = {
         "both": (names.SCENE_CAMERA, names.EYE_CAMERA),
         "scene": (names.SCENE_CAMERA,),
         "eye": (names.EYE_CAMERA,),
@@ -241,7 +241,7 @@ RENDER_CAMERAS = tuple(EyeCatchEnv.render_cameras)
 
 
 # ---------------------------------------------------------------- the family record (visuomotor_gym.family)
-from visuomotor_gym.family import BeliefMPC, ExtraEnv, Family
+from visuomotor_gym.family import BeliefMPC, ExtraEnv, Family, Viz
 
 CATCH_MAX_EPISODE_STEPS = 125  # 2.5 s at 50 Hz: the longest flight is 1.4 s
 TWO_BALLS_MAX_EPISODE_STEPS = 150  # 3 s: the second ball arrives at most 2.2 s after the first release
@@ -280,4 +280,23 @@ FAMILY = Family(
     golden_extra=(("oracle", "EyeCatchOracle-v0"),),
     belief_mpc=BeliefMPC("visuomotor_gym.baselines.belief_mpc:BeliefMPCAgent",
                          "visuomotor_gym.baselines.belief_mpc.agent:BeliefMPCParams", env_vision=True),
+    rate_aliases=("catch_rate",),  # the catch summary's own name of the success rate
+    viz=Viz(
+        figure="visuomotor_gym.viz.plots:catch_figure",
+        contents="gaze vs ball azimuth/elevation over time with saccades (Eyecatch Fig. 3/12), hand and eye speed "
+                 "(Fig. 4), the visual field, 3-D ball and hand paths",
+        trace_field="ball_pos",
+        scene_view="scene_camera",
+        video_stride=1,
+        dpi=110,
+        outcome_words=("caught", "missed"),
+        failure_field="missed",
+    ),
+    doc_links=(("Eyecatch (Yeo et al. 2012)", "reproductions/eyecatch.md"),
+               ("Eom et al. 2019: belief MPC, two balls", "reproductions/eom.md"),
+               ("The default vision: moving-target localisation", "reproductions/gaze_default.md"),
+               ("PPO baselines", "baselines/ppo.md")),
+    doc_pictures=(("images/eyecatch_record_frame.png",
+                   ("The Eyecatch agent catching: scene camera (the green line is its line of sight) beside its "
+                    "eye camera")),),
 )

@@ -1,5 +1,5 @@
 """ObstacleDodge: walk to a goal while pedestrians cross the path, seen only through a foveated, saccading
-eye (issue 13; Eom et al. section 7, seed 001).
+eye (Eom, Han, Shin & Noh 2019, Sec. 7, "Moving obstacle avoidance").
 
 ``ObstacleDodgeEnv`` composes the embodiment core (:mod:`visuomotor_gym.core`), the walker with a
 heading-and-speed action (:mod:`visuomotor_gym.body.dodge_body` over the scripted gait of
@@ -8,7 +8,7 @@ heading-and-speed action (:mod:`visuomotor_gym.body.dodge_body` over the scripte
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, ClassVar
 
 from visuomotor_gym.body import names
 from visuomotor_gym.body import walker_names as wn
@@ -105,10 +105,10 @@ class ObstacleDodgeEnv(WalkerEnv):
 
     ## Version History
 
-    * v0: initial release (issue 13).
+    * v0: initial release.
     """
 
-    render_cameras = {
+    render_cameras: ClassVar[dict[str, tuple[str, ...]]] = {
         "both": (DODGE_TOP_CAMERA, names.EYE_CAMERA),
         "side": (wn.WALKER_SIDE_CAMERA,),
         "follow": (wn.WALKER_FOLLOW_CAMERA,),
@@ -154,7 +154,7 @@ if ObstacleDodgeEnv.__doc__:
 
 
 # ---------------------------------------------------------------- the family record (visuomotor_gym.family)
-from visuomotor_gym.family import BeliefMPC, Family
+from visuomotor_gym.family import BeliefMPC, Family, FollowView, Viz
 
 DODGE_MAX_EPISODE_STEPS = 2000  # 40 s at 50 Hz: about three times the nominal walk (1.3 m/s) to the farthest (20 m) goal
 
@@ -175,4 +175,15 @@ FAMILY = Family(
     belief_mpc=BeliefMPC("visuomotor_gym.baselines.belief_mpc.dodge:DodgeBeliefMPCAgent",
                          "visuomotor_gym.baselines.belief_mpc.dodge:DodgeBeliefMPCParams",
                          vision_note="env_vision_params"),
+    viz=Viz(
+        figure="visuomotor_gym.viz.family_plots:dodge_figure",
+        contents="top view: walker and pedestrian paths with times, the line of sight and where it meets a "
+                 "pedestrian (coloured by time); gaze angles, gaze-to-pedestrian angles and distances over time",
+        trace_field="pedestrian_pos",
+        # From behind and high: 6 m ahead and the pedestrians starting 4-6 m to either side.
+        scene_view=FollowView(distance=10.0, azimuth=0.0, elevation=-40.0, offset=(3.5, 0.0, -0.9), fovy=50.0),
+        video_stride=2,
+    ),
+    doc_links=(("Dodging pedestrians (Fajen & Warren 2003; Eom et al. 2019, section 7)", "reproductions/dodge.md"),),
+    doc_pictures=(("images/obstacledodge_record_frame.png", "The fajen_warren agent among the pedestrians"),),
 )

@@ -13,10 +13,11 @@ from __future__ import annotations
 from visuomotor_gym.body.seated import SEATED_BLOCKS
 from visuomotor_gym.core.eye import EYE_BLOCKS
 from visuomotor_gym.core.head import HEAD_BLOCKS
-from visuomotor_gym.core.observation import Block, ObservationLayout as _Layout
+from visuomotor_gym.core.observation import Block
+from visuomotor_gym.core.observation import ObservationLayout as _Layout
 from visuomotor_gym.tasks.catch import BALL_PERCEPT_BLOCKS, SECOND_BALL_BLOCKS, TIME_BLOCK
 
-__all__ = ["Block", "CATCH_OBSERVATION", "ObservationLayout", "SECOND_BALL_OBSERVATION", "catch_observation"]
+__all__ = ["CATCH_OBSERVATION", "SECOND_BALL_OBSERVATION", "Block", "ObservationLayout", "catch_observation"]
 
 CATCH_OBSERVATION = BALL_PERCEPT_BLOCKS + EYE_BLOCKS + HEAD_BLOCKS + SEATED_BLOCKS + (TIME_BLOCK,)
 SECOND_BALL_OBSERVATION = SECOND_BALL_BLOCKS

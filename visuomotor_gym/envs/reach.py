@@ -8,7 +8,7 @@ documentation.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, ClassVar
 
 from visuomotor_gym.body import names, reach_names
 from visuomotor_gym.body.reach_body import (
@@ -53,7 +53,7 @@ class ShelfReachEnv(VisuomotorEnv):
     The seated upper body of the catch family (3-DOF torso, 7-DOF right arm, 2-DOF neck, cyclopean
     eye) must reach, with its right hand, an object standing on one of **30 shelf targets: three
     towers (in front, 45 deg to the right, 90 deg to the right) x five heights x two depths**, the
-    layout of Faraway, Reed & Wang (2007, seed 002), whose Bézier model of human hand paths is the
+    layout of Faraway, Reed & Wang (2007), whose Bézier model of human hand paths is the
     realism reference of this family (``visuomotor_gym.handpath``). The object is seen **only through
     the eye**: its position reaches the agent as samples of the foveated noise model (Eyecatch Eq. 1-3;
     depth noise 5 % of the distance at the fovea, growing with eccentricity), nothing outside the
@@ -93,7 +93,7 @@ class ShelfReachEnv(VisuomotorEnv):
     ## Starting State
 
     The body sits upright with the hand at its home posture, in front of the belly near the midline
-    (~(0.32, -0.05, 0.74) m: the seated analogue of seed 002's home shelf). The target is drawn
+    (~(0.32, -0.05, 0.74) m: the seated analogue of Faraway et al.'s home shelf). The target is drawn
     uniformly from the 30, with a +-1 cm jitter on its board; the gaze starts on the front tower's middle
     level between its two depths, with a 2 deg Gaussian jitter. The same seed gives the same target on
     every rung of the ladder. ``info`` at reset: ``target_index`` (0-29: tower-major, then level, then
@@ -117,7 +117,7 @@ class ShelfReachEnv(VisuomotorEnv):
     * v0: initial release.
     """
 
-    render_cameras = {
+    render_cameras: ClassVar[dict[str, tuple[str, ...]]] = {
         "both": (reach_names.SCENE_CAMERA, names.EYE_CAMERA),
         "scene": (reach_names.SCENE_CAMERA,),
         "eye": (names.EYE_CAMERA,),
@@ -197,7 +197,7 @@ def _action_table() -> str:
         "|---|---|---|---|",
         f"| 0-2 | - | 0-2 | hand target (catch-site centre; with bezier: the reach's end point), seat frame, mapped from [-1, 1] to x in [{x0}, {x1}], y in [{y0}, {y1}], z in [{z0}, {z1}] m |",
         "| - | 0-9 | - | torso (3) and arm (7) joint setpoints, mapped onto each joint's range |",
-        f"| - | - | 3-5, 6-8 | interior control-point offsets Y1, Y2 per metre of reach, body frame (lateral right, forward, up), [-1, 1] onto [-{BEZIER_OFFSET_RANGE}, {BEZIER_OFFSET_RANGE}] (seed 002's axis parameterisation; 0 = straight) |",
+        f"| - | - | 3-5, 6-8 | interior control-point offsets Y1, Y2 per metre of reach, body frame (lateral right, forward, up), [-1, 1] onto [-{BEZIER_OFFSET_RANGE}, {BEZIER_OFFSET_RANGE}] (Faraway et al.'s axis parameterisation; 0 = straight) |",
         f"| - | - | 9 | reach duration, [-1, 1] onto [{lo}, {hi}] s |",
         "| - | - | 10 | reach start: > 0 starts a reach from the hand reference when none is in progress |",
         "| 3 | 10 | 11 | grasp: -1 open ... 1 closed |",
@@ -217,7 +217,7 @@ if ShelfReachEnv.__doc__:
 
 
 # ---------------------------------------------------------------- the family record (visuomotor_gym.family)
-from visuomotor_gym.family import Family
+from visuomotor_gym.family import Family, Viz
 
 REACH_MAX_EPISODE_STEPS = 150  # 3 s at 50 Hz: first saccade (~0.2 s), fixation, a ~0.6-1 s reach, slack (modelling choice)
 
@@ -234,4 +234,16 @@ FAMILY = Family(
     reaction_from_t0=True,  # the object appears at t = 0
     agents=("faraway",),
     golden_agent="faraway",
+    viz=Viz(
+        figure="visuomotor_gym.viz.family_plots:reach_figure",
+        contents="top and side view of the shelf: object, hand path, gaze point at the object's distance (coloured "
+                 "by time); gaze and object angles, gaze-object angle, hand-object distance and hand speed over time",
+        trace_field="object_pos",
+        scene_view="scene_camera",
+        video_stride=1,
+    ),
+    doc_links=(("Faraway et al. 2007: reaches as Bézier curves", "reproductions/faraway.md"),),
+    doc_pictures=(("images/shelfreach_record_frame.png", "The faraway agent reaching to a shelf target"),
+                  ("reproductions/images/faraway_reach_paths.png",
+                   "Hand paths of the faraway agent to the shelf targets")),
 )

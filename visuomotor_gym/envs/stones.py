@@ -1,5 +1,5 @@
-"""SteppingStones: cross a gap on stones seen only through a foveated, saccading eye (issue 13; Eom et
-al. 2019 section 7, seed 001).
+"""SteppingStones: cross a gap on stones seen only through a foveated, saccading eye (Eom, Han, Shin &
+Noh 2019, Sec. 7, "Walking on stepping stones").
 
 ``SteppingStonesEnv`` composes the embodiment core (:mod:`visuomotor_gym.core`), the turning walker
 (:class:`~visuomotor_gym.body.walker_body.TurningWalkerBody`: ObstacleWalk's body and gait with a turn
@@ -9,7 +9,7 @@ per footstep) on ``envs_assets/stones.xml`` and the stepping-stones task
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, ClassVar
 
 from visuomotor_gym.body import names
 from visuomotor_gym.body import walker_names as wn
@@ -47,7 +47,7 @@ class SteppingStonesEnv(WalkerEnv):
     benchmark, Xie et al. 2020), **seeing the stones only through a human-like eye**: the same
     oculomotor plant, foveated noise (Eyecatch Eq. 1-3), saccadic suppression and vestibulo-ocular
     reflex as the catch family, and the walk family's field: a stone is seen only within **20 deg of the
-    line of sight** (Iwao et al.'s view angle while walking, seed 003 section 4.2.3). The stone two steps
+    line of sight** (Iwao et al.'s view angle while walking, Sec. 4.2.3). The stone two steps
     ahead lies ~45 deg below a level gaze: to place its feet the walker has to look down at the stones,
     as humans fixate stepping targets about two steps ahead (Patla & Vickers 2003) and shift gaze to the
     next stone as the foot starts its swing (Eom et al. 2019 section 7).
@@ -122,12 +122,12 @@ class SteppingStonesEnv(WalkerEnv):
 
     ## Version History
 
-    * v0: initial release (issue 13). Redefined in place (issue 13, ALLSTEPS' turns): the walker turns
+    * v0: initial release. Redefined in place (ALLSTEPS' turns): the walker turns
       (a fourth footstep value, the ``foothold_headings`` block) and the path may drift to +-60 deg, where
       the first definition's walker kept its heading and the path stayed within +-20 deg (8 actions).
     """
 
-    render_cameras = {
+    render_cameras: ClassVar[dict[str, tuple[str, ...]]] = {
         "both": (wn.WALKER_SIDE_CAMERA, names.EYE_CAMERA),
         "side": (wn.WALKER_SIDE_CAMERA,),
         "follow": (wn.WALKER_FOLLOW_CAMERA,),
@@ -168,7 +168,7 @@ class SteppingStonesEnv(WalkerEnv):
 
 
 assert STONES_LAYOUT.structure == {b.name: b.size for b in STONES_LAYOUT.blocks}
-assert K_SLOTS == len(PERCEPT_BLOCKS)
+assert len(PERCEPT_BLOCKS) == K_SLOTS
 if SteppingStonesEnv.__doc__:
     SteppingStonesEnv.__doc__ = SteppingStonesEnv.__doc__.replace(
         "OBSERVATION_TABLE", "\n    ".join(STONES_LAYOUT.markdown_table().splitlines())
@@ -176,7 +176,7 @@ if SteppingStonesEnv.__doc__:
 
 
 # ---------------------------------------------------------------- the family record (visuomotor_gym.family)
-from visuomotor_gym.family import BeliefMPC, Family
+from visuomotor_gym.family import BeliefMPC, Family, FollowView, Viz
 
 STONES_MAX_EPISODE_STEPS = 1000  # 20 s at 50 Hz: twice the nominal crossing (~18 steps of 0.5 s) (modelling choice)
 
@@ -198,4 +198,17 @@ FAMILY = Family(
     belief_mpc=BeliefMPC("visuomotor_gym.baselines.belief_mpc.stones:StonesBeliefMPCAgent",
                          "visuomotor_gym.baselines.belief_mpc.stones:StonesBeliefMPCParams",
                          vision_note="stones_vision"),
+    viz=Viz(
+        figure="visuomotor_gym.viz.family_plots:stones_figure",
+        contents="top view: numbered stones, pelvis path, footholds, gaze on the floor (coloured by time); gaze "
+                 "angles and the stone under the gaze vs the feet's next stone over time",
+        trace_field="stones",
+        # From behind the walker, higher, turning with it: the next stones ahead (the path turns by up to 60 deg).
+        scene_view=FollowView(distance=5.0, azimuth=30.0, elevation=-50.0, offset=(1.5, 0.0, -0.8),
+                              follow_heading=True),
+        video_stride=2,
+    ),
+    doc_links=(("Stepping stones (Eom et al. 2019, section 7; Patla & Vickers 2003)", "reproductions/stones.md"),),
+    doc_pictures=(("images/steppingstones_record_frame.png", "The lookahead agent on SteppingStones-v0"),
+                  ("reproductions/images/stones_turning.png", "The lookahead agent turning through a 60 deg course")),
 )

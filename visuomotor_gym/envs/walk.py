@@ -1,5 +1,5 @@
-"""ObstacleWalk: walk a path across obstacles seen only through a foveated, saccading eye (issue 12;
-Iwao et al., seed 003).
+"""ObstacleWalk: walk a path across obstacles seen only through a foveated, saccading eye (Iwao
+et al.).
 
 ``ObstacleWalkEnv`` composes the embodiment core (:mod:`visuomotor_gym.core`), the walker
 (:mod:`visuomotor_gym.body.walker_body` over the scripted gait of :mod:`visuomotor_gym.body.walker`)
@@ -8,7 +8,7 @@ and the obstacle-walk task (:mod:`visuomotor_gym.tasks.obstacle_walk`).
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, ClassVar
 
 from visuomotor_gym.body import names
 from visuomotor_gym.body import walker_names as wn
@@ -21,10 +21,10 @@ from visuomotor_gym.core.head import HEAD_BLOCKS
 from visuomotor_gym.core.observation import ObservationLayout
 from visuomotor_gym.core.parts import Task
 from visuomotor_gym.tasks.obstacle_walk import (
+    COURSE_PRESETS,
     DEFAULT_REWARD_WEIGHTS,
     K_SLOTS,
     PERCEPT_BLOCKS,
-    COURSE_PRESETS,
     REWARD_TERMS,
     TRAILING_BLOCKS,
     CourseDistribution,
@@ -36,11 +36,11 @@ __all__ = ["OBSTACLE_VIEW_ANGLE_DEG", "WALK_LAYOUT", "WALK_VISION", "ObstacleWal
 
 RENDER_CAMERAS = ("both", "side", "follow", "scene", "eye")
 # The field in which an obstacle is seen at all: Iwao et al.'s view angle for obstacle recognition
-# while walking, theta_Vmax = 20 deg (seed 003 section 4.2.3: walkers look at an obstacle "indirectly",
+# while walking, theta_Vmax = 20 deg (Iwao et al., Sec. 4.2.3: walkers look at an obstacle "indirectly",
 # within their view angle; 20 deg walking, 30 deg running), instead of the eye's whole +-60 deg field
 # (Eom et al.) of the catch family. The noise law is the same. Measured (docs/reproductions/iwao.md):
 # with +-60 deg a gaze-blind twin that fuses its peripheral samples (iwao:gaze_blind=true) crossed 29 of
-# 30 courses, so looking would not be tested (DESIGN section 2); with 20 deg it fails most of them.
+# 30 courses, so looking would not be tested; with 20 deg it fails most of them.
 OBSTACLE_VIEW_ANGLE_DEG = 20.0
 WALK_VISION = VisionParams(field_of_view_deg=OBSTACLE_VIEW_ANGLE_DEG)
 WALK_LAYOUT = ObservationLayout(PERCEPT_BLOCKS + EYE_BLOCKS + HEAD_BLOCKS + WALKER_BLOCKS + TRAILING_BLOCKS)
@@ -84,9 +84,9 @@ class ObstacleWalkEnv(WalkerEnv):
     flat 70 cm mats, **seeing them only through a human-like eye**: the same oculomotor plant, foveated noise (Eyecatch Eq. 1-3),
     field of view, saccadic suppression and vestibulo-ocular reflex as the catch family. An obstacle
     2 m ahead lies ~40 deg below a level gaze, where the noise is ~20x the fovea's: to place its feet
-    the walker has to look down (Iwao et al., seed 003; Patla & Vickers 1997). An obstacle is seen
+    the walker has to look down (Iwao et al.; Patla & Vickers 1997). An obstacle is seen
     only within **20 deg of the line of sight**, Iwao et al.'s view angle for obstacle recognition while
-    walking (seed 003 section 4.2.3), not the eye's whole +-60 deg field: with the whole field, a
+    walking (Iwao et al., Sec. 4.2.3), not the eye's whole +-60 deg field: with the whole field, a
     walker whose gaze stays level fused enough peripheral glimpses to cross 29 of 30 courses.
 
     Walking is a scripted gait with a **footstep-level action** (DeepLoco-style footstep planning):
@@ -166,12 +166,12 @@ class ObstacleWalkEnv(WalkerEnv):
 
     ## Version History
 
-    * v0: initial release (issue 12); redefined before release: the 1.5 m walkway (off path ends the
+    * v0: initial release; redefined before release: the 1.5 m walkway (off path ends the
       episode), bars across it, four seen points per obstacle. Opt-in ``course_distribution="rough"``
-      (issue 23, prototype): the default course and its observations unchanged.
+      (prototype): the default course and its observations unchanged.
     """
 
-    render_cameras = {
+    render_cameras: ClassVar[dict[str, tuple[str, ...]]] = {
         "both": (wn.WALKER_SIDE_CAMERA, names.EYE_CAMERA),
         "side": (wn.WALKER_SIDE_CAMERA,),
         "follow": (wn.WALKER_FOLLOW_CAMERA,),
@@ -218,7 +218,7 @@ class ObstacleWalkEnv(WalkerEnv):
 
 
 assert WALK_LAYOUT.structure == {b.name: b.size for b in WALK_LAYOUT.blocks}
-assert K_SLOTS == len(PERCEPT_BLOCKS)
+assert len(PERCEPT_BLOCKS) == K_SLOTS
 if ObstacleWalkEnv.__doc__:
     ObstacleWalkEnv.__doc__ = ObstacleWalkEnv.__doc__.replace(
         "OBSERVATION_TABLE", "\n    ".join(WALK_LAYOUT.markdown_table().splitlines())
@@ -226,7 +226,7 @@ if ObstacleWalkEnv.__doc__:
 
 
 # ---------------------------------------------------------------- the family record (visuomotor_gym.family)
-from visuomotor_gym.family import Family
+from visuomotor_gym.family import Family, FollowView, Viz
 
 WALK_MAX_EPISODE_STEPS = 2000  # 40 s at 50 Hz: three times the nominal walk (1.3 m/s) of the longest (20 m) course
 
@@ -243,4 +243,18 @@ FAMILY = Family(
     outcome_labels=("success rate", "time to finish (s)", "distance left, failed walks (m)"),
     agents=("iwao",),
     golden_agent="iwao",
+    viz=Viz(
+        figure="visuomotor_gym.viz.family_plots:walk_figure",
+        contents="top view of the walkway: obstacles by kind and height, pelvis path, footholds, where the gaze "
+                 "meets the floor or an obstacle (coloured by time); side view of obstacle and sole heights; gaze "
+                 "angles and look-ahead distance over time",
+        trace_field="obstacles",
+        # From behind and to the right, above: the legs and the next 3-4 m of walkway with its obstacles.
+        scene_view=FollowView(distance=5.0, azimuth=55.0, elevation=-28.0, offset=(1.6, 0.0, -0.6)),
+        video_stride=2,
+    ),
+    doc_links=(("Iwao et al.: gaze while walking over obstacles", "reproductions/iwao.md"),
+               ("PPO baselines (the walk recipe)", "baselines/ppo.md")),
+    doc_pictures=(("images/obstaclewalk_iwao_seed0_frame.png",
+                   "The iwao agent on ObstacleWalk-v0: side view with the line of sight, and its eye camera"),),
 )

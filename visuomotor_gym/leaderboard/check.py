@@ -149,7 +149,7 @@ def provenance_problems(entry: Entry, where: str) -> list[Problem]:
     try:
         argv = shlex.split(command)
     except ValueError as exc:
-        return out + [Problem(where, "provenance", f"provenance.command cannot be parsed: {exc}")]
+        return [*out, Problem(where, "provenance", f"provenance.command cannot be parsed: {exc}")]
     if argv[:2] == ["vmgym", "bench"]:
         expected = {
             "--agent": r["agent"],
@@ -160,12 +160,13 @@ def provenance_problems(entry: Entry, where: str) -> list[Problem]:
     elif argv[:3] == ["vmgym", "leaderboard", "submit"]:
         expected = {"--agent": r["agent"], "--env": r["env_id"], "--name": entry.name}
     else:
-        return out + [
+        return [
+            *out,
             Problem(
                 where,
                 "provenance",
                 f"provenance.command {command!r} is neither `vmgym bench` nor `vmgym leaderboard submit`",
-            )
+            ),
         ]
     given = {argv[i]: argv[i + 1] for i in range(len(argv) - 1) if argv[i].startswith("--")}
     for flag, value in expected.items():
@@ -507,7 +508,7 @@ def policy_problems(lb: Leaderboard, entry: Entry, export: bool = True) -> list[
     if export and fmt.reexport and entry.superseded is None:
         try:
             fresh = fmt.export(entry.results["agent"], entry.env_id)
-        except Exception as exc:  # noqa: BLE001 - any failure to rebuild the spec is a refusal
+        except Exception as exc:  # any failure to rebuild the spec is a refusal
             return [
                 Problem(
                     where,
@@ -745,7 +746,7 @@ def _plan(lb: Leaderboard, entry: Entry, new: bool, base_sha: str | None, sample
     r = entry.results
     pinned = [r["seed"] + i for i in range(r["episodes"])]
     if seeds is not None:
-        return _Plan(entry, [s for s in seeds], False)
+        return _Plan(entry, list(seeds), False)
     if new or sample == "all":
         return _Plan(entry, pinned, True)
     k = lb.protocol.rescore_sample if sample is None else int(sample)

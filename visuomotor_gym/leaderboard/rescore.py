@@ -83,7 +83,7 @@ def run_job(job: Job) -> JobResult:
                 out.records[seed] = episode_record(trace)
                 if job.keep_traces:
                     out.traces.append(trace)
-    except Exception as exc:  # noqa: BLE001 - a policy that cannot be re-played is refused, not a crash
+    except Exception as exc:  # a policy that cannot be re-played is refused, not a crash
         out.error = f"{type(exc).__name__}: {exc}"
     return out
 

@@ -1,10 +1,10 @@
 """Hand-path realism of the catch family: the hand's transport to the interception point against
-Faraway, Reed & Wang's (2007, seed 002) reach model, reported **beside** the catch family's gaze realism.
+Faraway, Reed & Wang's (2007) reach model, reported **beside** the catch family's gaze realism.
 
 Which part of a catch is compared with ``faraway_path``
 -------------------------------------------------------
-Seed 002 models a point-to-point reach to a resting object: one movement from a start to an end, one
-speed peak (the Beta(1.63, 1.75) profile). A catch is not that: the hand leaves its rest position towards
+Faraway et al. (2007) model a point-to-point reach to a resting object: one movement from a start to an end,
+one speed peak (the Beta(1.63, 1.75) profile). A catch is not that: the hand leaves its rest position towards
 an interception point that the catcher's estimate keeps revising while the ball flies (Eyecatch sec. 4.3:
 overlapping ~400 ms submovements, one per ~200 ms visuomotor update), and once there it waits or
 follows the ball in small corrections until the ball arrives. So the compared segment
@@ -27,7 +27,7 @@ follows the ball in small corrections until the ball arrives. So the compared se
 the distance measures what the transport did on its way; every revision of the interception point, every
 detour and return, adds to it. A catcher who predicted the interception point at the start and made one
 human-like reach to it would score like a human reach; a catcher who chased its estimate would not. This
-is the point of the measure, and also its limit: seed 002 measured reaches, not catches, so applying its
+is the point of the measure, and also its limit: Faraway et al. measured reaches, not catches, so applying its
 numbers to catching is our **modelling choice** (no human hand-path data for catching are in
 ``REFERENCES.md``; only the hand's peak speed, Eyecatch sec. 4.3, is a catching number, and it is reported
 unscored because the hand controller caps the hand at 2 m/s, so every agent met it).
@@ -77,19 +77,20 @@ ARRIVAL_RADIUS_M = 0.03
 GAZE_ON_TARGET_DEG = 5.0  # "on the interception point": as metrics.reach_realism.GAZE_ON_OBJECT_DEG (our choice)
 
 # Verdict thresholds (path_verdict), on the medians over episodes:
-HUMAN_LIKE_MAX_CM = 8.0  # seed 002 Table 2: the chosen model's median error against human reaches
-# Seed 002 Table 2: the straight minimum-jerk (Flash-Hogan) model's median error against human reaches.
-# A median distance to the chosen model above it is farther from the model than the rejected straight-line
-# model was from humans: not one reach. (It is *not* the distance of a straight path to faraway_path,
-# which is only ~6 cm at 56.7 cm: docs/reproductions/faraway.md.)
+# Faraway et al. (2007), Table 2: the chosen model's median error against human reaches.
+HUMAN_LIKE_MAX_CM = 8.0
+# Faraway et al. (2007), Table 2: the straight minimum-jerk (Flash-Hogan) model's median error against human
+# reaches. A median distance to the chosen model above it is farther from the model than the rejected
+# straight-line model was from humans: not one reach. (It is *not* the distance of a straight path to
+# faraway_path, which is only ~6 cm at 56.7 cm: docs/reproductions/faraway.md.)
 UNLIKE_REACH_MIN_CM = 12.6
 # The interquartile range of the curvature index of synthetic human reaches (docs/reproductions/faraway.md,
 # REACH_REFERENCE["curvature_index"]); a straight path has 0.
 HUMAN_CURVATURE_LOW = REACH_REFERENCE["curvature_index"]["low"]
 HUMAN_CURVATURE_HIGH = REACH_REFERENCE["curvature_index"]["high"]
 
-_APPLIED = (" Applied to the transport of a catch: modelling choice (seed 002 measured reaches to resting "
-            "objects; there is no human hand-path number for catching in REFERENCES.md).")
+_APPLIED = (" Applied to the transport of a catch: modelling choice (Faraway et al. 2007 measured reaches "
+            "to resting objects; there is no human hand-path number for catching in REFERENCES.md).")
 
 
 def _reference() -> dict[str, dict]:
@@ -106,8 +107,7 @@ def _reference() -> dict[str, dict]:
     ref["hand_peak_speed_m_s"] = {
         "value": None, "low": None, "high": None, "tolerance": None, "unit": "m/s", "scored": False,
         "source": "Eyecatch sec. 4.3: humans keep the hand below ~2 m/s. Not scored: the hand controller caps its "
-                  "reference at 2 m/s (control.hand.HandParams.max_speed_m_s), so every agent met the bound "
-                  "(issue 21).",
+                  "reference at 2 m/s (control.hand.HandParams.max_speed_m_s), so every agent met the bound.",
         "notes": "Median over catches of the peak catch-site speed within the transport (20 ms differences).",
     }
     ref["gaze_hand_lead_s"] = {
@@ -173,10 +173,7 @@ def catch_reach_segment(trace) -> tuple[int, int, int] | None:
     if moving.size == 0:
         return None
     onset = int(moving[0])
-    if bool(trace.success):
-        end = hand.shape[0] - 1
-    else:
-        end = int(np.argmin(np.linalg.norm(ball - hand, axis=1)))
+    end = hand.shape[0] - 1 if bool(trace.success) else int(np.argmin(np.linalg.norm(ball - hand, axis=1)))
     if end <= onset:
         return None
     away = np.flatnonzero(np.linalg.norm(hand[onset : end + 1] - hand[end], axis=1) > ARRIVAL_RADIUS_M)

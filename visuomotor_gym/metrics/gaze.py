@@ -93,7 +93,7 @@ def catchup_saccade_interval(trace) -> float:
     Eyecatch Sec. 4.1 and Fig. 4: catch-up saccades come about every 200 ms before the apex, after which
     pursuit takes over (Fig. 3). Only saccades that land on the ball count: the plant refuses onsets closer
     than 200 ms, so an eye saccading at random reached the human interval for free when every saccade
-    counted (issue 21).
+    counted (realism version 1).
     """
     onsets = ball_directed_onsets(trace)
     apex = ball_apex_time(trace)

@@ -1,4 +1,4 @@
-"""Hand-path realism of the reach family: a recorded reach against Faraway, Reed & Wang's (2007, seed 002)
+"""Hand-path realism of the reach family: a recorded reach against Faraway, Reed & Wang's (2007)
 model and the eye-hand timing of human reaching, scored against a sourced human table.
 
 Per episode (:func:`reach_measures`), from the trace only (``hand_pos`` per step, the task's ``object_pos``,
@@ -18,9 +18,9 @@ human-like paths: ``docs/reproductions/faraway.md``), scored with
 :func:`visuomotor_gym.metrics.realism.score_components` against :data:`REACH_REFERENCE`: times the share
 of the episodes that define it (0 when none does), and the score is the smallest of the three group means
 (``moves``: the first saccade's latency and the hand's lag behind it; ``where``: gaze on the object
-before and during the reach; ``hand``: the path). Before issue 21 the score was the mean of the defined
-components, so an eye that never moved kept the four hand-path points and scored 0.97. The result has the
-shape of ``gaze_realism`` (``{"score", "components"}``), so the evaluator's results schema holds it
+before and during the reach; ``hand``: the path). Before realism version 2 the score was the mean of the
+defined components, so an eye that never moved kept the four hand-path points and scored 0.97. The result has
+the shape of ``gaze_realism`` (``{"score", "components"}``), so the evaluator's results schema holds it
 unchanged.
 """
 
@@ -47,30 +47,31 @@ MIN_REACH_M = 0.05  # shorter hand movements are not reaches (modelling choice)
 REACH_REFERENCE: dict[str, dict] = {
     "faraway_distance_cm": {
         "value": 6.4, "low": 0.0, "high": 8.0, "tolerance": 2.0, "unit": "cm", "group": "hand",
-        "source": "Seed 002 Table 2: the chosen model's median maximum error against human reaches is 8.0 cm "
-                  "(Flash-Hogan 12.6 cm); 6.4 cm is the median of synthetic human-like reaches "
-                  "(docs/reproductions/faraway.md). Range [0, 8.0] and tolerance: our choice.",
+        "source": "Faraway et al. (2007), Table 2: the chosen model's median maximum error against human "
+                  "reaches is 8.0 cm (Flash-Hogan 12.6 cm); 6.4 cm is the median of synthetic human-like "
+                  "reaches (docs/reproductions/faraway.md). Range [0, 8.0] and tolerance: our choice.",
         "notes": "Median over reaches of the max distance to faraway_path at equal relative arc length, scaled "
                  "to a 56.7 cm reach. A straight reach also scores ~6 cm: this component alone cannot tell "
                  "straight from human-like (see curvature_index).",
     },
     "curvature_index": {
         "value": 0.92, "low": 0.48, "high": 1.40, "tolerance": 0.4, "unit": "-", "group": "hand",
-        "source": "Median and interquartile range of synthetic human-like reaches generated from seed 002's "
-                  "model with its within/between-subject variation (docs/reproductions/faraway.md); straight "
-                  "reaches give 0. Tolerance: our choice.",
+        "source": "Median and interquartile range of synthetic human-like reaches generated from Faraway "
+                  "et al.'s model with its within/between-subject variation (docs/reproductions/faraway.md); "
+                  "straight reaches give 0. Tolerance: our choice.",
         "notes": "Median over reaches of handpath.HandPathRealism.curvature_index.",
     },
     "hand_peak_speed_m_s": {
         "value": 1.4, "low": 0.5, "high": 2.0, "tolerance": 0.5, "unit": "m/s", "group": "hand",
         "source": "Upper bound: Eyecatch sec. 4.3 (human hand speed below ~2 m/s). Lower bound 0.5 m/s: our "
-                  "choice (a 57 cm reach of ~1 s with seed 002's Beta(1.63, 1.75) profile peaks at ~0.9 m/s).",
+                  "choice (a 57 cm reach of ~1 s with Faraway et al.'s Beta(1.63, 1.75) profile peaks at "
+                  "~0.9 m/s).",
         "notes": "Median over reaches of the peak catch-site speed (20 ms differences).",
     },
     "peak_speed_time": {
         "value": 0.48, "low": 0.34, "high": 0.58, "tolerance": 0.1, "unit": "relative time", "group": "hand",
-        "source": "Seed 002 Sec. 4: median relative time of peak speed 0.48; range: interquartile range of the "
-                  "synthetic reaches (docs/reproductions/faraway.md).",
+        "source": "Faraway et al. (2007), Sec. 4: median relative time of peak speed 0.48; range: "
+                  "interquartile range of the synthetic reaches (docs/reproductions/faraway.md).",
         "notes": "Median over reaches of the relative time of the peak speed within the reach.",
     },
     "gaze_hand_lead_s": {

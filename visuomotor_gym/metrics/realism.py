@@ -13,7 +13,7 @@ How a set of episodes is scored (:func:`score_components`, used by every family)
 * its ``score`` is :func:`score_component` of that value (1 inside the human range, a Gaussian fall-off
   outside) times its **coverage**, the share of the scored episodes that define it. A component that no
   episode defines scores **0**, not "left out": an eye that never saccades has no human saccade pattern,
-  an eye that never lands on a stone has no human look-ahead. (Before issue 21 undefined components were
+  an eye that never lands on a stone has no human look-ahead. (Before version 2 undefined components were
   dropped from the mean, so a still eye was never penalised for not moving.) Coverage stops a handful of
   stray episodes from scoring for the rest;
 * a component measured only on the rows or episodes where the eye was on a target (the look-ahead of the
@@ -34,7 +34,7 @@ How a set of episodes is scored (:func:`score_components`, used by every family)
   pelvis turns on the stepping stones, its fixations sweep past the targets and its ``where`` group
   fails); a random eye saccades at a human-like rate but its fixations fall on the task's targets only
   by chance, so its ``where`` group is low. A mean over all components (the score before
-  issue 21) let either of them bank the other group's points: a still eye scored 0.97-1.0 on three
+  version 2) let either of them bank the other group's points: a still eye scored 0.97-1.0 on three
   families. The minimum, not a product or a geometric mean, because a product punishes a human-like
   agent twice for one weak group and a geometric mean of two groups still gives sqrt(0.25) = 0.5 to an
   eye that is perfect in one group and poor in the other (modelling choice).

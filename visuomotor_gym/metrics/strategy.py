@@ -1,4 +1,4 @@
-"""Measures that need a *moving* eye, shared by every family's realism table (issue 21): how often the eye
+"""Measures that need a *moving* eye, shared by every family's realism table (version 2): how often the eye
 saccades, how long it rests between saccades, and what share of its resting time lands on the task's
 targets. Pure numpy on an :class:`~visuomotor_gym.bench.trace.EpisodeTrace` (``t``, ``dt``,
 ``saccade_onset``, ``in_saccade``); NaN where a measure is undefined.

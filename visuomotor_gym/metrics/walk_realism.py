@@ -105,7 +105,8 @@ WALK_REFERENCE: dict[str, dict] = {
     "gaze_below_horizon_deg": {
         "value": 45.0, "low": 30.0, "high": 60.0, "tolerance": 10.0, "unit": "deg", "group": "where",
         "source": "Muller et al. 2023, eLife 12:e82410: gaze 30-60 deg from the vertical on rocky ground "
-                  "(REFERENCES.md [V]); consistent with seed 003's arctan(h/l), 47 deg for h = 1.6, l = 1.5 m",
+                  "(REFERENCES.md [V]); consistent with Iwao et al.'s arctan(h/l) (Sec. 4.2.1), 47 deg for "
+                  "h = 1.6, l = 1.5 m",
         "notes": "Median over the episode's steps.",
     },
 }

@@ -136,7 +136,7 @@ class OculomotorParams:
         points = self.pursuit_gain_points
         if target_speed_deg_s <= points[0][0]:
             return points[0][1]
-        for (s0, g0), (s1, g1) in zip(points, points[1:]):
+        for (s0, g0), (s1, g1) in itertools.pairwise(points):
             if target_speed_deg_s <= s1:
                 return g0 + (g1 - g0) * (target_speed_deg_s - s0) / (s1 - s0)
         return points[-1][1]

@@ -14,9 +14,9 @@ from visuomotor_gym.body import names
 from visuomotor_gym.core.observation import Block
 from visuomotor_gym.core.parts import Task
 from visuomotor_gym.core.retina import FreeBodyTarget
-from visuomotor_gym.tasks.catch_rewards import catch_reward
 from visuomotor_gym.geometry import norm
 from visuomotor_gym.scenarios.throws import BALL_RADIUS, sample_second_throw, sample_throw
+from visuomotor_gym.tasks.catch_rewards import catch_reward
 from visuomotor_gym.vision import foveation
 
 MISS_BEHIND_X = -0.3  # seat frame: the ball is behind the catcher (modelling choice)
@@ -168,13 +168,13 @@ class CatchTask(Task):
 
     def reset_info(self) -> dict:
         throw = self.throw
-        info = dict(
-            release_pos=throw.release_pos.copy(),
-            release_vel=throw.release_vel.copy(),
-            arrival_pos=throw.arrival_pos.copy(),
-            flight_time=throw.flight_time,
-            wall_y=throw.wall_y,
-        )
+        info = {
+            "release_pos": throw.release_pos.copy(),
+            "release_vel": throw.release_vel.copy(),
+            "arrival_pos": throw.arrival_pos.copy(),
+            "flight_time": throw.flight_time,
+            "wall_y": throw.wall_y,
+        }
         if self.n_balls == 2:
             t2 = self.throw2
             info.update(release2_pos=t2.release_pos.copy(), release2_vel=t2.release_vel.copy(),

@@ -1,11 +1,11 @@
-"""The obstacle-dodge task (issue 13; Eom et al. section 7, seed 001): walk to a goal 15-20 m ahead while
-pedestrians cross the path, seen only through the foveated eye; coming closer to one than the two bodies'
-radii is a collision and ends the episode.
+"""The obstacle-dodge task (Eom, Han, Shin & Noh 2019, Sec. 7, "Moving obstacle avoidance"): walk to a goal
+15-20 m ahead while pedestrians cross the path, seen only through the foveated eye; coming closer to one than
+the two bodies' radii is a collision and ends the episode.
 
 **Scenario** (:func:`sample_crowd`, drawn first from the env's ``np_random`` so every rung of the ladder
 gets the same crowd for a seed): the walker starts at the origin walking along +x at 1.3 m/s; the goal
-line lies 15-20 m ahead (issue 13). ``N_PEDESTRIANS`` = 4 pedestrians appear one after the other (onset
-0.3-1.5 s after the start, then every 1.5-3 s: modelling choice, so that two or three walk at once),
+line lies 15-20 m ahead (modelling choice). ``N_PEDESTRIANS`` = 4 pedestrians appear one after the other
+(onset 0.3-1.5 s after the start, then every 1.5-3 s: modelling choice, so that two or three walk at once),
 each 4-6 m to one side, and walk straight across the path at 1.0-1.5 m/s (adults' comfortable walking
 speeds are 1.27-1.46 m/s, Bohannon 1997, Age Ageing 26:15; the wider range is a modelling choice), up to
 30 deg off the perpendicular (modelling choice). Each crosses the path where a walker going straight at
@@ -15,7 +15,7 @@ of the crossers would hit a walker that neither looks nor steers; modelling choi
 collision course; REFERENCES.md): it starts on a course that misses (|timing| 1.0-1.5 s), and when it
 comes within 3-5 m of the walker it turns onto a collision course (toward the point where it would meet
 the walker if both kept their velocities) for ``veer_s`` = 1.0 s (the veer in Jovancevic et al. lasted
-~1 s; REFERENCES.md "(10 %, ~1 s)"), then resumes its course. (Until issue 13's second pass ``veer_s`` was
+~1 s; REFERENCES.md "(10 %, ~1 s)"), then resumes its course. (In the first definition of v0 ``veer_s`` was
 1.5 s, a modelling choice; docs/reproductions/dodge.md has both.)
 
 **What the eye sees of a pedestrian**: one point on its axis at 1.5 m (upper chest, a modelling choice
@@ -80,7 +80,7 @@ CROWD_RULES = {
 class CrowdDistribution:
     """The scenario sampler's ranges (SI units; uniform draws). Sources in the module docstring."""
 
-    goal_m: tuple[float, float] = (15.0, 20.0)  # issue 13
+    goal_m: tuple[float, float] = (15.0, 20.0)  # modelling choice
     first_onset_s: tuple[float, float] = (0.3, 1.5)
     onset_gap_s: tuple[float, float] = (1.5, 3.0)
     side_m: tuple[float, float] = (4.0, 6.0)  # lateral distance of the start from the path

@@ -1,4 +1,4 @@
-"""The obstacle-walk task (issue 12; Iwao et al., seed 003): walk a straight 15-20 m path across bars,
+"""The obstacle-walk task (Iwao et al.): walk a straight 15-20 m path across bars,
 boxes and flat mats seen only through the foveated eye; a leg striking an obstacle is a trip (the end),
 a foot landing on one a misstep (no success).
 
@@ -7,8 +7,8 @@ gets the same course for a seed): the path runs along +x from the walker's first
 origin to a finish line 15-20 m ahead. Obstacles follow one another along it with free gaps of
 1.6-3.0 m; each is a bar (5 cm deep, spanning the walkway: stepped over), a box (20-40 cm deep, 40-80 cm
 wide: stepped over or around) or a flat mat (70 x 70 cm, 1 cm: Iwao's cloth, stepped around; landing on
-it is a misstep), 5-30 cm high except the mats (issue 12). Kinds, sizes and lateral offsets are uniform
-draws (modelling choice).
+it is a misstep), 5-30 cm high except the mats (modelling choice). Kinds, sizes and lateral offsets are
+uniform draws (modelling choice).
 
 **The walkway**: the path is a walkway ``walkway_width_m`` = 1.5 m wide (modelling choice: the passing
 width of accessible routes, ADA 2010 Standards 403.5.3, 60 in), its edges painted on the floor. A foot
@@ -30,10 +30,10 @@ number of obstacles the pelvis has passed by more than ``PASSED_M``): with free 
 reach >= 6 m ahead, more than the 2 steps (~1.3 m) that walkers need to see (Matthis & Fajen 2014) and
 the 1-2 m of travel fixations (Patla & Vickers 1997). A point not seen this step reads as zeros.
 
-**The rough course** (opt-in, ``course_distribution="rough"``: :data:`ROUGH_COURSE`, issue 23): small
+**The rough course** (opt-in, ``course_distribution="rough"``: :data:`ROUGH_COURSE`): small
 hazards strewn over the walkway so that nearly every foothold has to be chosen. Instead of a few
 large bars and mats with 1.6-3 m between them, up to 16 (the scene's pool) small flat *patches* (a
-foot must not land on them: misstep) and low *rocks* (a leg must not strike them: trip), 15-40 cm
+foot must not land on them: misstep) and low *rocks* (a leg must not strike them: trip), 15-35 cm
 across, follow one another every 0.5-0.9 m along the path (near edge to near edge: about one hazard
 per 0.65 m step), each anywhere across the walkway (centre within 0.5 m of the centre line),
 never overlapping. Humans on such ground look at the footholds 2-3 steps ahead, ~1.5 s before the foot
@@ -110,12 +110,12 @@ COURSE_RULES = {
 class CourseDistribution:
     """The course sampler's ranges (metres; uniform draws). Sources in the module docstring."""
 
-    length_m: tuple[float, float] = (15.0, 20.0)  # issue 12: a 15-20 m path
+    length_m: tuple[float, float] = (15.0, 20.0)  # a 15-20 m path (modelling choice)
     first_m: tuple[float, float] = (3.0, 4.5)  # near edge of the first obstacle (>= 2 s of approach at 1.3 m/s)
     gap_m: tuple[float, float] = (1.6, 3.0)  # free gap between consecutive obstacles (modelling choice)
     finish_clear_m: float = 1.5  # no obstacle within this distance of the finish (modelling choice)
     kind_p: tuple[float, float, float] = (0.4, 0.35, 0.25)  # bar, box, mat (modelling choice)
-    height_m: tuple[float, float] = (0.05, 0.30)  # issue 12: bars and boxes 5-30 cm high
+    height_m: tuple[float, float] = (0.05, 0.30)  # bars and boxes 5-30 cm high (modelling choice)
     walkway_width_m: float = 1.5  # see the module docstring (modelling choice); bars span it
     bar_depth_m: float = 0.05
     box_depth_m: tuple[float, float] = (0.2, 0.4)

@@ -1,4 +1,4 @@
-"""The shelf-reach task (seed 002, Faraway, Reed & Wang 2007): an object stands on one of 30 shelf
+"""The shelf-reach task (Faraway, Reed & Wang 2007): an object stands on one of 30 shelf
 targets (3 towers x 5 heights x 2 depths); the seated body must reach it with the right hand, seeing
 it only through the eye.
 
@@ -49,17 +49,17 @@ class ShelfLayout:
     """The 30 targets, world frame (x forward, y left, z up; the seat axis is x = y = 0). ``envs_assets/reach.xml``
     is built from these numbers (a test compares them)."""
 
-    # Seed 002 Sec. 2: towers "in front of the subject, to the right-hand side and 45 deg to the right"
-    # (sourced); azimuth measured about the body's vertical (seat) axis, negative = to the right.
+    # Faraway et al. (2007), Sec. 2: towers "in front of the subject, to the right-hand side and 45 deg to the
+    # right" (sourced); azimuth measured about the body's vertical (seat) axis, negative = to the right.
     tower_azimuth_deg: tuple[float, float, float] = (0.0, -45.0, -90.0)
     # Horizontal distance of the object centres from the seat axis, near and far (modelling choice: the
-    # seated arm reaches both with the torso's help; the median reach, 0.53 m, is near seed 002's 56.7 cm).
+    # seated arm reaches both with the torso's help; the median reach, 0.53 m, is near the paper's 56.7 cm).
     depth_m: tuple[float, float] = (0.50, 0.65)
     # Object-centre heights: 5 levels from seat height (0.55 m) to 0.18 m above the seated eye (1.13 m),
-    # the seated analogue of seed 002's "five levels ranging from eye to ankle level" (modelling choice).
+    # the seated analogue of the paper's "five levels ranging from eye to ankle level" (modelling choice).
     level0_z_m: float = 0.55
     level_step_m: float = 0.19
-    # The object: a vertical cylinder (seed 002's subjects moved "a vertical cylinder"); size modelling choice.
+    # The object: "a vertical cylinder", as the paper's subjects moved; size modelling choice.
     object_radius_m: float = 0.03
     object_half_height_m: float = 0.06
     # Back panel of each tower, this far behind the far depth (modelling choice: ~7 cm of room for the palm,

@@ -1,5 +1,5 @@
-"""The stepping-stones task (issue 13; Eom et al. 2019 section 7, seed 001): cross a gap on a path of
-stones seen only through the foveated eye; a foot that lands off every support ends the episode.
+"""The stepping-stones task (Eom, Han, Shin & Noh 2019, Sec. 7, "Walking on stepping stones"): cross a gap on
+a path of stones seen only through the foveated eye; a foot that lands off every support ends the episode.
 
 **Course** (:func:`sample_course`, drawn first from the env's ``np_random`` so every rung of the ladder
 gets the same course for a seed): the walker starts on a slab (``envs_assets/stones.xml``) whose far
@@ -189,7 +189,7 @@ class SteppingStonesTask(Task):
         self.mocap = [int(m.body_mocapid[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, n)]) for n in STONE_NAMES]
         self._park = [m.body_pos[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, n)].copy() for n in STONE_NAMES]
         self.slab = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, SLAB)
-        if min(self.geoms + [self.slab]) < 0:
+        if min([*self.geoms, self.slab]) < 0:
             raise ValueError(f"the model lacks stones or the slab: is it envs_assets/{STONES_SCENE}?")
         self.radius = float(m.geom_size[self.geoms[0], 0])  # one source: the XML (0.25 m, ALLSTEPS)
         half_height = float(m.geom_size[self.geoms[0], 1])

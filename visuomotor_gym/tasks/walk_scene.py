@@ -1,4 +1,4 @@
-# ruff: noqa: PLR1730  (ObstaclePool.near writes max as the builtin's comparisons, on purpose)
+# ObstaclePool.near writes max as the builtin's comparison, on purpose.
 """The obstacle scene of the walker families: the pool of obstacle boxes and where each one stands.
 
 Scene state, not the gait's: the walker scene (``envs_assets/walker.xml``) carries
@@ -63,9 +63,9 @@ class ObstaclePool:
         half = (0.5 * length, 0.5 * width, 0.5 * height)
         model.geom_size[g] = half
         model.geom_rbound[g] = math.sqrt(half[0] ** 2 + half[1] ** 2 + half[2] ** 2)
-        model.geom_aabb[g] = (0.0, 0.0, 0.0) + half
+        model.geom_aabb[g] = (0.0, 0.0, 0.0, *half)
         if self.bvh[i] >= 0:
-            model.bvh_aabb[self.bvh[i]] = (0.0, 0.0, 0.0) + half
+            model.bvh_aabb[self.bvh[i]] = (0.0, 0.0, 0.0, *half)
         if rgba is not None:
             model.geom_rgba[g] = rgba
         data.mocap_pos[self.mocap[i]] = (x, y, half[2])
@@ -89,13 +89,13 @@ class ObstaclePool:
                 # dx = max(x0 - x, 0.0, x - x1) and dy alike, as conditional expressions (the same
                 # comparisons as the builtin's, in the same order).
                 dx = x0 - x
-                if 0.0 > dx:
+                if dx < 0.0:
                     dx = 0.0
                 t = x - x1
                 if t > dx:
                     dx = t
                 dy = box[2] - y
-                if 0.0 > dy:
+                if dy < 0.0:
                     dy = 0.0
                 t = y - box[3]
                 if t > dy:

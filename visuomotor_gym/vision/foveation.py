@@ -26,13 +26,13 @@ the paper; the defaults below follow the text):
   1972: "position and velocity errors [of pursuit] are the main determinants of DVA"). So a pursued
   ball is localised to ~1 arcmin and one sweeping past a still eye at 50 deg/s to ~20 arcmin. Not
   in the Eyecatch paper (static 20/20 acuity at any speed: ``position_slip_knee_deg_s=inf``,
-  ``EyeCatchPaper-v0``); added in issue 11 so that where the eye looks decides the catch
+  ``EyeCatchPaper-v0``); added before the first release so that where the eye looks decides the catch
   (``docs/reproductions/gaze_default.md``);
 * everything is divided by the acuity factor ``alpha(theta) = E2 / (E2 + theta)`` (``theta`` the
   eccentricity from the line of sight, ``E2`` = 2 deg: acuity halves 2 deg from the fovea, the
   standard cortical-magnification form, e.g. Levi, Klein & Aitsebaomo 1985);
 * nothing is seen beyond the field of view (+-60 deg, Eom et al. 2019) or during a saccade;
-* opt-in human peripheral vision (issue 23; all off by default): a human-shaped field of view, a
+* opt-in human peripheral vision (vision/periphery.py; all off by default): a human-shaped field of view, a
   position law faster than the acuity law, crowding, and depth noise that grows away from the
   vergence distance (:mod:`visuomotor_gym.vision.periphery`).
 
@@ -94,7 +94,7 @@ class VisionParams:
     position_slip_knee_deg_s: float = 2.5
     noise_scale: float = 1.0  # multiplies every standard deviation (x10: Eyecatch "poor vision")
     foveated: bool = True  # False: foveal acuity everywhere, no field-of-view limit (FullView)
-    # --- Human peripheral vision (issue 23; vision/periphery.py), each off by default. Metadata
+    # --- Human peripheral vision (vision/periphery.py), each off by default. Metadata
     # "bounds": the allowed range [low, high] ("low_open": low itself excluded), "optional": None allowed
     # (the mechanism off); "choices": the allowed strings.
     # Field of view: "cone" (half-angle field_of_view_deg, all round) or "human": 60 deg up, 75 down,
@@ -217,7 +217,7 @@ def _sigmas(distance, eccentricity_rad, retinal_speed, params, fixation=None):
     lateral_rate = k * (
         params.retinal_velocity_weber * abs(retinal_speed) + params.retinal_velocity_floor_deg_s * DEG
     )
-    if params.periphery_on:  # issue 23's laws (off by default: the arithmetic above, unchanged)
+    if params.periphery_on:  # the periphery laws (off by default: the arithmetic above, unchanged)
         if params.position_e2_deg is not None:
             lateral = (distance * params.noise_scale * periphery.position_factor(eccentricity_rad, params)
                        * params.retinal_position_std_arcmin * ARCMIN * slip_factor(retinal_speed, params))

@@ -1,4 +1,4 @@
-"""Human peripheral vision beyond the Eyecatch acuity law (issue 23): four opt-in mechanisms.
+"""Human peripheral vision beyond the Eyecatch acuity law: four opt-in mechanisms.
 
 Each is switched on by a :class:`~visuomotor_gym.vision.foveation.VisionParams` field and is off by
 default (today's eye, bit for bit); all of them act only on a foveated eye (``foveated=False``, the

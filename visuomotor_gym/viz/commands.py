@@ -22,21 +22,20 @@ import sys
 import tempfile
 from pathlib import Path
 
-# What ``vmgym plot`` draws for each family (the command's help; visuomotor_gym.viz.plots and
-# visuomotor_gym.viz.family_plots draw it).
-PLOT_CONTENTS = {
-    "catch": "gaze vs ball azimuth/elevation over time with saccades (Eyecatch Fig. 3/12), hand and eye speed "
-             "(Fig. 4), the visual field, 3-D ball and hand paths",
-    "reach": "top and side view of the shelf: object, hand path, gaze point at the object's distance (coloured by "
-             "time); gaze and object angles, gaze-object angle, hand-object distance and hand speed over time",
-    "walk": "top view of the walkway: obstacles by kind and height, pelvis path, footholds, where the gaze meets the "
-            "floor or an obstacle (coloured by time); side view of obstacle and sole heights; gaze angles and "
-            "look-ahead distance over time",
-    "stones": "top view: numbered stones, pelvis path, footholds, gaze on the floor (coloured by time); gaze angles "
-              "and the stone under the gaze vs the feet's next stone over time",
-    "dodge": "top view: walker and pedestrian paths with times, the line of sight and where it meets a pedestrian "
-             "(coloured by time); gaze angles, gaze-to-pedestrian angles and distances over time",
-}
+
+def plot_contents() -> dict[str, str]:
+    """What ``vmgym plot`` draws for each family (the command's help): family name -> its record's
+    ``viz.contents`` (:mod:`visuomotor_gym.viz.plots` and :mod:`visuomotor_gym.viz.family_plots` draw it)."""
+    from visuomotor_gym.families import families
+
+    return {f.name: f.viz.contents for f in families() if f.viz is not None}
+
+
+def __getattr__(name: str):
+    """``PLOT_CONTENTS`` (:func:`plot_contents`), for older callers."""
+    if name == "PLOT_CONTENTS":
+        return plot_contents()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def plot_filename(env_id: str, agent: str, seed: int) -> str:
@@ -186,7 +185,9 @@ def cmd_record(args: argparse.Namespace) -> int:
 
 def register(subparsers) -> None:
     """Add ``plot`` and ``record`` to the ``vmgym`` subparsers (each sets ``func(args) -> int``)."""
-    per_family = "\n".join(f"  {family}: {text}" for family, text in PLOT_CONTENTS.items())
+    from visuomotor_gym.families import families
+
+    per_family = "\n".join(f"  {family}: {text}" for family, text in plot_contents().items())
     p = subparsers.add_parser(
         "plot",
         help="plot one episode of any family: gaze on the scene, targets, hand or feet, saccades, time series",
@@ -223,7 +224,8 @@ def register(subparsers) -> None:
     p.add_argument("--height", type=int, default=360)
     p.add_argument("--fps", type=int, default=25, help="frames per second (default 25; 50 / stride is real time)")
     p.add_argument("--stride", type=int, default=None,
-                   help="render every N-th control step (default: 1 for catch and reach, 2 for walk, stones, dodge)")
+                   help="render every N-th control step (default: the family's, "
+                        + ", ".join(f"{f.name} {f.viz.video_stride}" for f in families() if f.viz is not None) + ")")
     p.add_argument("--camera", default="both",
                    help="both (scene view beside eye, every family), scene, eye, or a family's own MJCF camera "
                         "(catch/reach: over_shoulder; walker families: side, follow; ...); an unknown one is "

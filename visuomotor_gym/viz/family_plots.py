@@ -655,5 +655,13 @@ def reach_figure(trace: EpisodeTrace):
     return fig
 
 
-FIGURES = {"reach": reach_figure, "walk": walk_figure, "stones": stones_figure, "dodge": dodge_figure}
+def __getattr__(name: str):
+    """``FIGURES``: family name -> figure function, from the records' ``viz.figure`` (for older callers;
+    the records are the one place a family's figure is named)."""
+    if name == "FIGURES":
+        from visuomotor_gym.families import families
+        from visuomotor_gym.family import resolve
+
+        return {f.name: resolve(f.viz.figure) for f in families() if f.viz is not None}
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 

@@ -188,19 +188,23 @@ def apex_time(trace: EpisodeTrace) -> float:
 
 
 def outcome(trace: EpisodeTrace) -> str:
-    """One word (and the time of success): how the episode ended, in its family's words."""
-    from visuomotor_gym.registration import family_of
+    """One word (and the time of success): how the episode ended, in its family's words (the record's
+    ``viz.outcome_words``; a trace of an unregistered id is read with the default family's)."""
+    from visuomotor_gym.families import default_family, family_for
 
     try:
-        catching = family_of(str(trace.env_id)) == "catch"
-    except ValueError:  # a synthetic or unregistered trace: the catch family's words
-        catching = True
+        record = family_for(str(trace.env_id))
+    except ValueError:  # a synthetic or unregistered trace: the default (catch) family's words
+        record = default_family()
+    viz = record.viz
+    success, failure = viz.outcome_words if viz is not None else ("succeeded", "failed")
+    failure_field = viz.failure_field if viz is not None else None
     if trace.success:
-        return f"{'caught' if catching else 'succeeded'} at {float(trace.t[-1]):.2f} s"
+        return f"{success} at {float(trace.t[-1]):.2f} s"
     if trace.diverged:
         return "physics diverged"
-    if getattr(trace, "missed", False) if catching else not trace.truncated:
-        return "missed" if catching else "failed"
+    if getattr(trace, failure_field, False) if failure_field is not None else not trace.truncated:
+        return failure
     if trace.truncated:
         return "truncated (time limit)"
     return "ended"
@@ -234,7 +238,7 @@ def _mark_events(ax, trace: EpisodeTrace, *, saccades: str = "span", labels: boo
                        label="saccade onset" if (labels and i == 0) else None)
     ax.axvline(apex_time(trace), color=APEX_COLOR, ls="--", lw=1.2, label="ball apex" if labels else None)
     if trace.caught:
-        ax.axvline(trace.catch_time, color=CATCH_COLOR, ls="-", lw=1.2, label="catch" if labels else None)
+        ax.axvline(trace.catch_time, color=CATCH_COLOR, ls="-", lw=1.2, label="ball caught" if labels else None)
     else:
         ax.axvline(_end_time(trace), color=CATCH_COLOR, ls=(0, (1, 3)), lw=1.2,
                    label="episode end (no catch)" if labels else None)
@@ -254,7 +258,7 @@ def plot_gaze_vs_ball(trace: EpisodeTrace, ax=None, origin: str = "eye"):
     if ax is None:
         fig = _new_figure((7.5, 5.5))
         axes = list(fig.subplots(2, 1, sharex=True))
-    elif isinstance(ax, Sequence) or isinstance(ax, np.ndarray):
+    elif isinstance(ax, (Sequence, np.ndarray)):
         axes = list(ax)
         if len(axes) != 2:
             raise ValueError("ax must be one Axes or a pair (azimuth, elevation)")
@@ -305,7 +309,7 @@ def plot_gaze_path(trace: EpisodeTrace, ax=None, origin: str = "eye"):
             mfc="none", mec=APEX_COLOR, mew=2, label="ball apex")
     ax.plot(a["ball_az"][0], a["ball_el"][0], "s", color="k", ms=6, label="release")
     if trace.caught:
-        ax.plot(a["ball_az"][-1], a["ball_el"][-1], "*", color=CATCH_COLOR, ms=12, label="catch")
+        ax.plot(a["ball_az"][-1], a["ball_el"][-1], "*", color=CATCH_COLOR, ms=12, label="ball caught")
     ax.set_xlabel("azimuth (deg, + left; axis reversed)")
     ax.set_ylabel("elevation (deg)")
     if not ax.xaxis_inverted():
@@ -361,7 +365,7 @@ def plot_paths_3d(trace: EpisodeTrace, ax=None, zoom: float = 1.0):
     ax.scatter(*np.asarray(trace.arrival_pos), color=APEX_COLOR, marker="x", s=50, label="sampled arrival")
     ax.scatter(*trace.eye_pos[0], color=GAZE_COLOR, marker="o", s=25, label="eye")
     if trace.caught:
-        ax.scatter(*ball[-1], color=CATCH_COLOR, marker="*", s=120, label="catch")
+        ax.scatter(*ball[-1], color=CATCH_COLOR, marker="*", s=120, label="ball caught")
     else:
         ax.scatter(*ball[-1], color=CATCH_COLOR, marker="X", s=60, label="ball at the end")
     pts = np.concatenate([ball, hand, trace.eye_pos[:1], np.asarray(trace.arrival_pos)[None]])
@@ -393,24 +397,33 @@ def episode_summary(trace: EpisodeTrace) -> str:
             f"closest hand-ball {100 * closest:.1f} cm")
 
 
-# The field that tells a trace's family when its env id is not a registered one (a synthetic trace).
-_FAMILY_FIELDS = (("ball_pos", "catch"), ("object_pos", "reach"), ("obstacles", "walk"), ("stones", "stones"),
-                  ("pedestrian_pos", "dodge"))
-FAMILIES = tuple(family for _, family in _FAMILY_FIELDS)
-
-
 def trace_family(trace: EpisodeTrace) -> str:
-    """The family of a trace: from its registered env id, else from the task fields it holds."""
-    from visuomotor_gym.registration import family_of
+    """The family of a trace: from its registered env id, else from the task fields it holds (the
+    records' ``viz.trace_field``)."""
+    return _trace_record(trace).name
+
+
+def _trace_record(trace: EpisodeTrace):
+    from visuomotor_gym.families import families, family_for
 
     try:
-        return family_of(str(trace.env_id))
+        return family_for(str(trace.env_id))
     except ValueError:
-        for name, family in _FAMILY_FIELDS:
-            if name in trace.task:
-                return family
+        markers = [f for f in families() if f.viz is not None]
+        for record in markers:
+            if record.viz.trace_field in trace.task:
+                return record
     raise ValueError(f"cannot tell the family of the trace of {trace.env_id!r}: not a registered id and none of "
-                     f"the fields {[name for name, _ in _FAMILY_FIELDS]} in its task fields {sorted(trace.task)}")
+                     f"the fields {[f.viz.trace_field for f in markers]} in its task fields {sorted(trace.task)}")
+
+
+def __getattr__(name: str):
+    """``FAMILIES``: the names of the families with a figure, from the records (for older callers)."""
+    if name == "FAMILIES":
+        from visuomotor_gym.families import families
+
+        return tuple(f.name for f in families() if f.viz is not None)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def catch_figure(trace: EpisodeTrace, origin: str = "eye"):
@@ -437,15 +450,21 @@ def catch_figure(trace: EpisodeTrace, origin: str = "eye"):
 
 
 def episode_figure(trace: EpisodeTrace, origin: str = "eye"):
-    """The figure of one episode for its family (:func:`trace_family`): :func:`catch_figure`, or the
-    reach/walk/stones/dodge figures of :mod:`visuomotor_gym.viz.family_plots`. ``origin`` is the
-    catch family's (see :func:`gaze_ball_angles`). Returns a matplotlib ``Figure`` (Agg canvas)."""
-    family = trace_family(trace)
-    if family == "catch":
-        return catch_figure(trace, origin=origin)
-    from visuomotor_gym.viz.family_plots import FIGURES
+    """The figure of one episode for its family (:func:`trace_family`): the function its record names
+    (``viz.figure``: :func:`catch_figure`, or the reach/walk/stones/dodge figures of
+    :mod:`visuomotor_gym.viz.family_plots`). ``origin`` is passed to a figure function that takes it
+    (the catch family's, see :func:`gaze_ball_angles`). Returns a matplotlib ``Figure`` (Agg canvas)."""
+    import inspect
 
-    return FIGURES[family](trace)
+    from visuomotor_gym.family import resolve
+
+    record = _trace_record(trace)
+    if record.viz is None:
+        raise ValueError(f"the {record.name} family declares no figure (its Family record has no viz)")
+    figure = resolve(record.viz.figure)
+    if "origin" in inspect.signature(figure).parameters:
+        return figure(trace, origin=origin)
+    return figure(trace)
 
 
 def save_figure(fig, path, dpi: int = 100) -> Path:
@@ -457,9 +476,10 @@ def save_figure(fig, path, dpi: int = 100) -> Path:
 
 
 def plot_episode(trace: EpisodeTrace, path, dpi: int | None = None, origin: str = "eye") -> Path:
-    """Write :func:`episode_figure` of ``trace`` to ``path`` (PNG) at ``dpi`` (default: 110 for catch,
-    100 for the other families' larger figures). Creates the parent folder; overwrites ``path``.
-    Returns the path written."""
+    """Write :func:`episode_figure` of ``trace`` to ``path`` (PNG) at ``dpi`` (default: the family
+    record's ``viz.dpi``: 110 for catch, 100 for the other families' larger figures). Creates the
+    parent folder; overwrites ``path``. Returns the path written."""
     if dpi is None:
-        dpi = 110 if trace_family(trace) == "catch" else 100
+        record = _trace_record(trace)
+        dpi = record.viz.dpi if record.viz is not None else 100
     return save_figure(episode_figure(trace, origin=origin), path, dpi)

@@ -6,14 +6,15 @@ every ``stride``-th step (the last step always), so ``fps = 50 / stride`` plays 
 the default ``fps=25`` the catch and reach families (``stride`` 1 by default, episodes of 1-3 s) play
 at **half speed** (a 1 s throw lasts 2 s on screen, slow enough to see the saccades), as ``vmgym
 demo`` does; the walker families (``stride`` 2 by default, episodes of 10-20 s) in real time
-(:data:`DEFAULT_STRIDE`).
+(the family record's ``viz.video_stride``, :func:`default_stride`).
 
-**Scene views** (:data:`SCENE_VIEWS`): the catch and reach families use their scene's fixed camera
-(``scene_camera`` in the MJCF); the walker families (walk, stones, dodge) a camera defined here, not
-in the MJCF (so the compiled models and their golden digests do not change): a free
-:class:`mujoco.MjvCamera` whose look-at point follows the pelvis each frame, at a distance and angle
-chosen per family so that what the task is about stays in view: the next obstacles (walk), the next
-stones (stones), the pedestrians 4-6 m to either side (dodge).
+**Scene views** (the family record's ``viz.scene_view``, :func:`scene_view`): the catch and reach
+families use their scene's fixed camera (``scene_camera`` in the MJCF); the walker families (walk,
+stones, dodge) a :class:`~visuomotor_gym.family.FollowView` declared in their record, not in the MJCF
+(so the compiled models and their golden digests do not change): a free :class:`mujoco.MjvCamera`
+whose look-at point follows the pelvis each frame, at a distance and angle chosen per family so that
+what the task is about stays in view: the next obstacles (walk), the next stones (stones), the
+pedestrians 4-6 m to either side (dodge).
 
 **Speed** (software OpenGL, Mesa llvmpipe, on a headless machine): shadows and 4x multisampling cost
 ~4-8x the rest of a frame, so they are off unless ``quality="high"``; one :class:`mujoco.Renderer`
@@ -32,52 +33,53 @@ from __future__ import annotations
 
 import os
 import sys
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from visuomotor_gym.bench.trace import EpisodeTrace, run_episode
+from visuomotor_gym.family import FollowView  # declared in the family records; importable from here too
 
 VIDEO_SUFFIXES = (".mp4", ".mkv", ".mov")
 QUALITIES = ("fast", "high")
 CONTROL_HZ = 50  # the envs' control rate (dt = 20 ms): fps = CONTROL_HZ / stride is real time
-# Frames per control step by family (modelling choice): every step for the short catch and reach
-# episodes (saccades of 40-60 ms span 2-3 frames); every other step for the walker families, whose
-# 10-20 s episodes would otherwise take twice as long to render and to watch.
-DEFAULT_STRIDE = {"catch": 1, "reach": 1, "walk": 2, "stones": 2, "dodge": 2}
 
 
-@dataclass(frozen=True)
-class FollowView:
-    """A free camera that looks at the pelvis plus ``offset`` (world frame, m) from ``distance`` m away,
-    ``azimuth`` deg about z (0: looking along +x, the path's direction; 90: along +y) and ``elevation``
-    deg (negative: from above), with a vertical field of view of ``fovy`` deg. Values are modelling
-    choices, checked by eye on a frame of each family."""
-
-    distance: float
-    azimuth: float
-    elevation: float
-    offset: tuple[float, float, float]
-    fovy: float = 45.0
-    # Turn with the walker: azimuth and offset are then relative to the pelvis's heading, smoothed with
-    # a first-order filter of time constant heading_tau_s (modelling choice: 1 s averages out the
-    # gait's sway of the pelvis, ~2 steps, and still turns with the path within a few steps).
-    follow_heading: bool = False
-    heading_tau_s: float = 1.0
+def scene_view(env_id: str | None):
+    """The scene view of ``env_id``'s family (its record's ``viz.scene_view``: an MJCF camera name or
+    a :class:`FollowView`); None for an unregistered id or a family without ``viz``."""
+    record = _record(env_id)
+    return None if record is None or record.viz is None else record.viz.scene_view
 
 
-# The scene view of each family: an MJCF camera name (catch, reach) or a FollowView (walker families).
-SCENE_VIEWS: dict[str, str | FollowView] = {
-    "catch": "scene_camera",
-    "reach": "scene_camera",
-    # From behind and to the right, above: the legs and the next 3-4 m of walkway with its obstacles.
-    "walk": FollowView(distance=5.0, azimuth=55.0, elevation=-28.0, offset=(1.6, 0.0, -0.6)),
-    # From behind the walker, higher, turning with it: the next stones ahead (the path turns by up to 60 deg).
-    "stones": FollowView(distance=5.0, azimuth=30.0, elevation=-50.0, offset=(1.5, 0.0, -0.8), follow_heading=True),
-    # From behind and high: 6 m ahead and the pedestrians starting 4-6 m to either side.
-    "dodge": FollowView(distance=10.0, azimuth=0.0, elevation=-40.0, offset=(3.5, 0.0, -0.9), fovy=50.0),
-}
+def default_stride(env_id: str) -> int:
+    """Frames per control step when ``stride`` is not given: the family record's ``viz.video_stride``
+    (1 for an unregistered id or a family without ``viz``)."""
+    record = _record(env_id)
+    return 1 if record is None or record.viz is None else record.viz.video_stride
+
+
+def _record(env_id):
+    from visuomotor_gym.families import family_for
+
+    if env_id is None:
+        return None
+    try:
+        return family_for(env_id)
+    except ValueError:
+        return None
+
+
+def __getattr__(name: str):
+    """``DEFAULT_STRIDE`` and ``SCENE_VIEWS`` (family name -> stride, scene view), built from the family
+    records for older callers; the records' ``viz`` is the one place these are declared."""
+    from visuomotor_gym.families import families
+
+    if name == "DEFAULT_STRIDE":
+        return {f.name: f.viz.video_stride for f in families() if f.viz is not None}
+    if name == "SCENE_VIEWS":
+        return {f.name: f.viz.scene_view for f in families() if f.viz is not None}
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def _default_headless_gl() -> None:
@@ -334,11 +336,8 @@ def resolve_views(env, camera: str) -> tuple:
     """The views of ``camera`` for this env: ``both`` (scene view beside the eye camera), ``scene``,
     ``eye``, or one of the env's own ``render_camera`` sets (its MJCF cameras: catch/reach
     ``over_shoulder``, walker ``side``/``follow``, ...). ValueError naming the choices otherwise."""
-    from visuomotor_gym.registration import family_of
-
     u = env.unwrapped
-    family = family_of(u.spec.id) if u.spec is not None else None
-    scene = SCENE_VIEWS.get(family) if family is not None else None
+    scene = scene_view(u.spec.id if u.spec is not None else None)
     own = dict(getattr(u, "render_cameras", {}))
     if scene is None:  # an unregistered env: its own scene set
         scene = own.get("scene", own.get("both", ("",)))[0]
@@ -347,7 +346,7 @@ def resolve_views(env, camera: str) -> tuple:
     for name, cams in own.items():
         views.setdefault(name, tuple(cams))
     if camera not in views:
-        raise ValueError(f"camera={camera!r} is not one of {sorted(views)} for {u.spec.id if u.spec else family}")
+        raise ValueError(f"camera={camera!r} is not one of {sorted(views)} for {u.spec.id if u.spec else type(u).__name__}")
     return views[camera]
 
 
@@ -370,7 +369,7 @@ def record_episode(
     Each view is ``width`` x ``height``; with ``camera="both"`` (scene view beside eye camera) a frame
     is ``2 * width`` wide (odd sizes are padded by one pixel). A frame after reset and after every
     ``stride``-th step and the last (``ceil(steps / stride) + 1`` frames); ``fps = 50 / stride`` is
-    real time. ``stride=None`` takes the family's :data:`DEFAULT_STRIDE` (1 for catch and reach: half
+    real time. ``stride=None`` takes the family's :func:`default_stride` (1 for catch and reach: half
     speed at the default 25 fps; 2 for the walker families: real time). ``quality``: ``"fast"`` (no shadows or
     multisampling) or ``"high"``. ``overlay`` writes a small label (env, agent, seed, time, saccade,
     outcome) on every frame. The video is written to a temporary file beside ``path`` and renamed
@@ -401,9 +400,7 @@ def record_episode(
 
     start = time.perf_counter()
     if stride is None:
-        from visuomotor_gym.registration import family_of
-
-        stride = DEFAULT_STRIDE.get(family_of(env_id), 1)
+        stride = default_stride(env_id)
     width, height, fps, stride = int(width), int(height), int(fps), int(stride)
     tmp = path.with_name(f".{path.stem}.partial{path.suffix}")
     env = gym.make(env_id)

@@ -1,4 +1,4 @@
-"""The human periphery, mechanism by mechanism, on every family (issue 23, measurement part).
+"""The human periphery, mechanism by mechanism, on every family (docs/reproductions/data/periphery/).
 
 For each family's best baseline, its held twin (``gaze_blind:<agent>``) and its best static twin
 (``static_gaze:<agent>``, the posture searched under the *default* vision, from
@@ -53,7 +53,7 @@ HUMAN_FIELD = {"field_shape": "human"}  # 60 up / 75 down / 100 to each side (Sp
 POSITION_E2 = {"position_e2_deg": 0.7}
 CROWDING = {"crowding": True}  # Bouma's b = 0.5 (Bouma 1970), compulsory averaging (Parkes et al. 2001)
 # Disparity pedestal at which the depth std doubles: 10 arcmin, modelling choice (stereo thresholds rise
-# steeply with the pedestal, Blakemore 1970; McKee, Levi & Bowne 1990); swept (60 arcmin, with --extra).
+# steeply with the pedestal, Blakemore 1970; McKee et al.); swept (60 arcmin and off, with --extra).
 DEPTH = {"depth_pedestal_arcmin": 10.0}
 CONDITIONS = {
     "a default": {},

@@ -1,4 +1,4 @@
-"""The rough course of ObstacleWalk-v0 (issue 23, prototype): a baseline, its held and static twins
+"""The rough course of ObstacleWalk-v0 (prototype): a baseline, its held and static twins
 under the human periphery, on the pinned seeds ``0..N-1``.
 
 A condition is the rough course (``course_distribution="rough"``) plus a set of ``VisionParams`` fields
