@@ -35,6 +35,8 @@ CONDITIONS = {
     "rough, human field": ("rough", dict(HUMAN_FIELD)),
     "rough, field + E2 + crowding": ("rough", {**HUMAN_FIELD, **POSITION_E2, **CROWDING}),
     "rough, all four": ("rough", {**HUMAN_FIELD, **POSITION_E2, **CROWDING, **DEPTH}),
+    # a variant: the rough course with flat patches only (no rocks), ROUGH_COURSE with kind_p = (0, 0, 1)
+    "rough patches only, field + E2 + crowding": ("rough patches", {**HUMAN_FIELD, **POSITION_E2, **CROWDING}),
 }
 
 
@@ -48,6 +50,12 @@ def _setup() -> None:
 
 def env_kwargs(course, vision: dict) -> dict:
     out = {}
+    if course == "rough patches":
+        import dataclasses
+
+        from visuomotor_gym.tasks.obstacle_walk import ROUGH_COURSE
+
+        course = dataclasses.asdict(dataclasses.replace(ROUGH_COURSE, kind_p=(0.0, 0.0, 1.0)))
     if course:
         out["course_distribution"] = course
     if vision:
