@@ -29,6 +29,7 @@ pinned evaluation seeds (see :func:`search`).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import functools
 import json
 import math
@@ -328,6 +329,31 @@ def make_static_gaze(env_id, action_dim, seed, base=None, **posture_overrides) -
 
 
 # --- the search ----------------------------------------------------------------------------------
+@contextlib.contextmanager
+def registered_kwargs(env_id: str, kwargs: dict | None):
+    """Within the block, ``env_id``'s registered kwargs carry ``kwargs`` (e.g. ``vision_params``,
+    ``course_distribution``) in this process, so that the env and every agent's ``for_env`` (which reads
+    the registered kwargs) agree on them; restored on exit. Empty or None: nothing changes."""
+    import gymnasium as gym
+
+    import visuomotor_gym  # noqa: F401  (registers the ids)
+
+    if not kwargs:
+        yield
+        return
+    if not isinstance(kwargs, dict):
+        raise TypeError(f"env kwargs must be a dict of constructor arguments, got {type(kwargs).__name__}")
+    spec = gym.registry[env_id.removeprefix("visuomotor_gym:")]
+    saved = dict(spec.kwargs)
+    spec.kwargs.update(kwargs)
+    try:
+        gym.make(spec.id).close()  # refuse a bad argument here, naming it, before any search
+        yield
+    finally:
+        spec.kwargs.clear()
+        spec.kwargs.update(saved)
+
+
 def neck_along(az: float, el: float, geometry: EyeGeometry) -> tuple[float, float]:
     """The neck pointing along the line of sight, within its range (the coarse grid's neck)."""
     return (min(max(az, geometry.neck_yaw_deg[0]), geometry.neck_yaw_deg[1]),
@@ -371,12 +397,11 @@ class _Scorer:
     episode succeeds (``bar``: the k-th best complete score so far, so the pruning never changes which
     postures make the top k; ties continue, as the tie rule might favour the newcomer)."""
 
-    def __init__(self, env_id: str, agent: str, design_seed: int, log=None, env_kwargs: dict | None = None):
+    def __init__(self, env_id: str, agent: str, design_seed: int, log=None):
         from visuomotor_gym.bench.evaluate import make_env
 
         self.env_id, self.agent, self.design_seed = env_id, agent, design_seed
-        self.env_kwargs = dict(env_kwargs or {})
-        self.env = make_env(env_id) if not self.env_kwargs else _make_env_with(env_id, self.env_kwargs)
+        self.env = make_env(env_id)
         self.results: dict[Posture, list[bool]] = {}
         self.stage_of: dict[Posture, str] = {}
         self.log = log or (lambda *_: None)
@@ -403,9 +428,7 @@ class _Scorer:
                 break
             if len(have) >= RACE_MIN_EPISODES and wilson_upper(sum(have), len(have)) < race:
                 break
-            traces = run_chunk(spec, self.env_id, chunk_seeds, env=self.env) if not self.env_kwargs \
-                else run_chunk_with(spec, self.env_id, chunk_seeds, self.env)
-            have.extend(tr.success for tr in traces)
+            have.extend(tr.success for tr in run_chunk(spec, self.env_id, chunk_seeds, env=self.env))
             self.episodes_played += len(chunk_seeds)
         complete = len(have) >= episodes
         if len(have) > before or not complete:
@@ -437,29 +460,6 @@ class _Scorer:
         self.env.close()
 
 
-def _make_env_with(env_id: str, env_kwargs: dict):
-    """``gymnasium.make(env_id, **env_kwargs)``, refusing anything but a dict of keyword arguments."""
-    import gymnasium as gym
-
-    import visuomotor_gym  # noqa: F401
-
-    if not isinstance(env_kwargs, dict) or not all(isinstance(k, str) for k in env_kwargs):
-        raise TypeError(f"env_kwargs must be a dict of the env's keyword arguments, got {env_kwargs!r}")
-    return gym.make(env_id, **env_kwargs)
-
-
-def run_chunk_with(spec: str, env_id: str, seeds: list[int], env) -> list:
-    """:func:`visuomotor_gym.bench.evaluate.run_chunk` on an env made with keyword arguments: the agent
-    (built for ``env_id``, seeded with ``seeds[0]``) is given the env's own ``VisionParams``
-    (``agents.match_vision``), as its registered id would give them."""
-    from visuomotor_gym.agents import make_agent, match_vision
-    from visuomotor_gym.bench.trace import run_episode
-
-    policy = make_agent(spec, env_id, action_dim=int(env.action_space.shape[0]), seed=int(seeds[0]))
-    match_vision(policy, env.unwrapped.vision_params)
-    return [run_episode(env, policy, seed=int(s), env_id=env_id, agent=spec) for s in seeds]
-
-
 def search(env_id: str, agent: str, *, design_seed: int = DESIGN_SEED, coarse_episodes: int = COARSE_EPISODES,
            final_episodes: int = FINAL_EPISODES, coarse_step: float = 20.0, refine_steps=(10.0, 5.0),
            refine_top: int = 3, finalists: int = 5, neck_step: float = 20.0, postures=None,
@@ -480,10 +480,6 @@ def search(env_id: str, agent: str, *, design_seed: int = DESIGN_SEED, coarse_ep
        the along-the-line-of-sight neck (the postures the eye can hold; none when ``neck_step`` is 0),
        on ``final_episodes`` seeds.
 
-    ``env_kwargs``: keyword arguments of the env (a course preset, ``vision_params``...; recorded in the
-    results); every posture then plays on ``gymnasium.make(env_id, **env_kwargs)`` with the agent given
-    that env's ``VisionParams`` (:func:`run_chunk_with`). Without them, the registered env as it is.
-
     A posture stops early once it cannot reach the score that selection needs (stages 1-2: the
     ``max(refine_top, finalists)``-th best on ``coarse_episodes`` seeds; 3-4: the best on
     ``final_episodes`` seeds), which never changes the selection (see :class:`_Scorer`), or, in
@@ -491,8 +487,23 @@ def search(env_id: str, agent: str, *, design_seed: int = DESIGN_SEED, coarse_ep
     best complete rate so far (racing: a posture clearly worse than the best is not played out). The chosen
     posture is the best on ``final_episodes`` seeds; ties go to the line of sight nearer straight
     ahead, then the neck nearer straight ahead. ``postures``: an explicit list instead of the grid
-    (each on ``final_episodes`` seeds, no early stop; for tests).
+    (each on ``final_episodes`` seeds, no early stop; for tests). ``env_kwargs``: constructor
+    arguments laid over the registered id's for the whole search (:func:`registered_kwargs`; e.g. the
+    human periphery's ``vision_params`` or ``course_distribution="rough"``), recorded in the result.
     """
+    with registered_kwargs(env_id, env_kwargs):
+        record = _search(env_id, agent, design_seed=design_seed, coarse_episodes=coarse_episodes,
+                         final_episodes=final_episodes, coarse_step=coarse_step, refine_steps=refine_steps,
+                         refine_top=refine_top, finalists=finalists, neck_step=neck_step, postures=postures,
+                         command=command, log=log)
+    if env_kwargs:
+        record["env_kwargs"] = dict(env_kwargs)
+    return record
+
+
+def _search(env_id: str, agent: str, *, design_seed: int, coarse_episodes: int, final_episodes: int,
+            coarse_step: float, refine_steps, refine_top: int, finalists: int, neck_step: float, postures,
+            command: str | None, log) -> dict:
     from visuomotor_gym.bench.evaluate import check_env_id
     from visuomotor_gym.bench.provenance import provenance
 
@@ -504,9 +515,7 @@ def search(env_id: str, agent: str, *, design_seed: int = DESIGN_SEED, coarse_ep
     geometry = env_geometry(env_id)
     origin = provenance(command)  # the code that runs (taken before, not after, a long search)
     started = time.perf_counter()
-    if env_kwargs:  # refused before the search starts, not after its first posture
-        _make_env_with(env_id, env_kwargs).close()
-    scorer = _Scorer(env_id, agent, design_seed, log=log, env_kwargs=env_kwargs)
+    scorer = _Scorer(env_id, agent, design_seed, log=log)
     stages = []
     keep = max(refine_top, finalists)
     try:
@@ -572,7 +581,7 @@ def search(env_id: str, agent: str, *, design_seed: int = DESIGN_SEED, coarse_ep
         scorer.close()
     wall = time.perf_counter() - started
     k = sum(scorer.results[chosen][:final_episodes])
-    record = {
+    return {
         "env_id": env_id,
         "agent": agent,
         "chosen": {**asdict(chosen), "spec": static_gaze_spec(chosen, agent), "successes": k,
@@ -598,9 +607,6 @@ def search(env_id: str, agent: str, *, design_seed: int = DESIGN_SEED, coarse_ep
         "wall_time_s": round(wall, 1),
         "provenance": origin,
     }
-    if env_kwargs:
-        record["env_kwargs"] = dict(env_kwargs)
-    return record
 
 
 def evaluate_pinned(record: dict, episodes: int = 200, seed: int = 0, workers: int = 1) -> dict:
@@ -608,19 +614,12 @@ def evaluate_pinned(record: dict, episodes: int = 200, seed: int = 0, workers: i
     from visuomotor_gym.bench.evaluate import evaluate
 
     spec = record["chosen"]["spec"]
-    if record.get("env_kwargs"):  # an env made with keyword arguments: played here, in one process
-        env = _make_env_with(record["env_id"], record["env_kwargs"])
-        started = time.perf_counter()
-        try:
-            traces = run_chunk_with(spec, record["env_id"], list(range(seed, seed + episodes)), env)
-        finally:
-            env.close()
-        k, wall = sum(tr.success for tr in traces), time.perf_counter() - started
-    else:
-        result = evaluate(spec, record["env_id"], episodes, seed, workers=workers, keep_traces=True)
-        k, wall = sum(tr.success for tr in result.traces), result.wall_time_s
+    with registered_kwargs(record["env_id"], record.get("env_kwargs")):
+        result = evaluate(spec, record["env_id"], episodes, seed, workers=workers if not record.get("env_kwargs") else 1,
+                          keep_traces=True)
+    k = sum(tr.success for tr in result.traces)
     record["pinned"] = {"spec": spec, "seed": seed, "episodes": episodes, "successes": k,
-                        "success": k / episodes, "wall_time_s": round(wall, 1)}
+                        "success": k / episodes, "wall_time_s": round(result.wall_time_s, 1)}
     return record
 
 
@@ -707,7 +706,8 @@ def main(argv=None) -> int:
     s.add_argument("--update-postures", action="store_true",
                    help="write the chosen posture into the package's static_postures.json")
     s.add_argument("--env-kwargs", type=str, default=None, metavar="JSON",
-                   help='keyword arguments of the env as a JSON object, e.g. \'{"course_distribution": "rough"}\'')
+                   help="constructor arguments laid over the registered id's for the whole search, as a JSON "
+                        "object, e.g. '{\"course_distribution\": \"rough\", \"vision_params\": {\"crowding\": true}}'")
     s.add_argument("--quiet", action="store_true")
     p = sub.add_parser("pinned", help="add the pinned-seed evaluation to an existing results JSON")
     p.add_argument("results")
@@ -749,9 +749,9 @@ def main(argv=None) -> int:
         try:
             env_kwargs = json.loads(args.env_kwargs)
         except json.JSONDecodeError as exc:
-            raise SystemExit(f"--env-kwargs: not JSON ({exc}): {args.env_kwargs!r}") from None
+            raise SystemExit(f"--env-kwargs: not JSON ({exc})") from None
         if not isinstance(env_kwargs, dict):
-            raise SystemExit(f"--env-kwargs must be a JSON object of the env's keyword arguments, got {args.env_kwargs!r}")
+            raise SystemExit(f"--env-kwargs: must be a JSON object of constructor arguments, got {args.env_kwargs!r}")
     record = search(args.env, args.agent, design_seed=args.design_seed, coarse_episodes=args.coarse_episodes,
                     final_episodes=args.final_episodes, coarse_step=args.coarse_step,
                     refine_steps=tuple(float(x) for x in args.refine_steps.split(",") if x),
@@ -775,5 +775,6 @@ if __name__ == "__main__":
     raise SystemExit(main())
 
 
-__all__ = ["DEAD_BAND_DEG", "Posture", "StaticGaze", "check_posture", "env_geometry", "resolve_spec", "search",
+__all__ = ["DEAD_BAND_DEG", "Posture", "StaticGaze", "check_posture", "env_geometry", "registered_kwargs",
+           "resolve_spec", "search",
            "searched_posture", "static_gaze_spec"]

@@ -44,6 +44,10 @@ _FIXATION = _S["fixation"].start  # the eye's vergence distance (m): propriocept
 _LOG_FIX = tuple(math.log(x) for x in OculomotorParams().fixation_range_m)
 _GAIT_PHASE, _FOOTHOLDS, _TIME = _S["gait_phase"].start, _S["footholds"].start, _S["time"].start
 _SLOTS = tuple(_S[f"obstacle_{k}"].start for k in range(K_SLOTS))
+# With gaze_mode="footholds" the planner sees an obstacle's footprint std capped at this (m): a far, crowded
+# glimpse (its keep-out zone grown by 2 std would close the walkway) keeps a zone of its estimate's size plus
+# 2 caps; the gaze fixates it before a foothold near it is chosen (modelling choice).
+FOOTHOLDS_PLAN_MAX_SD_M = 0.1
 NECK_PITCH_DOWN_DEG = 50.0  # the head action's -1 (envs_assets/common/head_eye.xml: neck_pitch -50 .. 40)
 
 
@@ -74,6 +78,29 @@ class IwaoParams:
     pursuit_lead_s: float = 0.0
     gaze_blind: bool = False
     control_dt: float = 0.02
+    # Where the gaze goes: "iwao" (the Gaussians of Eq. 1-10 toward the next obstacle, the default) or
+    # "footholds" (for the rough course, tasks.obstacle_walk.ROUGH_COURSE; set by ``for_env`` when the
+    # registered course is rough): fixations of 0.24-0.4 s, each held on a hazard among the next footholds
+    # (the least certain first) or on the ground ahead (see _foothold_target, _look_footholds).
+    gaze_mode: str = "iwao"
+    # Hazards whose near edge lies within this many steps of the last latched foothold are candidates
+    # (Matthis, Yates & Hayhoe 2018: fixations on footholds 2-3 steps ahead on rough terrain).
+    foothold_look_steps: float = 3.0
+    # ... and one whose footprint is known to within this std (m) needs no fixation (modelling choice: a
+    # tenth of the smallest hazard, the 4 cm lateral margin of the planner is then hardly used).
+    foothold_precise_m: float = 0.02
+    # With no hazard to look at, the gaze goes to the ground this many steps ahead of the last latched
+    # foothold, where the next hazards come into the fovea's reach (Matthis et al. 2018: 2-3 steps;
+    # 1.5 steps, nearer Patla & Vickers' 1-2 m travel fixations, crossed 21 of 24 design courses, 2.5 steps 24).
+    foothold_travel_steps: float = 2.5
+    # A hazard known precisely is looked at (again) once it lies this many steps beyond the last latched
+    # foothold: 2-3 steps ahead of the feet (Matthis, Yates & Hayhoe 2018).
+    foothold_ahead_steps: float = 1.0
+    # A fixation lasts at least foothold_min_fixation_s before the gaze moves on from a target known
+    # precisely by then (or from the ground), and at most foothold_max_fixation_s (fixations last ~0.2-0.4 s
+    # in real environments: Tatler & Land 2016; modelling choices within that range).
+    foothold_min_fixation_s: float = 0.24
+    foothold_max_fixation_s: float = 0.4
 
 
 class IwaoAgent:
@@ -108,6 +135,8 @@ class IwaoAgent:
         # fields when the id is registered with them), so the obstacle memory weights each sample as
         # this eye makes it; the noise scale, foveation and slip knee given as overrides win.
         params = replace(base, **overrides)
+        if "gaze_mode" not in overrides and _registered_course_is_rough(env_id):
+            params = replace(params, gaze_mode="footholds")
         vision = env_vision_params(env_id)
         mine = {"vision_noise_scale": "noise_scale", "foveated": "foveated",
                 "position_slip_knee_deg_s": "position_slip_knee_deg_s"}
@@ -135,6 +164,8 @@ class IwaoAgent:
         self.peaks = (0.0, 0.0)
         self.target = None  # (x, y, z) of the point looked at this cycle, path frame
         self.target_id = -1
+        self.fix_steps = 0  # control steps since the footholds gaze picked its target
+        self.fix_count: dict[int, int] = {}  # fixations per hazard label (footholds gaze)
         self.footstep = WalkerBody.action_from_footstep(self.gait.nominal_step_m, 0.0, self.gait.nominal_clearance_m,
                                                         self.gait)
         self.log: list[tuple] = []  # (time, target id, theta_H, theta_E) per step, for plots
@@ -170,6 +201,8 @@ class IwaoAgent:
         # (One float32 array from the list: the same rounding as writing into np.zeros(8, float32).)
         if self.params.gaze_blind:
             return np.array(self.footstep + [0.0, 0.0, 0.0, 0.0, 0.0], dtype=np.float32)
+        if self.params.gaze_mode == "footholds":
+            return np.array(self.footstep + self._look_footholds(obs, phase, pose), dtype=np.float32)
         return np.array(self.footstep + self._look(obs, phase, pose), dtype=np.float32)
 
     def _perceive(self, ol: list, pose, vergence: float | None = None) -> None:
@@ -206,6 +239,10 @@ class IwaoAgent:
         footholds = self._footholds(obs, odo)
         u_last = footholds[-1][0]
         ahead = [o for o in self.memory.known() if o.x1 > footholds[0][0] - 0.3 and o.x0 < u_last + 6.0]
+        if self.params.gaze_mode == "footholds":
+            cap = FOOTHOLDS_PLAN_MAX_SD_M
+            ahead = [o if max(o.sx, o.sy, o.sz) <= cap else replace(o, sx=min(o.sx, cap), sy=min(o.sy, cap), sz=min(o.sz, cap))
+                     for o in ahead]
         length, lateral, clearance = self.planner.plan(footholds, ahead)
         return WalkerBody.action_from_footstep(length, lateral, clearance, self.gait)
 
@@ -221,6 +258,96 @@ class IwaoAgent:
         # Slots seen on one edge only, or not yet: the travel point ahead on the ground.
         eye_x = odo[0] + pose[0][0]
         return (eye_x + self.params.travel_look_ahead_m, odo[1], 0.0), -1
+
+    def _foothold_target(self, obs: np.ndarray, pose):
+        """The rough course's next fixation target (path frame) and its label (-1: a ground point).
+
+        Among the hazards not yet stepped over whose near edge lies within ``foothold_look_steps`` of the
+        last latched foothold: the one whose footprint is least certain, if its std exceeds
+        ``foothold_precise_m`` (an obstacle seen at one edge only counts as uncertain, at its seen point);
+        else, of those at least ``foothold_ahead_steps`` beyond that foothold (2-3 steps ahead), the one
+        fixated least often so far, the nearest on ties; else the ground ``foothold_travel_steps`` ahead
+        of that foothold, on the centre line."""
+        p = self.params
+        footholds = self._footholds(obs, pose[2])
+        u_last = footholds[-1][0]
+        step = self.gait.nominal_step_m
+        reach = u_last + p.foothold_look_steps * step
+        unsure, unsure_sd = None, p.foothold_precise_m
+        sure = []
+        known = {o.index: o for o in self.memory.known()}
+        for index, points in self.memory.corners.items():
+            o = known.get(index)
+            if o is not None:
+                if o.x1 <= u_last or o.x0 > reach:
+                    continue
+                sd = max(o.sx, o.sy)
+                centre = (0.5 * (o.x0 + o.x1), 0.5 * (o.y0 + o.y1), o.height)
+            else:
+                seen = [pt.estimate()[0] for pt in points if pt.n >= 2]
+                if not seen:
+                    continue
+                centre = tuple(float(c) for c in seen[0])
+                if centre[0] <= u_last or centre[0] > reach:
+                    continue
+                sd = math.inf
+            if sd > unsure_sd or (sd == unsure_sd and unsure is not None and centre[0] < unsure[0][0]):
+                unsure, unsure_sd = (centre, index), sd
+            elif o is not None and o.x0 >= u_last + p.foothold_ahead_steps * step:
+                sure.append((self.fix_count.get(index, 0), centre[0], centre, index))
+        if unsure is not None:
+            return unsure
+        if sure:
+            _, _, centre, index = min(sure)
+            return centre, index
+        return (u_last + p.foothold_travel_steps * step, 0.0, 0.0), -1
+
+    def _look_footholds(self, obs: np.ndarray, phase: float, pose) -> list:
+        """The rough course's gaze (``gaze_mode="footholds"``): at each step's start a saccade to
+        :meth:`_foothold_target`, held there for the step (the request follows the point's direction, so
+        the plant's pursuit stabilises it while walking: Matthis, Yates & Hayhoe 2018); the head pitched
+        down by Iwao's share ``alpha / (1 + alpha)`` of the gaze's depression (Eq. 6), the eye the rest;
+        vergence on the target under the depth law."""
+        _, rot, odo = pose
+        p = self.params
+        self.fix_steps += 1
+        held = self.fix_steps * p.control_dt
+        if self.target is None or held >= p.foothold_max_fixation_s:
+            decide = True
+        elif held >= p.foothold_min_fixation_s:  # on once the target is known well enough (or is the ground)
+            o = self.memory.obstacle(self.target_id) if self.target_id >= 0 else None
+            decide = self.target_id < 0 or (o is not None and max(o.sx, o.sy) <= p.foothold_precise_m)
+        else:
+            decide = False
+        if decide:
+            target, target_id = self._foothold_target(obs, pose)
+            if target_id != self.target_id or target_id < 0 or self.target is None:
+                self.target, self.target_id = target, target_id
+                self.fixation = target
+                if target_id >= 0:
+                    self.fix_count[target_id] = self.fix_count.get(target_id, 0) + 1
+            self.fix_steps = 0
+        ex, ey, ez = _eye_in_path(pose)[0]
+        fx, fy, fz = self.fixation
+        az, el = _angles(fx - ex, fy - ey, fz - ez)
+        a = self.gaze_params.alpha
+        head = max(-el, 0.0) * a / (1.0 + a)
+        self.log.append((float(obs[_TIME]), self.target_id, head, max(-el, 0.0) - head))
+        ce = math.cos(el)
+        wx, wy, wz = ce * math.cos(az), ce * math.sin(az), math.sin(el)
+        c, s_ = math.cos(odo[2]), math.sin(odo[2])
+        wx, wy = c * wx + s_ * wy, -s_ * wx + c * wy  # path frame to pelvis frame (yaw)
+        (a00, a01, a02), (a10, a11, a12), (a20, a21, a22) = rot
+        e0 = a00 * wx + a10 * wy + a20 * wz  # R^T w: in the eye frame
+        e1 = a01 * wx + a11 * wy + a21 * wz
+        e2 = a02 * wx + a12 * wy + a22 * wz
+        d_az = math.atan2(e1, e0)
+        d_el = math.atan2(e2, math.hypot(e0, e1))
+        r = self.gaze_range
+        return [min(max(d_az / r, -1.0), 1.0), min(max(d_el / r, -1.0), 1.0),
+                self._verge(ex, ey, ez, wx, wy, wz, True),
+                0.0,  # head yaw straight
+                min(max(-head / (NECK_PITCH_DOWN_DEG * DEG), -1.0), 0.0)]
 
     def _verge(self, ex, ey, ez, wx, wy, wz, fixating: bool) -> float:
         """The fixation (vergence) action. Without the depth law in the agent's vision model 0 (the
@@ -319,6 +446,23 @@ class IwaoAgent:
                 self._verge(ex, ey, ez, wx, wy, wz, fixating),
                 0.0,  # head yaw straight
                 min(max(-head / (NECK_PITCH_DOWN_DEG * DEG), -1.0), 0.0)]
+
+
+def _registered_course_is_rough(env_id: str) -> bool:
+    """Whether ``env_id`` is registered (in this process) with the rough course of ObstacleWalk."""
+    import gymnasium as gym
+
+    from visuomotor_gym.tasks.obstacle_walk import CourseDistribution
+
+    try:
+        course = (gym.spec(env_id).kwargs or {}).get("course_distribution")
+    except gym.error.Error:
+        return False
+    if isinstance(course, str):
+        return course == "rough"
+    if isinstance(course, dict):
+        return course.get("layout") == "rough"
+    return isinstance(course, CourseDistribution) and course.rough
 
 
 def _fixation_action(distance: float) -> float:

@@ -21,6 +21,7 @@ from visuomotor_gym.core.head import HEAD_BLOCKS
 from visuomotor_gym.core.observation import ObservationLayout
 from visuomotor_gym.core.parts import Task
 from visuomotor_gym.tasks.obstacle_walk import (
+    COURSE_PRESETS,
     DEFAULT_REWARD_WEIGHTS,
     K_SLOTS,
     PERCEPT_BLOCKS,
@@ -153,6 +154,12 @@ class ObstacleWalkEnv(WalkerEnv):
     padded with NaN rows to the scene's 16 obstacles, of which the first ``n_obstacles`` are the
     course's (a fixed shape, so that ``gymnasium.make_vec`` can stack it).
 
+    **The rough course** (opt-in, ``course_distribution="rough"``; ``ROUGH_COURSE`` in
+    ``visuomotor_gym.tasks.obstacle_walk``): 12-14 m with up to 16 small patches and rocks (15-35 cm,
+    about one per step, anywhere across the walkway), so that nearly every foothold must be chosen. On it
+    an obstacle is sampled only within 5 m of the pelvis, and a slot's id is a label given in the order
+    the eye first saw the obstacle (an obstacle never seen takes no slot; an empty slot reads id -1).
+
     ## Arguments
 
     ARGUMENTS_TABLE
@@ -160,7 +167,8 @@ class ObstacleWalkEnv(WalkerEnv):
     ## Version History
 
     * v0: initial release; redefined before release: the 1.5 m walkway (off path ends the
-      episode), bars across it, four seen points per obstacle.
+      episode), bars across it, four seen points per obstacle. Opt-in ``course_distribution="rough"``
+      (prototype): the default course and its observations unchanged.
     """
 
     render_cameras: ClassVar[dict[str, tuple[str, ...]]] = {
@@ -175,7 +183,8 @@ class ObstacleWalkEnv(WalkerEnv):
     default_reward_weights = DEFAULT_REWARD_WEIGHTS
     reward_terms = REWARD_TERMS
     argument_meanings = {  # noqa: RUF012  (read only: the generated Arguments table)
-        "course_distribution": "``CourseDistribution`` or dict",
+        "course_distribution": ('``CourseDistribution``, dict, or a preset name: ``"walkway"`` (the default) or '
+                                '``"rough"`` (``ROUGH_COURSE``: small hazards on most footholds, opt-in)'),
         "vision": ('``"foveated"``, ``"full_view"`` (foveal noise everywhere, no field-of-view limit, no saccadic '
                    'blindness) or ``"oracle"`` (true corners)'),
         "vision_params": ("``VisionParams`` or a dict of its fields; the default is the catch family's except "
@@ -188,9 +197,12 @@ class ObstacleWalkEnv(WalkerEnv):
         self,
         render_mode: str | None = None,
         *,
-        course_distribution: CourseDistribution | dict | None = None,
+        course_distribution: CourseDistribution | dict | str | None = None,
         **shared: Any,
     ):
+        if isinstance(course_distribution, str):
+            course_distribution = COURSE_PRESETS[args.choice(course_distribution, tuple(COURSE_PRESETS),
+                                                             "course_distribution")]
         self.course_distribution = args.coerce(CourseDistribution, course_distribution, "course_distribution")
         super().__init__(render_mode, **shared)
 

@@ -29,6 +29,21 @@ the ``K_SLOTS`` = 4 next obstacles of the course (slot ``k`` = course obstacle `
 number of obstacles the pelvis has passed by more than ``PASSED_M``): with free gaps >= 1.6 m four slots
 reach >= 6 m ahead, more than the 2 steps (~1.3 m) that walkers need to see (Matthis & Fajen 2014) and
 the 1-2 m of travel fixations (Patla & Vickers 1997). A point not seen this step reads as zeros.
+
+**The rough course** (opt-in, ``course_distribution="rough"``: :data:`ROUGH_COURSE`): small
+hazards strewn over the walkway so that nearly every foothold has to be chosen. Instead of a few
+large bars and mats with 1.6-3 m between them, up to 16 (the scene's pool) small flat *patches* (a
+foot must not land on them: misstep) and low *rocks* (a leg must not strike them: trip), 15-35 cm
+across, follow one another every 0.5-0.9 m along the path (near edge to near edge: about one hazard
+per 0.65 m step), each anywhere across the walkway (centre within 0.5 m of the centre line),
+never overlapping. Humans on such ground look at the footholds 2-3 steps ahead, ~1.5 s before the foot
+lands (Matthis, Yates & Hayhoe 2018, Curr Biol 28:1224); the sizes, spacings and the 4-12 cm rocks are
+modelling choices (irregular footholds smaller than a step, a few of them within each step's reach;
+ALLSTEPS, Xie et al. 2020, uses stones of 25-50 cm for its stepping-stone curricula). On this course
+the slots carry no hidden truth: an obstacle is sampled by the eye only within ``sight_range_m`` of the
+pelvis, its slot id is a *label* given in the order the eye first saw it (never a course index), and the
+slots hold the labelled obstacles not yet passed, lowest label first: an obstacle that was never seen
+takes no slot and changes no id when it is passed.
 """
 
 from __future__ import annotations
@@ -40,7 +55,7 @@ import numpy as np
 
 from visuomotor_gym.body import walker_names as wn
 from visuomotor_gym.core import args
-from visuomotor_gym.core.args import Num, Pair, Weights
+from visuomotor_gym.core.args import Choice, Num, Pair, Weights
 from visuomotor_gym.core.observation import Block
 from visuomotor_gym.core.parts import Task
 from visuomotor_gym.core.retina import PointTarget
@@ -52,10 +67,16 @@ K_SLOTS = 4
 TOP_POINTS = ("near_left", "far_right", "near_mid", "far_mid")
 N_POINTS = len(TOP_POINTS)
 PASSED_M = 0.5  # an obstacle whose far edge is this far behind the pelvis leaves the slots (modelling choice)
+# On the rough course an obstacle leaves the slots once its far edge is less than 0.3 m ahead of the pelvis
+# (modelling choice: hazards come every ~0.7 m, so the four slots must reach beyond the next two footholds,
+# ~1.3-2 m ahead; the hazard under the feet is behind the leading foot by then, and an agent keeps in its
+# own memory what it saw of it).
+ROUGH_PASSED_M = -0.3
 KINDS = ("bar", "box", "mat")
 BAR, BOX, MAT = 0, 1, 2
 REWARD_TERMS = ("finish", "trip", "misstep", "off_path", "progress")
 DEFAULT_REWARD_WEIGHTS = {"finish": 1.0, "trip": -1.0, "misstep": -1.0, "off_path": -1.0, "progress": 0.0}
+LAYOUTS = ("walkway", "rough")  # CourseDistribution.layout: today's course, the rough one (module docstring)
 OBSTACLE_RGBA = {BAR: (0.80, 0.25, 0.20, 1.0), BOX: (0.85, 0.55, 0.15, 1.0), MAT: (0.08, 0.08, 0.08, 1.0)}
 
 
@@ -77,6 +98,11 @@ COURSE_RULES = {
     "mat_height_m": Num(0.0, 0.1, low_open=True),
     "offset_m": Pair(Num(-2.0, 2.0)),
     "mat_offset_m": Pair(Num(-2.0, 2.0)),
+    "layout": Choice(LAYOUTS),
+    "rough_step_m": Pair(Num(0.05, 10.0)),
+    "rough_lateral_m": Pair(Num(-2.0, 2.0)),
+    "rough_patch_m": Pair(Num(0.0, 5.0, low_open=True)),
+    "sight_range_m": Num(0.5, 200.0),
 }
 
 
@@ -98,9 +124,32 @@ class CourseDistribution:
     mat_height_m: float = 0.01
     offset_m: tuple[float, float] = (-0.15, 0.15)  # boxes: centre beside the path's centre line
     mat_offset_m: tuple[float, float] = (-0.3, 0.3)
+    # The rough course (module docstring; used only with layout="rough", see ROUGH_COURSE): hazards
+    # follow one another every rough_step_m (near edge to near edge), their centres rough_lateral_m from
+    # the centre line; patches rough_patch_m along and across (drawn apart: irregular); rocks are boxes
+    # (box_depth_m, box_width_m, height_m); the eye samples obstacles within sight_range_m ahead.
+    layout: str = "walkway"
+    rough_step_m: tuple[float, float] = (0.5, 0.9)  # modelling choice: about one hazard per 0.65 m step
+    rough_lateral_m: tuple[float, float] = (-0.5, 0.5)  # modelling choice: anywhere on the 1.5 m walkway
+    rough_patch_m: tuple[float, float] = (0.2, 0.35)  # modelling choice: smaller than a step, ~a foot long
+    sight_range_m: float = 5.0  # modelling choice: ~4 s of walking; beyond the 2-3 steps humans fixate
 
     def __post_init__(self) -> None:
         args.check_fields(self, COURSE_RULES)
+
+    @property
+    def rough(self) -> bool:
+        return self.layout == "rough"
+
+
+# The opt-in rough course (module docstring): 12-14 m, the first hazard 2.5-3.5 m ahead, no bars,
+# rocks (40 %: 15-25 cm, 4-12 cm high) and patches (60 %: 20-35 cm, 1 cm high). Modelling choices; the
+# density is the highest at which the iwao planner with true footprints (ObstacleWalkOracle-v0) still
+# crosses nearly every course (docs/reproductions/data/terrain/obstacle_walk.md).
+ROUGH_COURSE = CourseDistribution(layout="rough", length_m=(12.0, 14.0), first_m=(2.5, 3.5), finish_clear_m=1.0,
+                                  kind_p=(0.0, 0.4, 0.6), height_m=(0.04, 0.12), box_depth_m=(0.15, 0.25),
+                                  box_width_m=(0.15, 0.25))
+COURSE_PRESETS = {"walkway": CourseDistribution(), "rough": ROUGH_COURSE}
 
 
 @dataclass(frozen=True)
@@ -113,6 +162,8 @@ def sample_course(rng: np.random.Generator, dist: CourseDistribution, max_obstac
     """One course: obstacles in path order, free gaps between them, none near the finish."""
     if not dist.walkway_width_m > 0.0:
         raise ValueError(f"course_distribution.walkway_width_m must be > 0 m, got {dist.walkway_width_m!r}")
+    if dist.rough:
+        return _sample_rough(rng, dist, max_obstacles)
     length = float(rng.uniform(*dist.length_m))
     rows = []
     near = float(rng.uniform(*dist.first_m))
@@ -132,6 +183,52 @@ def sample_course(rng: np.random.Generator, dist: CourseDistribution, max_obstac
         rows.append((near + 0.5 * depth, y, depth, width, height, kind))
         near += depth + float(rng.uniform(*dist.gap_m))
     return Course(length, np.array(rows, dtype=float).reshape(-1, 6))
+
+
+ROUGH_TRIES = 6  # lateral draws before a hazard that overlaps another is moved along the path
+ROUGH_CLEAR_M = 0.05  # free space kept between two hazards' footprints (modelling choice)
+
+
+def _sample_rough(rng: np.random.Generator, dist: CourseDistribution, max_obstacles: int) -> Course:
+    """The rough course (module docstring): hazards every ``rough_step_m`` along the path, each at a
+    lateral offset drawn until its footprint keeps ``ROUGH_CLEAR_M`` from every earlier one (after
+    ``ROUGH_TRIES`` draws it moves on along the path, past the far edge of the hazards it overlaps)."""
+    length = float(rng.uniform(*dist.length_m))
+    rows: list[tuple] = []
+    near = float(rng.uniform(*dist.first_m))
+    w = np.asarray(dist.kind_p, dtype=float)
+    while len(rows) < max_obstacles:
+        kind = int(rng.choice(3, p=w / w.sum()))
+        if kind == MAT:
+            depth, width = float(rng.uniform(*dist.rough_patch_m)), float(rng.uniform(*dist.rough_patch_m))
+            height = dist.mat_height_m
+        elif kind == BOX:
+            depth, width = float(rng.uniform(*dist.box_depth_m)), float(rng.uniform(*dist.box_width_m))
+            height = float(rng.uniform(*dist.height_m))
+        else:  # a bar across the walkway
+            depth, width, height = dist.bar_depth_m, dist.walkway_width_m, float(rng.uniform(*dist.height_m))
+        for _ in range(ROUGH_TRIES):
+            y = 0.0 if kind == BAR else float(rng.uniform(*dist.rough_lateral_m))
+            hit = [r for r in rows if _overlap(near, depth, y, width, r)]
+            if not hit:
+                break
+        else:
+            while hit:  # keep the last lateral draw; move on past what it overlaps
+                near = max(r[0] + 0.5 * r[2] for r in hit) + ROUGH_CLEAR_M
+                hit = [r for r in rows if _overlap(near, depth, y, width, r)]
+        if near + depth > length - dist.finish_clear_m:
+            break
+        rows.append((near + 0.5 * depth, y, depth, width, height, kind))
+        near += float(rng.uniform(*dist.rough_step_m))
+    rows.sort(key=lambda r: r[0] - 0.5 * r[2])  # path order of the near edges
+    return Course(length, np.array(rows, dtype=float).reshape(-1, 6))
+
+
+def _overlap(near: float, depth: float, y: float, width: float, row: tuple) -> bool:
+    """Whether a footprint (near edge, depth, centre y, width) comes within ``ROUGH_CLEAR_M`` of ``row``'s."""
+    x, ry, d, w = row[:4]
+    return (near < x + 0.5 * d + ROUGH_CLEAR_M and near + depth > x - 0.5 * d - ROUGH_CLEAR_M
+            and abs(y - ry) < 0.5 * (width + w) + ROUGH_CLEAR_M)
 
 
 def obstacle_blocks(k: int) -> Block:
@@ -180,6 +277,8 @@ class ObstacleWalkTask(Task):
                              for name in wn.WALKER_WALKWAY_EDGES]
         self._sole_sites = list(body.gait.sole_sites)
         self.half_width = 0.5 * course_distribution.walkway_width_m
+        self.rough = course_distribution.rough  # labelled slots, sight range (module docstring)
+        self.sight_range = course_distribution.sight_range_m
         self.course = Course(0.0, np.zeros((0, 6)))
         self.reset_state()
 
@@ -197,6 +296,8 @@ class ObstacleWalkTask(Task):
         self._n_events = 0
         self._prev_x = 0.0
         self.seen = [False] * K_SLOTS
+        self.labels: dict[int, int] = {}  # rough course: course index -> label (order of first sighting)
+        self._passed: list[bool] = []  # rough course: each obstacle passed by the pelvis
 
     def reset_episode(self, data: mujoco.MjData, rng: np.random.Generator) -> None:
         """Draw the course, place the obstacles and the finish line (the walker is already at the start)."""
@@ -262,6 +363,14 @@ class ObstacleWalkTask(Task):
         n0 = self.n_passed
         while self.n_passed < len(obs) and obs[self.n_passed, 0] + 0.5 * obs[self.n_passed, 2] < x - PASSED_M:
             self.n_passed += 1
+        if self.rough:
+            # Sampled: every obstacle not yet passed whose near edge lies within the sight range.
+            self._passed = passed = [row[0] + 0.5 * row[2] < x - ROUGH_PASSED_M for row in obs.tolist()]
+            for i, row in enumerate(obs.tolist()):
+                hidden = passed[i] or row[0] - 0.5 * row[2] > x + self.sight_range
+                for t in self.targets[N_POINTS * i: N_POINTS * (i + 1)]:
+                    t.hidden = hidden
+            return
         if n0 != self.n_passed or not self._slots_set:
             # Only the slots' obstacles are sampled (the others would not reach the observation; those
             # passed lie behind the walker, beyond any reach of the eye and the head).
@@ -274,6 +383,9 @@ class ObstacleWalkTask(Task):
     def observe_leading(self, values: list, samples: list) -> None:
         """The :data:`PERCEPT_BLOCKS`: per slot, id, the four points (eye frame) and their seen flags."""
         n_obstacles = len(samples) // N_POINTS
+        if self.rough:
+            self._observe_labelled(values, samples, n_obstacles)
+            return
         for k in range(K_SLOTS):
             i = self.n_passed + k
             values.append(float(i))
@@ -285,6 +397,30 @@ class ObstacleWalkTask(Task):
                 values += seen
                 self.seen[k] = 1.0 in seen
             else:
+                values += _UNSEEN_SLOT
+                self.seen[k] = False
+
+    def _observe_labelled(self, values: list, samples: list, n_obstacles: int) -> None:
+        """The rough course's slots (module docstring): labels in the order of first sighting (course
+        order within a step), the labelled obstacles not yet passed, lowest label first; an empty slot
+        reads id -1, zeros and unseen flags."""
+        labels = self.labels
+        for i in range(n_obstacles):
+            if i not in labels and any(v for _, _, v in samples[N_POINTS * i: N_POINTS * (i + 1)]):
+                labels[i] = len(labels)
+        slots = sorted((label, i) for i, label in labels.items() if not self._passed[i])[:K_SLOTS]
+        for k in range(K_SLOTS):
+            if k < len(slots):
+                label, i = slots[k]
+                values.append(float(label))
+                seen = []
+                for p, _, v in samples[N_POINTS * i: N_POINTS * (i + 1)]:
+                    values += p
+                    seen.append(1.0 if v else 0.0)
+                values += seen
+                self.seen[k] = 1.0 in seen
+            else:
+                values.append(-1.0)
                 values += _UNSEEN_SLOT
                 self.seen[k] = False
 
@@ -363,5 +499,6 @@ def top_points_of(obstacles: np.ndarray) -> np.ndarray:
 _UNSEEN_SLOT = [0.0] * (4 * N_POINTS)
 
 
-__all__ = ["KINDS", "K_SLOTS", "N_POINTS", "TOP_POINTS", "Course", "CourseDistribution", "ObstacleWalkTask",
+__all__ = ["COURSE_PRESETS", "KINDS", "K_SLOTS", "LAYOUTS", "N_POINTS", "ROUGH_COURSE", "TOP_POINTS", "Course",
+           "CourseDistribution", "ObstacleWalkTask",
            "sample_course", "top_points", "top_points_of"]
