@@ -232,7 +232,7 @@ def test_lookahead_adapts_only_when_its_vision_model_has_the_periphery():
 def test_static_gaze_search_takes_env_kwargs(tmp_path):
     """``--env-kwargs`` reaches the env (the rough course, the human periphery) and the agent's vision
     model, is recorded, and bad values are refused before any episode."""
-    from visuomotor_gym.static_gaze import _Scorer, main
+    from visuomotor_gym.static_gaze import _Scorer, main, registered_kwargs
 
     kwargs = {"course_distribution": "rough", "vision_params": {"field_shape": "human", "crowding": True}}
     out = tmp_path / "s.json"
@@ -241,12 +241,16 @@ def test_static_gaze_search_takes_env_kwargs(tmp_path):
                  "--env-kwargs", json.dumps(kwargs)]) == 0
     record = json.loads(out.read_text())
     assert record["env_kwargs"] == kwargs and len(record["postures"]) == 1
-    scorer = _Scorer("SteppingStones-v0", "lookahead", 100000, env_kwargs=kwargs)
-    try:
-        assert scorer.env.unwrapped.course_distribution.hazards_per_stone == 2
-        assert scorer.env.unwrapped.vision_params.crowding
-    finally:
-        scorer.close()
+    with registered_kwargs("SteppingStones-v0", kwargs):
+        scorer = _Scorer("SteppingStones-v0", "lookahead", 100000)
+        try:
+            assert scorer.env.unwrapped.course_distribution.hazards_per_stone == 2
+            assert scorer.env.unwrapped.vision_params.crowding
+            agent = make_agent("lookahead", "SteppingStones-v0", 9)
+            assert agent.vision == scorer.env.unwrapped.vision_params  # the agent models the env's eye
+        finally:
+            scorer.close()
+    assert not gym.spec("SteppingStones-v0").kwargs  # restored
     with pytest.raises(SystemExit, match="JSON object"):
         main(["search", "--env", "SteppingStones-v0", "--agent", "lookahead", "--out", str(out),
               "--env-kwargs", "[1, 2]"])
