@@ -52,6 +52,16 @@ saccade that brought it (modelling choice; shorter than a typical human fixation
 ``search_azimuth_deg`` = 45 deg to either side (where pedestrians 4-6 m to the side appear), each side
 an urgency that grows with the time since it was last scanned.
 
+**Groups** (only when the env's ``crowd_distribution`` has groups; :func:`group_prior`, the agent's prior
+about the crowd like the known number of pedestrians): while pedestrians remain unseen, each known one
+with no known neighbour is assumed to have companions abreast at the env's mean spacing, which the
+evasion avoids (``companion_m``); fixations last at least ``GROUP_MIN_DWELL_S`` = 0.2 s (the short end
+of human fixations, 200-400 ms: Tatler & Land 2016), counted from the saccade that brought the gaze
+(``dwell_saccade_s``: catch-up saccades on a near pedestrian no longer restart it); the search for the
+next group is more urgent (``GROUP_SEARCH_WEIGHT``), since half the pedestrians appear at once and a
+near group holds the gaze. Re-fixating each member follows from the risk rule: each member has its own
+slot and filter. See docs/reproductions/data/terrain/dodge_groups.md.
+
 ``gaze_blind=True`` holds gaze and head (gaze action 0: gaze stays level at the goal; head straight):
 the gaze-blind twin (docs/gaze_gain.md), the same filter and steering.
 """
@@ -76,10 +86,10 @@ _FIXATION = _S["fixation"].start  # the eye's vergence distance (m): propriocept
 _LOG_FIX = tuple(math.log(x) for x in OculomotorParams().fixation_range_m)
 MIN_STD = 1e-3  # floor of the measurement std (the oracle rung is noiseless)
 # With groups, half the pedestrians come at once and a near group holds the gaze: the search urgency per
-# second is raised so that the next group is found in time (modelling choice; swept on seeds 0-19 of
-# docs/reproductions/data/terrain/dodge_groups.md).
+# second is raised so that the next group is found in time (modelling choice; 0.6, 1.2 and 2.0 tried on
+# seeds 0-19, docs/reproductions/data/terrain/dodge_groups.md).
 GROUP_SEARCH_WEIGHT = 2.0
-GROUP_MIN_DWELL_S = 0.2
+GROUP_MIN_DWELL_S = 0.2  # s: the short end of human fixations, 200-400 ms (Tatler & Land 2016)
 
 
 @dataclass(frozen=True)

@@ -18,12 +18,24 @@ the walker if both kept their velocities) for ``veer_s`` = 1.0 s (the veer in Jo
 ~1 s; REFERENCES.md "(10 %, ~1 s)"), then resumes its course. (In the first definition of v0 ``veer_s`` was
 1.5 s, a modelling choice; docs/reproductions/dodge.md has both.)
 
+**Groups** (opt-in: ``CrowdDistribution.group_size`` other than (1, 1); :func:`sample_groups`): the same
+4 pedestrians come as groups (e.g. ``group_size=(2, 3)``: pairs and triads, the commonest groups of
+Moussaid, Perozo, Garnier, Helbing & Theraulaz 2010, PLoS ONE 5:e10047, Fig. 1), one group per onset,
+members walking abreast ``group_spacing_m`` = 0.7-0.9 m apart (their "side by side" formation at low
+density, around the fitted preferred distance of 0.8 m, Fig. 4) across the path together; one member
+of a group may veer alone (so that 10 % of the pedestrians still veer). A group is a wider obstacle
+than a pedestrian, its members close enough to be pooled by crowding in the periphery
+(``VisionParams.crowding``), so that each has to be looked at. With groups the observation's slots
+are given in order of first sight (below), not of onset.
+
 **What the eye sees of a pedestrian**: one point on its axis at 1.5 m (upper chest, a modelling choice
 near the eyes' height so a level gaze sees it) with its velocity (:class:`PedestrianTarget`), sampled by
 the retina like any target (eccentricity-dependent noise on position and velocity, the walk family's 20
 deg recognition field, saccadic suppression, visual delay). The observation holds ``K_SLOTS`` = 4 slots,
 slot ``k`` = pedestrian ``k`` of the episode (in onset order; the number of pedestrians never exceeds the
-slots): seen flag, position and velocity in the eye frame (zeros when not seen this step).
+slots): seen flag, position and velocity in the eye frame (zeros when not seen this step). With groups,
+slot ``k`` = the ``k``-th pedestrian the eye has seen (those first seen on one step from left to right as
+perceived), so that no slot id tells of a pedestrian not seen yet.
 
 **Collision**: the horizontal distance from the pelvis axis to a pedestrian's axis below
 ``PEDESTRIAN_RADIUS_M`` + the walker's half-width (its chest and arms, read from the model), checked every
@@ -455,4 +467,4 @@ def intercept_velocity(px: float, py: float, speed: float, wx: float, wy: float,
 
 
 __all__ = ["K_SLOTS", "N_PEDESTRIANS", "Crowd", "CrowdDistribution", "ObstacleDodgeTask", "PedestrianTarget",
-           "intercept_velocity", "sample_crowd"]
+           "intercept_velocity", "sample_crowd", "sample_groups"]
