@@ -11,7 +11,8 @@ docs/reproductions/scripts/periphery_sweep.py does), so the env and every agent'
 
 ``--search`` first runs the static posture search (coarse step 30 deg, ``--coarse-episodes``) under the
 condition and plays the chosen posture; ``--posture AZ,EL`` plays a given one instead. Every cell is
-written to ``--out`` (merged by condition) as it finishes.
+written to ``--out`` (merged by condition) as it finishes. ``--combine OUT PART.json ...`` merges the
+per-condition records into one and prints the table.
 """
 
 from __future__ import annotations
@@ -70,7 +71,32 @@ def play(spec: str, seeds: list[int]) -> tuple[list[int], dict, list]:
     return ok, why, traces
 
 
+def combine(parts: list[Path], out: Path) -> str:
+    """Merge the per-condition records ``parts`` into ``out``; return the Markdown table (condition x
+    baseline, held, static, gain = baseline - max(held, static), realism of the baseline)."""
+    cells = [c for p in parts for c in json.loads(p.read_text())["cells"]]
+    record = {"env_id": ENV_ID, "agent": AGENT, "command": " ".join(sys.argv), "conditions": {
+        k: {"crowd_distribution": v[0], "vision_params": v[1]} for k, v in CONDITIONS.items()}, "cells": cells}
+    out.write_text(json.dumps(record, indent=1) + "\n")
+    by = {(c["condition"], c["role"]): c for c in cells}
+    lines = ["| condition | fajen_warren | held twin | best static twin (posture) | gaze gain | realism |",
+             "|---|---|---|---|---|---|"]
+    for cond in CONDITIONS:
+        b, h, s_ = (by.get((cond, r)) for r in ("baseline", "held", "static"))
+        if b is None:
+            continue
+        pct = [f"{100 * c['rate']:.1f} % ({c['successes']}/{c['episodes']})" if c else "–" for c in (b, h, s_)]
+        if s_:
+            pct[2] += f" ({s_['spec'].split(':')[1]})"
+        gain = f"**{100 * (b['rate'] - max(h['rate'], s_['rate'])):+.1f}**" if h and s_ else "–"
+        lines.append(f"| {cond} | {pct[0]} | {pct[1]} | {pct[2]} | {gain} | {b.get('gaze_realism', float('nan')):.3f} |")
+    return "\n".join(lines) + "\n"
+
+
 def main(argv=None) -> int:
+    if argv is None and len(sys.argv) > 1 and sys.argv[1] == "--combine":
+        print(combine([Path(p) for p in sys.argv[3:]], Path(sys.argv[2])), end="")
+        return 0
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--condition", required=True, choices=list(CONDITIONS))
     ap.add_argument("--roles", default="baseline,held,static")
