@@ -299,3 +299,185 @@ def test_fajen_warren_also_predicts_a_veering_pedestrian_returning_to_its_course
     tracks = agent._predicted_tracks([f], tau)
     assert tracks.shape == (4, len(tau), 2)
     assert np.allclose(tracks[3, -1], (3.0 + 1.0 * (tau[-1] - 1.0), 2.0 - 1.3))  # 1 s at -1.3 m/s, then (1, 0)
+
+
+# --- groups (opt-in CrowdDistribution.group_size) --------------------------------------------------
+GROUPS = {"group_size": (2, 3)}
+
+
+def test_groups_off_keep_the_draws_of_v0():
+    """(1, 1) is today's sampler, draw for draw (the RNG stream untouched: tests/test_golden.py)."""
+    for seed in range(5):
+        a = sample_crowd(np.random.default_rng(seed), CrowdDistribution())
+        b = sample_crowd(np.random.default_rng(seed), CrowdDistribution(group_size=(1, 1), group_spacing_m=(2, 3)))
+        assert a.goal == b.goal and np.array_equal(a.pedestrians, b.pedestrians)
+    assert not CrowdDistribution().groups and CrowdDistribution(**GROUPS).groups
+
+
+@pytest.mark.parametrize("bad", [(0, 2), (2, 5), (1.5, 2), (3, 2)])
+def test_group_size_rejects_what_is_not_a_range_of_whole_pedestrians(bad):
+    with pytest.raises(ValueError, match="group_size"):
+        CrowdDistribution(group_size=bad)
+
+
+def test_groups_walk_abreast_at_the_hand_computed_spacing():
+    # pairs, 0.8 m apart, crossing perpendicular to the path (angle 0): members side by side along the path,
+    # x 0.8 m apart, same y, onset and velocity; their crossings 0.8 m apart
+    dist = CrowdDistribution(group_size=(2, 2), group_spacing_m=(0.8, 0.8), angle_deg=0.0, veer_p=0.0)
+    crowd = sample_crowd(np.random.default_rng(3), dist)
+    p = crowd.pedestrians
+    assert p.shape == (N_PEDESTRIANS, 9)
+    for a, b in ((0, 1), (2, 3)):
+        assert p[a, 0] == p[b, 0] and np.array_equal(p[a, 3:5], p[b, 3:5])
+        assert p[a, 2] == pytest.approx(p[b, 2], abs=1e-12)
+        assert abs(p[a, 1] - p[b, 1]) == pytest.approx(0.8, abs=1e-12)
+        assert abs(p[a, 5] - p[b, 5]) == pytest.approx(0.8, abs=1e-12)
+        # the first row is the leftmost as the members walk: left of (vx, vy) is (-vy, vx)
+        left = np.array([-p[a, 4], p[a, 3]])
+        assert np.dot(p[a, 1:3] - p[b, 1:3], left) > 0.0
+    assert p[2, 0] - p[0, 0] >= 1.5 - 1e-9  # the groups one after the other (onset_gap_s)
+    # a triad at 30 deg: three collinear starts, 0.7 m apart, on the line perpendicular to the velocity
+    dist = CrowdDistribution(group_size=(3, 3), group_spacing_m=(0.7, 0.7), angle_deg=30.0)
+    for seed in range(20):
+        p = sample_crowd(np.random.default_rng(seed), dist).pedestrians
+        v = p[0, 3:5] / np.linalg.norm(p[0, 3:5])
+        for a, b in ((0, 1), (1, 2)):
+            d = p[a, 1:3] - p[b, 1:3]
+            assert np.linalg.norm(d) == pytest.approx(0.7, abs=1e-12)
+            assert np.dot(d, v) == pytest.approx(0.0, abs=1e-12)
+        assert p[3, 0] > p[0, 0]  # the fourth pedestrian: a group of its own, cut to what is left
+
+
+def test_groups_have_one_lone_veerer_and_keep_ten_percent_of_pedestrians_veering():
+    rng = np.random.default_rng(2)
+    veers = []
+    for _ in range(600):
+        p = sample_crowd(rng, CrowdDistribution(**GROUPS)).pedestrians
+        veers += p[:, 7].tolist()
+        for onset in np.unique(p[:, 0]):
+            assert p[p[:, 0] == onset, 7].sum() <= 1.0  # a member veers alone
+    assert 0.07 < np.mean(veers) < 0.13  # veer_p of the pedestrians (Jovancevic et al.)
+
+
+def test_groups_are_reproducible_and_one_seed_is_one_crowd_on_every_rung():
+    crowds = []
+    for env_id in DODGE_IDS:
+        env = gym.make(env_id, crowd_distribution=GROUPS)
+        env.reset(seed=11)
+        crowds.append(env.unwrapped.crowd.pedestrians.copy())
+        env.reset(seed=11)
+        assert np.array_equal(env.unwrapped.crowd.pedestrians, crowds[-1])
+        env.close()
+    assert all(np.array_equal(c, crowds[0]) for c in crowds)
+    assert len(np.unique(crowds[0][:, 0])) < N_PEDESTRIANS  # some walk together
+
+
+def _set_crowd(env, rows):
+    """Replace the episode's pedestrians by ``rows`` (the sampler's 9 columns) at time 0."""
+    from visuomotor_gym.tasks.obstacle_dodge import Crowd
+
+    task = env.task
+    task.crowd = Crowd(task.crowd.goal, np.array(rows, dtype=float))
+    task.pos = task.crowd.pedestrians[:, 1:3].copy()
+    task.vel = task.crowd.pedestrians[:, 3:5].copy()
+    task.reset_state()
+    for i in range(N_PEDESTRIANS):
+        task._park(env.data, i)
+    task._activate(env.data, 0.0)
+
+
+SEEN = (0.0, 8.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 4.0)  # ahead, walking away: in the gaze's 20 deg field
+UNSEEN = (0.0, -4.0, -3.0, -1.0, 0.0, 0.0, 0.0, 0.0, 4.0)  # behind the walker: never in the field
+LATER = (900.0, 10.0, 5.0, 0.0, -1.0, 10.0, 0.0, 0.0, 4.0)  # not yet there
+
+
+def test_with_groups_slot_ids_do_not_reveal_unseen_pedestrians():
+    """Counterfactual scenes: a pair of which the eye sees one member, the other behind the walker, with the
+    two in either order of the hidden pedestrian index. With groups the observations are identical (slot 0:
+    the first pedestrian seen); in onset order (v0) the seen member's slot would tell its hidden index,
+    i.e. that an unseen member came before it: the positive control."""
+    obs = {}
+    for order, rows in (("seen first", [SEEN, UNSEEN, LATER, LATER]), ("seen second", [UNSEEN, SEEN, LATER, LATER])):
+        for groups in (True, False):
+            env = ObstacleDodgeEnv(crowd_distribution=GROUPS if groups else None)
+            env.reset(seed=4)
+            _set_crowd(env, rows)
+            out = [env.step(np.zeros(7, dtype=np.float32))[0] for _ in range(25)]
+            assert any(env.task.seen) and sum(env.task.seen) == 1
+            obs[order, groups] = np.array(out)
+            env.close()
+    s0 = DODGE_LAYOUT.slices["pedestrian_0"]
+    assert obs["seen first", True][:, s0.start].max() == 1.0  # slot 0 does show the seen member
+    assert np.array_equal(obs["seen first", True], obs["seen second", True])
+    assert not np.array_equal(obs["seen first", False], obs["seen second", False])
+
+
+def test_simultaneous_first_sightings_take_slots_left_to_right():
+    left, right = list(SEEN), list(SEEN)
+    left[2], right[2] = 1.3, 0.5
+    for rows, left_index in (([left, right, LATER, LATER], 0), ([right, left, LATER, LATER], 1)):
+        env = ObstacleDodgeEnv(crowd_distribution=GROUPS)
+        env.reset(seed=4)
+        _set_crowd(env, rows)
+        o, *_ = env.step(np.zeros(7, dtype=np.float32))
+        s0, s1 = (DODGE_LAYOUT.slices[f"pedestrian_{k}"].start for k in (0, 1))
+        assert o[s0] == 1.0 and o[s1] == 1.0  # both first seen on this step
+        # slot 0: the one further left as perceived (azimuth ~9 against ~3.5 deg; depth is the noisy part)
+        assert math.atan2(o[s0 + 2], o[s0 + 1]) > math.atan2(o[s1 + 2], o[s1 + 1]) + math.radians(3.0)
+        assert env.task.slot_of[left_index] == 0 and env.task.slot_of[1 - left_index] == 1
+        env.close()
+
+
+def test_crowding_pools_group_members_within_the_critical_spacing():
+    """A pair abreast, 0.8 m apart, 7 m ahead (no noise): far in the periphery (about 40 deg off the line of
+    sight) the two lines of sight are ~3 deg apart, inside the critical spacing 0.5 x ~38 deg (Bouma), and
+    each member is seen at the pair's mean; straight ahead (one member near the fovea, the other ~6.5 deg
+    away: spacings ~0.35 and ~3.3 deg) neither is pooled. Hand check of the rule on the eye's real geometry."""
+    vp = {"crowding": True, "field_shape": "human", "noise_scale": 0.0}
+    env = ObstacleDodgeEnv(crowd_distribution=GROUPS, vision_params=vp)
+    env.reset(seed=4)
+    eye, data, task = env.eye, env.data, env.task
+    ex, ey, ez = eye.pos_list
+    r = np.array(eye.rot_flat).reshape(3, 3)
+    # periphery: abreast along the path 6 m to the left (azimuths ~40.6 and ~37.6 deg); ahead: abreast across
+    # the line of sight (one ~0.7 deg below the fovea, the other 0.8 m to its left)
+    for (ax, ay), (bx, by), crowded in (((7.0, 6.0), (7.8, 6.0), True), ((7.0, 0.0), (7.0, 0.8), False)):
+        a = (0.0, ex + ax, ey + ay, 0.0, 0.0, 0.0, 0.0, 0.0, 4.0)
+        b = (0.0, ex + bx, ey + by, 0.0, 0.0, 0.0, 0.0, 0.0, 4.0)
+        _set_crowd(env, [a, b, LATER, LATER])
+        out = env.retina._see_all(data, task.targets, eye, np.random.default_rng(0))
+        pts = [r.T @ (np.array([x, y, 1.5]) - np.array([ex, ey, ez])) for x, y in ((a[1], a[2]), (b[1], b[2]))]
+        u = [p / np.linalg.norm(p) for p in pts]
+        ecc = [math.degrees(math.acos(v[0])) for v in u]
+        sep = math.degrees(math.acos(float(np.dot(u[0], u[1]))))
+        assert out[0][2] and out[1][2] and not out[2][2]
+        assert all((sep < 0.5 * e) == crowded for e in ecc)  # the hand computation of Bouma's rule
+        if crowded:
+            for k in (0, 1):
+                np.testing.assert_allclose(out[k][0], (pts[0] + pts[1]) / 2.0, atol=1e-9)
+        else:
+            for k in (0, 1):
+                np.testing.assert_allclose(out[k][0], pts[k], atol=1e-9)
+    env.close()
+
+
+def test_fajen_warren_models_groups_only_when_the_env_has_them():
+    from visuomotor_gym.baselines.fajen_warren import FajenWarrenAgent
+
+    plain = FajenWarrenAgent.for_env("ObstacleDodge-v0")
+    assert plain.params.companion_m == 0.0 and plain.params.dwell_saccade_s is None
+    kwargs = gym.registry["ObstacleDodge-v0"].kwargs
+    kwargs["crowd_distribution"] = dict(GROUPS)
+    try:
+        grouped = FajenWarrenAgent.for_env("ObstacleDodge-v0")
+    finally:
+        kwargs.pop("crowd_distribution")
+    assert grouped.params.companion_m == pytest.approx(0.8)
+    # a lone known pedestrian, others unseen: companions abreast at 0.8 m either side, at its velocity
+    grouped.filters[0].x = np.array([5.0, 3.0, 0.0, -1.2])
+    grouped.filters[0].t = 0.0
+    comp = sorted(c[0].tolist() for c in grouped._companions())
+    np.testing.assert_allclose(comp, [[4.2, 3.0, 0.0, -1.2], [5.8, 3.0, 0.0, -1.2]], atol=1e-12)
+    grouped.filters[1].x = np.array([5.8, 3.0, 0.0, -1.2])  # its companion seen: no assumed ones
+    grouped.filters[1].t = 0.0
+    assert grouped._companions() == []

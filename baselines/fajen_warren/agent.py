@@ -52,6 +52,16 @@ saccade that brought it (modelling choice; shorter than a typical human fixation
 ``search_azimuth_deg`` = 45 deg to either side (where pedestrians 4-6 m to the side appear), each side
 an urgency that grows with the time since it was last scanned.
 
+**Groups** (only when the env's ``crowd_distribution`` has groups; :func:`group_prior`, the agent's prior
+about the crowd like the known number of pedestrians): while pedestrians remain unseen, each known one
+with no known neighbour is assumed to have companions abreast at the env's mean spacing, which the
+evasion avoids (``companion_m``); fixations last at least ``GROUP_MIN_DWELL_S`` = 0.2 s (the short end
+of human fixations, 200-400 ms: Tatler & Land 2016), counted from the saccade that brought the gaze
+(``dwell_saccade_s``: catch-up saccades on a near pedestrian no longer restart it); the search for the
+next group is more urgent (``GROUP_SEARCH_WEIGHT``), since half the pedestrians appear at once and a
+near group holds the gaze. Re-fixating each member follows from the risk rule: each member has its own
+slot and filter. See docs/reproductions/data/terrain/dodge_groups.md.
+
 ``gaze_blind=True`` holds gaze and head (gaze action 0: gaze stays level at the goal; head straight):
 the gaze-blind twin (docs/gaze_gain.md), the same filter and steering.
 """
@@ -75,6 +85,11 @@ _FIXATION = _S["fixation"].start  # the eye's vergence distance (m): propriocept
 # The plant's fixation range, onto which the fixation action is log-mapped (core.eye.Eye.command).
 _LOG_FIX = tuple(math.log(x) for x in OculomotorParams().fixation_range_m)
 MIN_STD = 1e-3  # floor of the measurement std (the oracle rung is noiseless)
+# With groups, half the pedestrians come at once and a near group holds the gaze: the search urgency per
+# second is raised so that the next group is found in time (modelling choice; 0.6, 1.2 and 2.0 tried on
+# seeds 0-19, docs/reproductions/data/terrain/dodge_groups.md).
+GROUP_SEARCH_WEIGHT = 2.0
+GROUP_MIN_DWELL_S = 0.2  # s: the short end of human fixations, 200-400 ms (Tatler & Land 2016)
 
 
 @dataclass(frozen=True)
@@ -131,6 +146,39 @@ class FajenWarrenParams:
     search_weight: float = 0.25  # a side's search urgency per second since it was last scanned
     head_share: float = 0.5  # the head takes this share of a gaze shift's azimuth
     gaze_blind: bool = False
+    # Groups (set by ``for_env`` when the env's crowd_distribution has groups; the defaults are v0's agent):
+    # ``companion_m`` > 0: while pedestrians remain unseen, each known pedestrian with no known neighbour
+    # within ``1.5 * companion_m`` is assumed to have companions abreast, ``companion_m`` to its left and
+    # right at its velocity (the evasion avoids them; the gaze looks at them to find out): the env's mean
+    # group spacing (Moussaid et al. 2010's pedestrians walk side by side). ``search_azimuths_deg``: the
+    # search looks at these azimuths in turn on each side (v0: ``search_azimuth_deg`` only); groups
+    # appear at the onset close to the walker's side, beyond 45 deg (modelling choice).
+    companion_m: float = 0.0
+    # Only a saccade within this long of choosing the target is the one that brought it (later ones,
+    # catch-up saccades on a near pedestrian, no longer restart the dwell, which would hold the gaze on it
+    # for good); None: every saccade restarts it (v0). Modelling choice: a saccade lasts well under 0.1 s
+    # at the amplitudes here (main sequence), plus the ~0.2 s saccade latency.
+    dwell_saccade_s: float | None = None
+    search_azimuths_deg: tuple = ()
+
+
+def group_prior(env_id: str) -> dict:
+    """The group parameters of :class:`FajenWarrenParams` for the registered env (empty without groups):
+    the agent's prior about the crowd, like the number of pedestrians (``K_SLOTS``)."""
+    import gymnasium as gym
+
+    from visuomotor_gym.tasks.obstacle_dodge import CrowdDistribution
+
+    kw = gym.spec(env_id).kwargs or {}
+    crowd = kw.get("crowd_distribution")
+    if crowd is None:
+        return {}
+    dist = crowd if isinstance(crowd, CrowdDistribution) else CrowdDistribution(**dict(crowd))
+    if not dist.groups:
+        return {}
+    return {"companion_m": 0.5 * (dist.group_spacing_m[0] + dist.group_spacing_m[1]),
+            "search_azimuths_deg": (45.0,), "search_weight": GROUP_SEARCH_WEIGHT,
+            "min_dwell_s": GROUP_MIN_DWELL_S, "dwell_saccade_s": 0.3}
 
 
 class PedestrianFilter:
@@ -220,7 +268,7 @@ class FajenWarrenAgent:
 
     @classmethod
     def for_env(cls, env_id: str, **overrides) -> FajenWarrenAgent:
-        base = FajenWarrenParams(**env_vision(env_id))
+        base = FajenWarrenParams(**env_vision(env_id), **group_prior(env_id))
         known = {f.name for f in fields(FajenWarrenParams)}
         unknown = sorted(set(overrides) - known)
         if unknown:
@@ -237,7 +285,9 @@ class FajenWarrenAgent:
         self.poses: list = []
         self.target = None  # ("ped", k) or ("search", side)
         self.target_since = -math.inf
+        self.target_chosen = -math.inf  # when the present target was chosen
         self.scanned = {1: -math.inf, -1: -math.inf}
+        self.search_turn = {1: -1, -1: -1}  # which of search_azimuths_deg each side looks at
         self.log: list[tuple] = []  # (time, target, phi) per step
         self._in_saccade = False
 
@@ -416,7 +466,7 @@ class FajenWarrenAgent:
         """The pedestrians' predicted positions at ``tau`` (N', T, 2): each at its estimated velocity, and
         for one whose velocity changed lately (a veer?) also the ``veer_return_s`` hypotheses."""
         p = self.params
-        peds = np.array([f.x for f in known])  # (N, 4)
+        peds = np.array([f.x for f in known] + [c for c, _ in self._companions()]).reshape(-1, 4)  # (N, 4)
         tracks = [peds[:, None, :2] + tau[None, :, None] * peds[:, None, 2:]]
         if p.veer_return_s and self.poses:
             t = self.poses[-1][4]
@@ -435,6 +485,25 @@ class FajenWarrenAgent:
                     a, b = np.minimum(tau, r), np.maximum(tau - r, 0.0)
                     tracks.append((f.x[:2][None, :] + a[:, None] * v[None, :] + b[:, None] * np.array(old)[None, :])[None])
         return np.concatenate(tracks, axis=0)
+
+    def _companions(self) -> list:
+        """Assumed companions (``companion_m``): (state x, y, vx, vy; the slot it walks beside) for each
+        known pedestrian with no known neighbour within ``1.5 * companion_m``, while any is unseen."""
+        d = self.params.companion_m
+        known = [(k, f) for k, f in enumerate(self.filters) if f.known]
+        if d <= 0.0 or len(known) == len(self.filters):
+            return []
+        out = []
+        for k, f in known:
+            x, y, vx, vy = f.x.tolist()
+            if any(j != k and math.hypot(g.x[0] - x, g.x[1] - y) < 1.5 * d for j, g in known):
+                continue
+            v = math.hypot(vx, vy)
+            if v < 1e-6:
+                continue
+            lx, ly = -vy / v, vx / v
+            out += [(np.array([x + sgn * d * lx, y + sgn * d * ly, vx, vy]), k) for sgn in (1.0, -1.0)]
+        return out
 
     # --- gaze ---------------------------------------------------------------------------------
     def _choose(self, threats, t: float):
@@ -460,15 +529,17 @@ class FajenWarrenAgent:
                     best, best_u = ("search", side), u
         if best != self.target:
             self.target, self.target_since = best, t
+            self.target_chosen = t
             if best is not None and best[0] == "search":
                 self.scanned[best[1]] = t
+                self.search_turn[best[1]] += 1
         return self.target
 
     def _look(self, pose, threats, t: float) -> list:
         p = self.params
         eye_pos, rot, odo, pelvis_z, _ = pose
-        if self._in_saccade:  # a fixation's dwell counts from the end of the saccade that brought it
-            self.target_since = t
+        if self._in_saccade and (p.dwell_saccade_s is None or t - self.target_chosen <= p.dwell_saccade_s):
+            self.target_since = t  # a fixation's dwell counts from the end of the saccade that brought it
         target = self._choose(threats, t)
         if target is None:
             return [0.0] * 5
@@ -480,7 +551,8 @@ class FajenWarrenAgent:
         else:
             side = target[1]
             self.scanned[side] = t
-            az = side * p.search_azimuth_deg * DEG
+            azs = p.search_azimuths_deg or (p.search_azimuth_deg,)
+            az = side * azs[self.search_turn[side] % len(azs)] * DEG
             tx, ty, tz = ex + p.search_distance_m * math.cos(az), ey + p.search_distance_m * math.sin(az), ez
         self.log.append((t, target, self.phi))
         return look_action((ex, ey, ez), (tx, ty, tz), odo[2], rot, self.gaze_range, p.head_share,

@@ -75,7 +75,7 @@ class ObstacleDodgeEnv(WalkerEnv):
     ``Box(-inf, inf, (N,), float32)`` (N in the table) by default, or with ``obs_mode="dict"`` a
     ``Dict`` of the same blocks. The pedestrian blocks are what the eye perceived this step (true
     state only with ``vision="oracle"``): slot ``k`` holds pedestrian ``k`` of the episode (onset
-    order); everything else is proprioception, path integration and the goal's place (known).
+    order; with groups, the ``k``-th pedestrian seen); everything else is proprioception, path integration and the goal's place (known).
 
     OBSERVATION_TABLE
 
@@ -105,7 +105,10 @@ class ObstacleDodgeEnv(WalkerEnv):
 
     ## Version History
 
-    * v0: initial release.
+    * v0: initial release. Later, opt-in and leaving v0's episodes unchanged: pedestrians in groups
+      (``crowd_distribution={"group_size": (2, 3)}``: pairs and triads walking abreast, one member may veer
+      alone; the pedestrian slots then in order of first sight), see
+      ``visuomotor_gym.tasks.obstacle_dodge`` and docs/reproductions/data/terrain/dodge_groups.md.
     """
 
     render_cameras: ClassVar[dict[str, tuple[str, ...]]] = {

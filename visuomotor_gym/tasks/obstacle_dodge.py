@@ -18,12 +18,24 @@ the walker if both kept their velocities) for ``veer_s`` = 1.0 s (the veer in Jo
 ~1 s; REFERENCES.md "(10 %, ~1 s)"), then resumes its course. (In the first definition of v0 ``veer_s`` was
 1.5 s, a modelling choice; docs/reproductions/dodge.md has both.)
 
+**Groups** (opt-in: ``CrowdDistribution.group_size`` other than (1, 1); :func:`sample_groups`): the same
+4 pedestrians come as groups (e.g. ``group_size=(2, 3)``: pairs and triads, the commonest groups of
+Moussaid, Perozo, Garnier, Helbing & Theraulaz 2010, PLoS ONE 5:e10047, Fig. 1), one group per onset,
+members walking abreast ``group_spacing_m`` = 0.7-0.9 m apart (their "side by side" formation at low
+density, around the fitted preferred distance of 0.8 m, Fig. 4) across the path together; one member
+of a group may veer alone (so that 10 % of the pedestrians still veer). A group is a wider obstacle
+than a pedestrian, its members close enough to be pooled by crowding in the periphery
+(``VisionParams.crowding``), so that each has to be looked at. With groups the observation's slots
+are given in order of first sight (below), not of onset.
+
 **What the eye sees of a pedestrian**: one point on its axis at 1.5 m (upper chest, a modelling choice
 near the eyes' height so a level gaze sees it) with its velocity (:class:`PedestrianTarget`), sampled by
 the retina like any target (eccentricity-dependent noise on position and velocity, the walk family's 20
 deg recognition field, saccadic suppression, visual delay). The observation holds ``K_SLOTS`` = 4 slots,
 slot ``k`` = pedestrian ``k`` of the episode (in onset order; the number of pedestrians never exceeds the
-slots): seen flag, position and velocity in the eye frame (zeros when not seen this step).
+slots): seen flag, position and velocity in the eye frame (zeros when not seen this step). With groups,
+slot ``k`` = the ``k``-th pedestrian the eye has seen (those first seen on one step from left to right as
+perceived), so that no slot id tells of a pedestrian not seen yet.
 
 **Collision**: the horizontal distance from the pelvis axis to a pedestrian's axis below
 ``PEDESTRIAN_RADIUS_M`` + the walker's half-width (its chest and arms, read from the model), checked every
@@ -73,7 +85,19 @@ CROWD_RULES = {
     "veer_s": Num(0.0, 20.0),
     "min_crossing_m": Num(0.0, 200.0),
     "goal_clear_m": Num(0.0, 200.0),
+    # groups (opt-in): whole members per group, at most the episode's pedestrians; spacings of people
+    # walking abreast, short of a street's width (modelling choice)
+    "group_size": lambda v, name: _group_size(v, name),
+    "group_spacing_m": Pair(Num(0.0, 5.0, low_open=True)),
 }
+
+
+def _group_size(value, name: str) -> tuple[float, float]:
+    lo, hi = Pair(Num(1.0, float(N_PEDESTRIANS)))(value, name)
+    if lo != int(lo) or hi != int(hi):
+        raise ValueError(f"{name} must be a (low, high) pair of whole numbers of pedestrians in "
+                         f"[1, {N_PEDESTRIANS}]; got {value!r}")
+    return (lo, hi)
 
 
 @dataclass(frozen=True)
@@ -93,9 +117,22 @@ class CrowdDistribution:
     veer_s: float = 1.0  # Jovancevic, Sullivan & Hayhoe: the veer lasted ~1 s
     min_crossing_m: float = 3.0  # crossing points between this far from the start ...
     goal_clear_m: float = 1.0  # ... and this far before the goal
+    # Groups (opt-in; (1, 1): every pedestrian alone, the draws of v0). Members per group, uniform over
+    # the whole numbers of the range (pairs the commonest group, then triads: Moussaid et al. 2010, Fig. 1),
+    # walking abreast (Moussaid et al. 2010: at low density "group members tend to walk side by side,
+    # forming a line perpendicular to the walking direction") with this centre-to-centre spacing between
+    # neighbours (around the 0.8 m preferred distance d_o of their fitted model, Fig. 4; the range is a
+    # modelling choice).
+    group_size: tuple[float, float] = (1.0, 1.0)
+    group_spacing_m: tuple[float, float] = (0.7, 0.9)
 
     def __post_init__(self) -> None:
         args.check_fields(self, CROWD_RULES)
+
+    @property
+    def groups(self) -> bool:
+        """Whether pedestrians walk in groups (``group_size`` other than (1, 1))."""
+        return self.group_size != (1.0, 1.0)
 
 
 @dataclass(frozen=True)
@@ -106,6 +143,8 @@ class Crowd:
 
 
 def sample_crowd(rng: np.random.Generator, dist: CrowdDistribution, n: int = N_PEDESTRIANS) -> Crowd:
+    if dist.groups:
+        return sample_groups(rng, dist, n)
     goal = float(rng.uniform(*dist.goal_m))
     rows = []
     onset = float(rng.uniform(*dist.first_onset_s))
@@ -127,6 +166,54 @@ def sample_crowd(rng: np.random.Generator, dist: CrowdDistribution, n: int = N_P
         vx, vy = speed * math.sin(angle), -side * speed * math.cos(angle)
         x0, y0 = x_cross - vx * path / speed, -vy * path / speed
         rows.append((onset, x0, y0, vx, vy, x_cross, timing, float(veers), veer_distance))
+        onset += float(rng.uniform(*dist.onset_gap_s))
+    return Crowd(goal, np.array(rows, dtype=float).reshape(-1, 9))
+
+
+def sample_groups(rng: np.random.Generator, dist: CrowdDistribution, n: int = N_PEDESTRIANS) -> Crowd:
+    """:func:`sample_crowd` with groups (``dist.group_size`` other than (1, 1)): the ``n`` pedestrians
+    come as groups of ``group_size`` members (the last group cut to what is left), one group after the
+    other (``onset_gap_s`` between groups). A group draws one side, start distance, speed, crossing
+    angle and timing like a lone pedestrian of v0 (its centre crosses where a lone one would), and its
+    members walk abreast: on a line through the centre perpendicular to their common velocity,
+    ``group_spacing_m`` apart (one spacing per group). **A member veers alone**: with probability
+    ``min(1, veer_p * size)`` the group's course misses (``veer_timing_s``, as a veering pedestrian's)
+    and one member, drawn uniformly, veers onto a collision course within ``veer_distance_m``; the
+    others keep the course (so ``veer_p`` of the pedestrians veer, as in v0: Jovancevic, Sullivan &
+    Hayhoe). Rows are in onset order, then left to right along the line as each member's own walking
+    direction sees it. Each member's row has its own crossing point and timing."""
+    goal = float(rng.uniform(*dist.goal_m))
+    rows: list[tuple] = []
+    onset = float(rng.uniform(*dist.first_onset_s))
+    lo, hi = (int(v) for v in dist.group_size)
+    while len(rows) < n:
+        size = min(int(rng.integers(lo, hi + 1)), n - len(rows))
+        side = 1.0 if rng.random() < 0.5 else -1.0
+        lateral = float(rng.uniform(*dist.side_m))
+        speed = float(rng.uniform(*dist.speed_m_s))
+        angle = float(rng.uniform(-dist.angle_deg, dist.angle_deg)) * math.pi / 180.0
+        veers = bool(rng.random() < min(1.0, dist.veer_p * size))
+        if veers:
+            timing = float(rng.uniform(*dist.veer_timing_s)) * (1.0 if rng.random() < 0.5 else -1.0)
+        else:
+            timing = float(rng.uniform(-dist.timing_s, dist.timing_s))
+        veer_distance = float(rng.uniform(*dist.veer_distance_m))
+        veerer = int(rng.integers(size)) if veers else -1
+        spacing = float(rng.uniform(*dist.group_spacing_m))
+        path = lateral / math.cos(angle)
+        t_cross = onset + path / speed
+        x_cross = NOMINAL_SPEED * (t_cross + timing)
+        x_cross = min(max(x_cross, dist.min_crossing_m), goal - dist.goal_clear_m)
+        vx, vy = speed * math.sin(angle), -side * speed * math.cos(angle)
+        x0, y0 = x_cross - vx * path / speed, -vy * path / speed
+        lx, ly = -vy / speed, vx / speed  # the members' left, as they walk
+        for m in range(size):
+            off = ((size - 1) / 2.0 - m) * spacing  # first row leftmost
+            mx0, my0 = x0 + lx * off, y0 + ly * off
+            t_m = -my0 / vy  # after the onset, when this member's line crosses the path (y = 0)
+            mx_cross = mx0 + vx * t_m
+            m_timing = mx_cross / NOMINAL_SPEED - (onset + t_m)
+            rows.append((onset, mx0, my0, vx, vy, mx_cross, m_timing, float(m == veerer), veer_distance))
         onset += float(rng.uniform(*dist.onset_gap_s))
     return Crowd(goal, np.array(rows, dtype=float).reshape(-1, 9))
 
@@ -201,6 +288,8 @@ class ObstacleDodgeTask(Task):
         self.veer_until = [-1.0] * N_PEDESTRIANS
         self.veered = [False] * N_PEDESTRIANS
         self.seen = [False] * N_PEDESTRIANS
+        # Groups: slot k holds the k-th pedestrian the eye has seen (-1: not seen yet), see observe_leading
+        self.slot_of = [-1] * N_PEDESTRIANS
         self.min_gap = math.inf
         self._prev_x = 0.0
 
@@ -271,10 +360,41 @@ class ObstacleDodgeTask(Task):
 
     # --- observation --------------------------------------------------------------------------
     def observe_leading(self, values: list, samples: list) -> None:
+        if self.dist.groups:
+            self._observe_by_sight(values, samples)
+            return
         for k in range(K_SLOTS):
             p, v, visible = samples[k]
             self.seen[k] = visible
             values.append(1.0 if visible else 0.0)
+            values += p
+            values += v
+
+    def _observe_by_sight(self, values: list, samples: list) -> None:
+        """With groups, slot ``k`` holds the ``k``-th pedestrian the eye has seen, so a slot id says
+        nothing about pedestrians not seen yet (in onset order, seeing one member of a group would tell
+        that a member with a lower slot exists). Pedestrians first seen on the same step take their slots
+        from left to right as they are perceived (perceived azimuth, largest first; their index breaks a
+        tie), never by their hidden order."""
+        new = [i for i in range(N_PEDESTRIANS) if samples[i][2] and self.slot_of[i] < 0]
+        new.sort(key=lambda i: (-math.atan2(samples[i][0][1], samples[i][0][0]), i))
+        nxt = max(self.slot_of) + 1
+        for i in new:
+            self.slot_of[i] = nxt
+            nxt += 1
+        by_slot = [-1] * K_SLOTS
+        for i, k in enumerate(self.slot_of):
+            if k >= 0:
+                by_slot[k] = i
+        for i in range(N_PEDESTRIANS):
+            self.seen[i] = bool(samples[i][2])
+        for k in range(K_SLOTS):
+            i = by_slot[k]
+            if i < 0 or not samples[i][2]:
+                values += (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+                continue
+            p, v, _ = samples[i]
+            values.append(1.0)
             values += p
             values += v
 
@@ -347,4 +467,4 @@ def intercept_velocity(px: float, py: float, speed: float, wx: float, wy: float,
 
 
 __all__ = ["K_SLOTS", "N_PEDESTRIANS", "Crowd", "CrowdDistribution", "ObstacleDodgeTask", "PedestrianTarget",
-           "intercept_velocity", "sample_crowd"]
+           "intercept_velocity", "sample_crowd", "sample_groups"]
