@@ -895,3 +895,30 @@ def test_the_page_gain_is_success_minus_the_better_twin_entry():
     assert with_static >= len(foveated)
     for env_id in foveated:
         assert any(r.env_id == env_id and r.gain is not None for r in rows), f"no static twin on {env_id}"
+
+
+def test_belief_mpc_file_without_later_default_fields_is_the_same_policy():
+    """A belief-MPC policy file committed before some parameters existed still matches the spec when the
+    fields it lacks sit at their defaults (the loader fills them in); not when a lacking field's fresh
+    value differs from its default, nor when a committed value differs."""
+    import json
+
+    from visuomotor_gym.leaderboard.policies import _belief_mpc_export, _belief_mpc_same
+
+    env_id = "SteppingStones-v0"
+    fresh = _belief_mpc_export("belief_mpc", env_id)
+    obj = json.loads(fresh)
+
+    def dump(o):
+        return (json.dumps(o, indent=2, allow_nan=False) + "\n").encode("utf-8")
+
+    old = {**obj, "params": {k: v for k, v in obj["params"].items() if k != "distrust_periphery"}}
+    assert _belief_mpc_same(dump(old), fresh, env_id)
+    assert not _belief_mpc_same(fresh, fresh, env_id)  # identical bytes are the caller's case, not this one
+    moved = json.loads(fresh)
+    moved["params"]["distrust_periphery"] = True  # the spec now resolves a non-default value
+    assert not _belief_mpc_same(dump(old), dump(moved), env_id)
+    changed = {**old, "params": {**old["params"], "w_tsk": old["params"]["w_tsk"] + 1.0}}
+    assert not _belief_mpc_same(dump(changed), fresh, env_id)
+    extra = {**obj, "params": {**obj["params"], "not_a_field": 1}}
+    assert not _belief_mpc_same(dump(extra), fresh, env_id)

@@ -516,7 +516,7 @@ def policy_problems(lb: Leaderboard, entry: Entry, export: bool = True) -> list[
                     f"the agent spec {entry.results['agent']!r} cannot be exported any more: {exc}",
                 )
             ]
-        if fresh != data:
+        if fresh != data and not (fmt.same_policy is not None and fmt.same_policy(data, fresh, entry.env_id)):
             out.append(
                 Problem(
                     where,

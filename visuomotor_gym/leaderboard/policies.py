@@ -52,6 +52,9 @@ class PolicyFormat:
     # Why the format may no longer be loaded (None: current). A retired format's ``load`` is never
     # called; its entries are only accepted while superseded.
     retired: str | None = None
+    # (committed bytes, fresh export, env id) -> True when a committed file that differs from the fresh
+    # export still describes the same policy (None: only identical bytes do); see _belief_mpc_same.
+    same_policy: Callable[[bytes, bytes, str], bool] | None = None
 
 
 _FORMATS: dict[str, PolicyFormat] = {}
@@ -74,13 +77,19 @@ def format_for_agent(agent_name: str) -> PolicyFormat | None:
     return None
 
 
-def _typed_params(params, cls, what: str) -> dict:
+def _typed_params(params, cls, what: str, fill_defaults: bool = False) -> dict:
     """``params`` checked against the dataclass ``cls``: exactly its fields, each value of its default's
     JSON type (bool, int, float (an int is accepted), str; a tuple of numbers from a JSON list of numbers,
-    returned as a tuple). Raises ValueError naming the field."""
+    returned as a tuple). Raises ValueError naming the field. ``fill_defaults``: a field the file lacks
+    takes the dataclass default (a file written before the field existed; the format's ``same_policy``
+    check has made sure that default is what the spec resolves today)."""
     from dataclasses import MISSING, fields
 
     known = {f.name: f for f in fields(cls)}
+    if fill_defaults and isinstance(params, dict):
+        for name, f in known.items():
+            if name not in params and f.default is not MISSING:
+                params = {**params, name: list(f.default) if isinstance(f.default, tuple) else f.default}
     if not isinstance(params, dict) or set(params) != set(known):
         missing = sorted(set(known) - set(params or {})) if isinstance(params, dict) else sorted(known)
         unknown = sorted(set(params or {}) - set(known)) if isinstance(params, dict) else []
@@ -223,12 +232,41 @@ def _belief_mpc_load(data: bytes, env_id: str) -> Policy:
 
     obj = _read_json_policy(data, BELIEF_MPC_FORMAT, env_id)
     agent_cls, params_cls, vision = _belief_mpc_classes(env_id)
-    params = params_cls(**_typed_params(obj["params"], params_cls, params_cls.__name__))
+    params = params_cls(**_typed_params(obj["params"], params_cls, params_cls.__name__, fill_defaults=True))
     return agent_cls(params, vision=env_vision_params(env_id)) if vision else agent_cls(params)
 
 
+def _belief_mpc_same(committed: bytes, fresh: bytes, env_id: str) -> bool:
+    """A committed belief-MPC file written before some parameters existed is the same policy as the
+    fresh export when the fresh export has exactly the committed file's fields and values plus fields
+    that sit at the params dataclass's default: :func:`_belief_mpc_load` fills a missing field with
+    that default, so loading the committed file builds the agent the spec builds today. (A field added
+    with a default that changes behaviour is still caught: the re-score replays the committed file.)"""
+    from dataclasses import MISSING, fields
+
+    old, new = json.loads(committed), json.loads(fresh)
+    if not (isinstance(old.get("params"), dict) and isinstance(new.get("params"), dict)):
+        return False
+    added = set(new["params"]) - set(old["params"])
+    if not added or set(old["params"]) - set(new["params"]):
+        return False
+    _, params_cls, _ = _belief_mpc_classes(env_id)
+    defaults = {}
+    for f in fields(params_cls):
+        if f.default is not MISSING:
+            defaults[f.name] = f.default
+        elif f.default_factory is not MISSING:
+            defaults[f.name] = f.default_factory()
+    for name in added:
+        if name not in defaults or json.loads(json.dumps(defaults[name])) != new["params"][name]:
+            return False
+    trimmed = {**new, "params": {k: v for k, v in new["params"].items() if k not in added}}
+    return (json.dumps(trimmed, indent=2, allow_nan=False) + "\n").encode("utf-8") == committed
+
+
 register_policy_format(
-    PolicyFormat(BELIEF_MPC_FORMAT, "belief_mpc", ".json", _belief_mpc_export, _belief_mpc_load)
+    PolicyFormat(BELIEF_MPC_FORMAT, "belief_mpc", ".json", _belief_mpc_export, _belief_mpc_load,
+                 same_policy=_belief_mpc_same)
 )
 
 
