@@ -335,19 +335,7 @@ class IwaoAgent:
         self.log.append((float(obs[_TIME]), self.target_id, head, max(-el, 0.0) - head))
         ce = math.cos(el)
         wx, wy, wz = ce * math.cos(az), ce * math.sin(az), math.sin(el)
-        c, s_ = math.cos(odo[2]), math.sin(odo[2])
-        wx, wy = c * wx + s_ * wy, -s_ * wx + c * wy  # path frame to pelvis frame (yaw)
-        (a00, a01, a02), (a10, a11, a12), (a20, a21, a22) = rot
-        e0 = a00 * wx + a10 * wy + a20 * wz  # R^T w: in the eye frame
-        e1 = a01 * wx + a11 * wy + a21 * wz
-        e2 = a02 * wx + a12 * wy + a22 * wz
-        d_az = math.atan2(e1, e0)
-        d_el = math.atan2(e2, math.hypot(e0, e1))
-        r = self.gaze_range
-        return [min(max(d_az / r, -1.0), 1.0), min(max(d_el / r, -1.0), 1.0),
-                self._verge(ex, ey, ez, wx, wy, wz, True),
-                0.0,  # head yaw straight
-                min(max(-head / (NECK_PITCH_DOWN_DEG * DEG), -1.0), 0.0)]
+        return self._gaze_request(wx, wy, wz, odo, rot, (ex, ey, ez), head, True)
 
     def _verge(self, ex, ey, ez, wx, wy, wz, fixating: bool) -> float:
         """The fixation (vergence) action. Without the depth law in the agent's vision model 0 (the
@@ -433,6 +421,12 @@ class IwaoAgent:
             az = math.atan2(self.target[1] - ey, max(self.target[0] - ex, 0.3))
             cp = math.cos(pitch)
             wx, wy, wz = cp * math.cos(az), cp * math.sin(az), -math.sin(pitch)
+        return self._gaze_request(wx, wy, wz, odo, rot, (ex, ey, ez), head, fixating)
+
+    def _gaze_request(self, wx, wy, wz, odo, rot, eye, head: float, fixating: bool) -> list:
+        """The gaze, vergence and head action that points the line of sight along ``(wx, wy, wz)`` (path
+        frame) from the eye at ``eye``, with the neck pitched down by ``head`` (rad) and yaw straight."""
+        ex, ey, ez = eye
         c, s_ = math.cos(odo[2]), math.sin(odo[2])
         wx, wy = c * wx + s_ * wy, -s_ * wx + c * wy  # path frame to pelvis frame (yaw)
         (a00, a01, a02), (a10, a11, a12), (a20, a21, a22) = rot
