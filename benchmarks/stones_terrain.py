@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import sys
 import time
 from pathlib import Path
@@ -56,15 +55,6 @@ LADDER = {f"rough + all four @ {rung}": (f"SteppingStones{rung}-v0", CONDITIONS[
 # its results in <folder>/stepping_stones_static_<slug>.json.
 STATIC_SEARCHES = {"rough + all four": "rough_all_four", "rough + human field + crowding": "rough_field_crowding",
                    "default + all four": "default_all_four", "default + human field + crowding": "default_field_crowding"}
-
-
-def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
-    if n == 0:
-        return 0.0, 1.0
-    p = k / n
-    c = p + z * z / (2 * n)
-    s = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n))
-    return (c - s) / (1 + z * z / n), (c + s) / (1 + z * z / n)
 
 
 def play(agent: str, kwargs: dict, seeds: list[int], env_id: str = ENV_ID) -> tuple[list, dict]:
@@ -150,6 +140,7 @@ def main(argv=None) -> None:
         return
     sys.path.insert(0, str(ROOT))
     import visuomotor_gym  # noqa: F401  (registers the ids)
+    from visuomotor_gym.metrics.stats import wilson_interval
 
     out = Path(args.out)
     rows = json.loads(out.read_text())["rows"] if args.resume and out.exists() else []
@@ -164,7 +155,7 @@ def main(argv=None) -> None:
             ok = [bool(tr.success) for tr in traces]
             why = ["success" if tr.success else "fell" if tr.task.get("fell") else "other" for tr in traces]
             k, n = sum(ok), len(ok)
-            lo, hi = wilson(k, n)
+            lo, hi = wilson_interval(k, n)
             rows = [r for r in rows if not (r["condition"] == name and r["agent"] == agent and r["seed"] == args.seed)]
             rows.append({"condition": name, "env_id": env_id, "kwargs": kwargs, "agent": agent, "seed": args.seed, "episodes": n,
                          "success": k, "rate": k / n, "wilson95": [round(lo, 4), round(hi, 4)],
