@@ -324,3 +324,18 @@ def test_every_family_runs_with_the_human_periphery(env_id):
     a, b = run(), run()
     assert np.all(np.isfinite(a))
     np.testing.assert_array_equal(a, b)
+
+
+def test_human_periphery_preset_sets_the_four_mechanisms_and_keeps_the_rest():
+    from dataclasses import replace
+
+    from visuomotor_gym.vision.foveation import HUMAN_PERIPHERY, VisionParams, human_periphery
+
+    v = human_periphery()
+    assert (v.field_shape, v.position_e2_deg, v.crowding, v.depth_pedestal_arcmin) == ("human", 0.7, True, 10.0)
+    assert v.periphery_on
+    base = VisionParams(noise_scale=2.0, field_of_view_deg=20.0)
+    assert human_periphery(base) == replace(base, **HUMAN_PERIPHERY)
+    assert human_periphery(depth_pedestal_arcmin=None).depth_pedestal_arcmin is None
+    with pytest.raises(ValueError, match="position_e2_deg"):
+        human_periphery(position_e2_deg=-1.0)

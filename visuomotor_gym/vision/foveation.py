@@ -140,6 +140,20 @@ class VisionParams:
         return replace(self, noise_scale=self.noise_scale * factor)
 
 
+#: The four human-periphery mechanisms together (``"all four"`` in docs/reproductions/gaze_default.md):
+#: the human field (Spector 1990), the position law with E2 = 0.7 deg (modelling choice, swept 0.35-1.4),
+#: crowding with Bouma's b = 0.5 (Bouma 1970; Parkes et al. 2001) and the depth pedestal of 10 arcmin
+#: (modelling choice, swept 10 / 60 / off). The fields of :class:`VisionParams` they set.
+HUMAN_PERIPHERY = {"field_shape": "human", "position_e2_deg": 0.7, "crowding": True, "depth_pedestal_arcmin": 10.0}
+
+
+def human_periphery(base: VisionParams | None = None, **overrides) -> VisionParams:
+    """``base`` (default: the default :class:`VisionParams`) with :data:`HUMAN_PERIPHERY` switched on,
+    then ``overrides`` (any :class:`VisionParams` field, e.g. ``depth_pedestal_arcmin=None`` to leave the
+    depth law off)."""
+    return replace(base if base is not None else VisionParams(), **{**HUMAN_PERIPHERY, **overrides})
+
+
 def acuity(eccentricity_rad: float, params: VisionParams) -> float:
     """Acuity factor alpha(theta) in (0, 1]: 1 at the fovea, E2/(E2+theta) away from it."""
     if not params.foveated:
