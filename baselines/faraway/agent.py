@@ -46,7 +46,7 @@ from visuomotor_gym.core.frames import SEAT_ORIGIN
 from visuomotor_gym.core.observation import ObservationLayout
 from visuomotor_gym.envs.actions import NECK_RANGE_DEG, hand_action
 from visuomotor_gym.envs.reach import reach_observation
-from visuomotor_gym.registration import env_vision
+from visuomotor_gym.registration import env_vision, env_vision_params
 from visuomotor_gym.tasks.reach import SHELF_LAYOUT
 from visuomotor_gym.vision import foveation, periphery
 from visuomotor_gym.vision.foveation import VisionParams
@@ -120,12 +120,19 @@ class FarawayAgent:
 
     @classmethod
     def for_env(cls, env_id: str, **overrides) -> FarawayAgent:
-        """An agent whose assumed vision matches the registered env (noise, foveation, latency)."""
+        """An agent whose assumed vision matches the registered env (noise, foveation, latency); when the
+        env's eye has a peripheral mechanism (``VisionParams.periphery_on``, e.g. ``human_periphery()``), the
+        agent models that whole eye (``registration.env_vision_params``), as ``agents.match_vision`` does,
+        unless the spec overrides the vision it assumes (``faraway:vision_noise_scale=5``)."""
         base = FarawayParams(**env_vision(env_id))
         unknown = sorted(set(overrides) - {f.name for f in fields(FarawayParams)})
         if unknown:
             raise TypeError(f"unknown faraway parameter(s) {unknown}; known: {[f.name for f in fields(FarawayParams)]}")
-        return cls(replace(base, **overrides))
+        agent = cls(replace(base, **overrides))
+        vision = env_vision_params(env_id)
+        if vision.periphery_on and not ({"vision_noise_scale", "foveated"} & set(overrides)):
+            agent.vision = vision
+        return agent
 
     def reset(self) -> None:
         """Forget the episode (called by the evaluator, and on ``episode_start``)."""
