@@ -327,6 +327,21 @@ def test_faraway_models_the_depth_law_only_when_its_eye_has_it():
     assert _faraway_with(human_periphery()).depth_law
 
 
+def test_faraway_for_env_models_the_registered_eye_only_when_it_has_a_periphery_law():
+    # vmgym bench builds the agent through for_env (no match_vision): under human_periphery() it must model
+    # that eye; on today's ids it keeps the VisionParams it always had (golden digests).
+    from visuomotor_gym.baselines.faraway import FarawayAgent
+
+    from visuomotor_gym.static_gaze import registered_kwargs
+    from visuomotor_gym.vision.foveation import HUMAN_PERIPHERY, VisionParams
+
+    assert FarawayAgent.for_env("ShelfReach-v0").vision == VisionParams()
+    with registered_kwargs("ShelfReach-v0", {"vision_params": dict(HUMAN_PERIPHERY)}):
+        agent = FarawayAgent.for_env("ShelfReach-v0")
+        assert agent.depth_law and agent.vision.position_e2_deg == 0.7
+        assert not FarawayAgent.for_env("ShelfReach-v0", vision_noise_scale=2.0).depth_law  # the spec's own eye
+
+
 def test_faraway_depth_sigma_hand_computed():
     # Eyecatch Eq. 2 depth std d * 5 % / alpha(theta), alpha = 2 deg / (2 deg + theta), times the depth
     # law 1 + eta / 10 arcmin, eta = 0.063 m * |1/d - 1/d_fix|.
