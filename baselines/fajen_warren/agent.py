@@ -77,7 +77,7 @@ from visuomotor_gym.baselines.crowding import crowd_std, crowded
 from visuomotor_gym.body.dodge_body import DodgeBody
 from visuomotor_gym.envs.dodge import DODGE_LAYOUT
 from visuomotor_gym.oculomotor.plant import OculomotorParams
-from visuomotor_gym.registration import env_vision
+from visuomotor_gym.registration import env_vision, env_vision_params
 from visuomotor_gym.tasks.obstacle_dodge import K_SLOTS, NOMINAL_SPEED
 from visuomotor_gym.vision.foveation import DEG, VisionParams, _los_rows, _sigmas
 
@@ -172,9 +172,11 @@ class FajenWarrenParams:
     # ... and pedestrians further than this from the heading are passing beside or behind: not looked at
     gaze_bearing_limit_deg: float = 75.0
     # ... and a pedestrian becomes a gaze target only this long after it was first seen (modelling choice:
-    # with the saccade's own latency and duration the first fixation then begins ~0.55 s after the
+    # with the saccade latency, the dwell on the present target and the saccade the first fixation then begins ~0.6 s after the
     # appearance, as in Jovancevic, Sullivan & Hayhoe: 548-740 ms)
-    notice_s: float = 0.3
+    notice_s: float = 0.15
+    # ... and the risk counts the position estimate's std too, this many s per m (modelling choice)
+    pos_std_weight: float = 1.0
 
 
 def group_prior(env_id: str) -> dict:
@@ -182,13 +184,11 @@ def group_prior(env_id: str) -> dict:
     the agent's prior about the crowd, like the number of pedestrians (``K_SLOTS``)."""
     import gymnasium as gym
 
-    from visuomotor_gym.tasks.obstacle_dodge import CrowdDistribution
+    from visuomotor_gym.core import args
+    from visuomotor_gym.tasks.obstacle_dodge import CrowdDistribution, crowd_preset
 
     kw = gym.spec(env_id).kwargs or {}
-    crowd = kw.get("crowd_distribution")
-    if crowd is None:
-        return {}
-    dist = crowd if isinstance(crowd, CrowdDistribution) else CrowdDistribution(**dict(crowd))
+    dist = args.coerce(CrowdDistribution, crowd_preset(kw.get("crowd_distribution")), "crowd_distribution")
     if not dist.groups:
         return {}
     return {"companion_m": 0.5 * (dist.group_spacing_m[0] + dist.group_spacing_m[1]),
@@ -311,7 +311,12 @@ class FajenWarrenAgent:
         unknown = sorted(set(overrides) - known)
         if unknown:
             raise TypeError(f"unknown fajen_warren parameter(s) {unknown}; known: {sorted(known)}")
-        return cls(replace(base, **overrides))
+        agent = cls(replace(base, **overrides))
+        if not ({"vision_noise_scale", "foveated"} & set(overrides)):
+            # every constant of the env's eye (the human periphery of the default ObstacleDodge-v0), as
+            # agents.match_vision gives it: the agent models the eye it sees with
+            agent.vision = env_vision_params(env_id)
+        return agent
 
     def reset(self) -> None:
         self.filters = [PedestrianFilter() for _ in range(K_SLOTS)]
@@ -570,7 +575,10 @@ class FajenWarrenAgent:
             if relevant and dmin < p.avoid_distance_m + 0.5:
                 w *= 3.0 * (1.0 + 2.0 / (1.0 + tca))
             vel_std = math.sqrt(max(0.5 * (f.P[2, 2] + f.P[3, 3]), 0.0))
-            u = (age + 0.05 + p.vel_std_weight * vel_std) * w
+            u = age + 0.05 + p.vel_std_weight * vel_std
+            if self.vision.periphery_on:  # the position too: depth from far in the periphery is poor
+                u += p.pos_std_weight * math.sqrt(max(0.5 * (f.P[0, 0] + f.P[1, 1]), 0.0))
+            u *= w
             if u > best_u:
                 best, best_u = ("ped", k), u
         unseen = sum(not f.known for f in self.filters)

@@ -111,6 +111,7 @@ def main(argv=None) -> int:
     ap.add_argument("--final-episodes", type=int, default=16)
     ap.add_argument("--out", required=True)
     ap.add_argument("--crowd", default=None, help="JSON of CrowdDistribution fields laid over the condition's")
+    ap.add_argument("--agent", default=AGENT, help="the baseline's agent spec (e.g. fajen_warren:notice_s=0.2)")
     ap.add_argument("--label", default=None, help="name of the condition in the record (default: --condition)")
     args = ap.parse_args(argv)
     sys.path.insert(0, str(ROOT / "benchmarks"))
@@ -148,7 +149,7 @@ def main(argv=None) -> int:
             else:
                 spec, search_record = f"static_gaze:{args.posture}:{AGENT}", None
         else:
-            spec, search_record = {"baseline": AGENT, "held": f"gaze_blind:{AGENT}"}[role], None
+            spec, search_record = {"baseline": args.agent, "held": f"gaze_blind:{args.agent}"}[role], None
         ok, why, traces = play(spec, seeds)
         cell = {"condition": label, "crowd_distribution": crowd, "vision_params": vision, "role": role,
                 "spec": spec, "seeds": [seeds[0], seeds[-1]], "successes": sum(ok), "episodes": len(ok),
