@@ -21,9 +21,9 @@ from visuomotor_gym.envs.dodge import DODGE_LAYOUT, ObstacleDodgeEnv
 from visuomotor_gym.metrics.dodge_realism import dodge_gaze_realism, pedestrian_fixations
 from visuomotor_gym.registration import ENV_SPECS, FAMILIES
 from visuomotor_gym.tasks.obstacle_dodge import (
+    CROWD_PRESETS,
     N_PEDESTRIANS,
     CrowdDistribution,
-    CROWD_PRESETS,
     intercept_velocity,
     sample_crowd,
 )
@@ -318,7 +318,7 @@ def test_single_is_the_default_and_keeps_the_draws_of_v0():
     assert not CrowdDistribution().groups and CrowdDistribution(**GROUPS).groups
     assert CROWD_PRESETS[SINGLE] == CrowdDistribution() and CROWD_PRESETS["groups"] == CrowdDistribution(**GROUPS)
     assert ObstacleDodgeEnv(crowd_distribution="groups").crowd_distribution == CrowdDistribution(**GROUPS)
-    with pytest.raises(ValueError, match="crowd_distribution.*presets"):
+    with pytest.raises(ValueError, match=r"crowd_distribution.*presets"):
         ObstacleDodgeEnv(crowd_distribution="pairs")
 
 
@@ -510,6 +510,7 @@ def _human():
 
 def test_fajen_warren_takes_every_constant_of_the_envs_eye():
     from visuomotor_gym.baselines.fajen_warren import FajenWarrenAgent
+
     from visuomotor_gym.vision.foveation import human_periphery
 
     assert FajenWarrenAgent.for_env("ObstacleDodge-v0").vision.field_of_view_deg == 20.0  # the walk family's
@@ -559,6 +560,7 @@ def test_fajen_warren_fuses_a_crowded_sample_with_its_crowding_zone():
     its vision model's std (E2 0.7 deg: 1 arcmin x (1 + 40 / 0.7) x d laterally); velocities start from the
     walking-speed prior (std <= 1.5 m/s). Without crowding in the vision model nothing is inflated."""
     from visuomotor_gym.baselines.fajen_warren import FajenWarrenAgent
+
     from visuomotor_gym.vision.foveation import human_periphery
 
     d, ecc = 6.0, math.radians(40.0)

@@ -62,6 +62,18 @@ next group is more urgent (``GROUP_SEARCH_WEIGHT``), since half the pedestrians 
 near group holds the gaze. Re-fixating each member follows from the risk rule: each member has its own
 slot and filter. See docs/reproductions/data/terrain/dodge_groups.md.
 
+**The human periphery** (only when the agent's eye -- every constant of the env's, from ``for_env`` --
+has the mechanisms of ``vision.periphery``; v0's agent otherwise; modelling choices, measured in
+docs/reproductions/data/terrain/dodge_groups.md): with the human field (100 deg to either side) no search
+(a pedestrian appearing at the side is seen wherever the eye looks ahead) but a look along the path
+(``path_urgency``) when no pedestrian needs one more; pedestrians beyond ``gaze_bearing_limit_deg`` of
+the heading (passing beside or behind) are not looked at, and one becomes a gaze target ``notice_s``
+after its first sight; a pedestrian first seen starts from a zero-mean velocity prior
+(``velocity_prior_std``, walking speeds) instead of one far-peripheral velocity sample; with crowding, a
+sample that may be pooled with another pedestrian's is fused with the spread of its crowding zone
+(``baselines.crowding``, as iwao and lookahead); the gaze risk also counts the position estimate's std
+(``pos_std_weight``): depth far in the periphery is poor.
+
 ``gaze_blind=True`` holds gaze and head (gaze action 0: gaze stays level at the goal; head straight):
 the gaze-blind twin (docs/gaze_gain.md), the same filter and steering.
 """
@@ -72,8 +84,8 @@ import math
 from dataclasses import dataclass, fields, replace
 
 import numpy as np
-
 from visuomotor_gym.baselines.crowding import crowd_std, crowded
+
 from visuomotor_gym.body.dodge_body import DodgeBody
 from visuomotor_gym.envs.dodge import DODGE_LAYOUT
 from visuomotor_gym.oculomotor.plant import OculomotorParams

@@ -95,7 +95,7 @@ CROWD_RULES = {
 }
 
 
-def crowd_preset(value) -> "CrowdDistribution | dict | None":
+def crowd_preset(value) -> CrowdDistribution | dict | None:
     """``value`` itself, or the :data:`CROWD_PRESETS` entry it names (a ``ValueError`` naming the presets
     for an unknown name)."""
     if isinstance(value, str):
@@ -484,5 +484,5 @@ def intercept_velocity(px: float, py: float, speed: float, wx: float, wy: float,
     return np.array([speed * dx / n, speed * dy / n])
 
 
-__all__ = ["CROWD_PRESETS", "K_SLOTS", "N_PEDESTRIANS", "Crowd", "CrowdDistribution", "crowd_preset", "ObstacleDodgeTask", "PedestrianTarget",
-           "intercept_velocity", "sample_crowd", "sample_groups"]
+__all__ = ["CROWD_PRESETS", "K_SLOTS", "N_PEDESTRIANS", "Crowd", "CrowdDistribution", "ObstacleDodgeTask",
+           "PedestrianTarget", "crowd_preset", "intercept_velocity", "sample_crowd", "sample_groups"]
