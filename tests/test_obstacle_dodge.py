@@ -590,7 +590,7 @@ def test_fajen_warren_dodges_groups_its_held_twin_runs_into():
     """Development seeds (outside the pinned 0-199) where the moving eye reaches the goal and the held eye
     (gaze and head held level at the goal: the human field still sees every pedestrian, far in its
     periphery) collides: looking at the group members is what tells where they are."""
-    seeds = (206, 210, 212)
+    seeds = (203, 207, 210)
     with _registered(crowd_distribution="groups", vision_params=_human()):
         assert _bench("fajen_warren", seeds) == len(seeds)
         assert _bench("gaze_blind:fajen_warren", seeds) == 0
