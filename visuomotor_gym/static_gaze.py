@@ -698,6 +698,18 @@ def _grid_text(stages: list) -> str:
     return "; ".join(parts)
 
 
+def parse_json_object(text: str, option: str, what: str) -> dict:
+    """A command-line option holding a JSON object (``what``: what its keys are); SystemExit naming
+    ``option`` otherwise."""
+    try:
+        value = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise SystemExit(f"{option}: not JSON ({exc})") from None
+    if not isinstance(value, dict):
+        raise SystemExit(f"{option}: must be a JSON object of {what}, got {text!r}")
+    return value
+
+
 def parse_fixations(text: str):
     """``--fixations``: ``"auto"`` -> None (the search decides), ``"none"`` -> (), else positive metres."""
     if text == "auto":
@@ -804,14 +816,7 @@ def main(argv=None) -> int:
                 raise SystemExit(f"--postures: {item!r} is not az,el[,neck_yaw,neck_pitch]")
             postures.append(Posture(*values))
     log = None if args.quiet else (lambda line: print(line, flush=True))
-    env_kwargs = None
-    if args.env_kwargs:
-        try:
-            env_kwargs = json.loads(args.env_kwargs)
-        except json.JSONDecodeError as exc:
-            raise SystemExit(f"--env-kwargs: not JSON ({exc})") from None
-        if not isinstance(env_kwargs, dict):
-            raise SystemExit(f"--env-kwargs: must be a JSON object of constructor arguments, got {args.env_kwargs!r}")
+    env_kwargs = parse_json_object(args.env_kwargs, "--env-kwargs", "constructor arguments") if args.env_kwargs else None
     fixations = parse_fixations(args.fixations)
     record = search(args.env, args.agent, design_seed=args.design_seed, coarse_episodes=args.coarse_episodes,
                     final_episodes=args.final_episodes, coarse_step=args.coarse_step,
