@@ -101,6 +101,13 @@ class IwaoParams:
     # in real environments: Tatler & Land 2016; modelling choices within that range).
     foothold_min_fixation_s: float = 0.24
     foothold_max_fixation_s: float = 0.4
+    # With gaze_mode="footholds": (mean, std) of an obstacle's top above the floor before any sample, or
+    # None. Walkers place what lies on the ground by the angle of its line of sight below the horizon,
+    # given their eye height (Ooi, Wu & He 2001, Nature 414:197): with depth from disparity poor away
+    # from the vergence distance (VisionParams.depth_pedestal_arcmin), the lateral (angular) precision
+    # of each sample then fixes the point along the path. The values: modelling choice (the rough
+    # course's tops lie 1-12 cm above the floor, tasks.obstacle_walk.ROUGH_COURSE).
+    height_prior_m: tuple[float, float] | None = (0.06, 0.05)
 
 
 class IwaoAgent:
@@ -115,7 +122,8 @@ class IwaoAgent:
         self.planner = FootstepPlanner(self.gait, planner)
         self.memory = ObstacleMemory(vision or VisionParams(noise_scale=p.vision_noise_scale, foveated=p.foveated,
                                                            position_slip_knee_deg_s=p.position_slip_knee_deg_s),
-                                     self.planner.p.walkway_half_width_m)
+                                     self.planner.p.walkway_half_width_m,
+                                     p.height_prior_m if p.gaze_mode == "footholds" else None)
         self.delay_steps = round(p.visual_delay_s / p.control_dt)
         self.gaze_range = p.gaze_action_range_deg * DEG
         self.period_steps = round(self.gait.step_s / p.control_dt)
