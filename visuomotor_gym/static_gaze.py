@@ -14,8 +14,9 @@
   the only block it reads.
 * **head**: a fixed neck (yaw, pitch), mapped to the head action as ``core.head.Head.command`` maps it
   (0 straight ahead, +-1 the joint's range ends, ``neck_range_deg()``).
-* **fixation** (vergence): a fixed distance (default :data:`DEFAULT_FIXATION_M`; vergence does not
-  change what the retina samples in these envs, so it is part of the posture for completeness only).
+* **fixation** (vergence): a fixed distance (default :data:`DEFAULT_FIXATION_M`). Without the depth law
+  vergence changes no retinal sample; with it (``VisionParams.depth_pedestal_arcmin``) depth is precise only
+  near the vergence distance, and the search also picks the distance (its ``fixation`` stage).
 
 ``static_gaze:<agent spec>`` (no posture) takes the posture found by :func:`search` for that env id
 and agent, from the package's ``data/static_postures.json``.
@@ -35,7 +36,7 @@ import json
 import math
 import sys
 import time
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from importlib import resources
 from pathlib import Path
 
@@ -45,7 +46,10 @@ from visuomotor_gym.agents import GazeBlind, Policy, make_agent, parse_agent_spe
 
 DEAD_BAND_DEG = 3.0  # modelling choice: the plant's saccade threshold (OculomotorParams.saccade_threshold_deg,
 # 3 deg), so every non-zero request is a saccade and a sub-threshold request never drives pursuit
-DEFAULT_FIXATION_M = 2.0  # modelling choice: vergence does not change the retina's samples in these envs
+DEFAULT_FIXATION_M = 2.0  # modelling choice: without the depth law vergence changes no retinal sample
+# The vergence distances the search tries when the env's vision has the depth law (a log grid over the
+# distances of these scenes: a shelf at arm's length to a pedestrian ahead; modelling choice).
+FIXATION_GRID_M = (0.5, 1.0, 2.0, 4.0, 8.0)
 POSTURE_KEYS = ("az", "el", "neck_yaw", "neck_pitch", "fix")
 POSTURES_FILE = "static_postures.json"
 DESIGN_SEED = 100_000  # design seeds 100000-100039: disjoint from the pinned seeds 0-199 and 200-399
@@ -100,6 +104,22 @@ def env_geometry(env_id: str) -> EyeGeometry:
             neck_yaw_deg=tuple(yaw),
             neck_pitch_deg=tuple(pitch),
         )
+    finally:
+        env.close()
+
+
+def vision_has_depth_law(env_id: str) -> bool:
+    """Whether the env (with any :func:`registered_kwargs` in effect) perceives depth with the depth law of
+    :mod:`visuomotor_gym.vision.periphery` (then vergence decides depth precision). Not cached: the
+    registered kwargs may change between calls."""
+    import gymnasium as gym
+
+    import visuomotor_gym  # noqa: F401
+
+    env = gym.make(env_id.removeprefix("visuomotor_gym:"))
+    try:
+        v = env.unwrapped.vision_params
+        return bool(v.foveated and v.depth_pedestal_arcmin is not None)
     finally:
         env.close()
 
@@ -441,10 +461,12 @@ class _Scorer:
 
     def rank(self, postures, episodes: int) -> list[Posture]:
         """The postures played on ``episodes`` seeds, best first: more successes, then the line of
-        sight nearer straight ahead, then the neck nearer straight ahead (the tie rule)."""
+        sight nearer straight ahead, then the neck nearer straight ahead, then the vergence nearer
+        :data:`DEFAULT_FIXATION_M` (the tie rule)."""
         return sorted(self.complete(postures, episodes),
                       key=lambda p: (-sum(self.results[p][:episodes]), p.distance_from_ahead_deg(),
-                                     abs(p.neck_yaw) + abs(p.neck_pitch), p.az, p.el))
+                                     abs(p.neck_yaw) + abs(p.neck_pitch),
+                                     abs(math.log(p.fix / DEFAULT_FIXATION_M)), p.az, p.el, p.fix))
 
     def best_rate(self, episodes: int) -> float:
         """The best complete success rate on ``episodes`` seeds (0 while none is complete)."""
@@ -463,7 +485,7 @@ class _Scorer:
 def search(env_id: str, agent: str, *, design_seed: int = DESIGN_SEED, coarse_episodes: int = COARSE_EPISODES,
            final_episodes: int = FINAL_EPISODES, coarse_step: float = 20.0, refine_steps=(10.0, 5.0),
            refine_top: int = 3, finalists: int = 5, neck_step: float = 20.0, postures=None,
-           command: str | None = None, log=None, env_kwargs: dict | None = None) -> dict:
+           command: str | None = None, log=None, env_kwargs: dict | None = None, fixations=None) -> dict:
     """Search the best static posture of ``agent`` on ``env_id``; returns the results record.
 
     Every posture is played with :func:`visuomotor_gym.bench.evaluate.run_chunk` in ``evaluate()``'s
@@ -478,7 +500,12 @@ def search(env_id: str, agent: str, *, design_seed: int = DESIGN_SEED, coarse_ep
     3. ``final``: the ``finalists`` best so far extended to ``final_episodes`` seeds;
     4. ``neck``: at the best final line of sight, the neck at +-``neck_step`` (yaw, pitch, both) around
        the along-the-line-of-sight neck (the postures the eye can hold; none when ``neck_step`` is 0),
-       on ``final_episodes`` seeds.
+       on ``final_episodes`` seeds;
+    5. ``fixation``: at the best posture so far, the vergence distance at each of ``fixations`` (metres,
+       within the eye's fixation range), on ``final_episodes`` seeds. ``fixations=None`` (default):
+       :data:`FIXATION_GRID_M` when the env's vision has the depth law (``depth_pedestal_arcmin``: depth
+       precision then depends on the vergence distance, so the static twin's vergence is part of what is
+       searched), else none (vergence changes no sample); ``()``: none.
 
     A posture stops early once it cannot reach the score that selection needs (stages 1-2: the
     ``max(refine_top, finalists)``-th best on ``coarse_episodes`` seeds; 3-4: the best on
@@ -495,7 +522,7 @@ def search(env_id: str, agent: str, *, design_seed: int = DESIGN_SEED, coarse_ep
         record = _search(env_id, agent, design_seed=design_seed, coarse_episodes=coarse_episodes,
                          final_episodes=final_episodes, coarse_step=coarse_step, refine_steps=refine_steps,
                          refine_top=refine_top, finalists=finalists, neck_step=neck_step, postures=postures,
-                         command=command, log=log)
+                         command=command, log=log, fixations=fixations)
     if env_kwargs:
         record["env_kwargs"] = dict(env_kwargs)
     return record
@@ -503,7 +530,7 @@ def search(env_id: str, agent: str, *, design_seed: int = DESIGN_SEED, coarse_ep
 
 def _search(env_id: str, agent: str, *, design_seed: int, coarse_episodes: int, final_episodes: int,
             coarse_step: float, refine_steps, refine_top: int, finalists: int, neck_step: float, postures,
-            command: str | None, log) -> dict:
+            command: str | None, log, fixations=None) -> dict:
     from visuomotor_gym.bench.evaluate import check_env_id
     from visuomotor_gym.bench.provenance import provenance
 
@@ -576,6 +603,20 @@ def _search(env_id: str, agent: str, *, design_seed: int, coarse_episodes: int, 
                            "line_of_sight": {"az": best.az, "el": best.el}, "postures": len(necks),
                            "early_stop_rank": 1})
             final = best_coarse + necks
+            if fixations is None:
+                fixations = FIXATION_GRID_M if vision_has_depth_law(env_id) else ()
+            best = scorer.rank(final, final_episodes)[0]
+            lo, hi = geometry.fixation_m
+            verged = [replace(best, fix=float(f)) for f in fixations
+                      if lo <= f <= hi and replace(best, fix=float(f)) not in scorer.results]
+            for p in verged:
+                scorer.play(p, final_episodes, "fixation", bar=scorer.bar(final_episodes, 1),
+                            race=scorer.best_rate(final_episodes))
+            if fixations:
+                stages.append({"name": "fixation", "episodes": final_episodes, "around": best.as_spec(),
+                               "fixations_m": [float(f) for f in fixations], "postures": len(verged),
+                               "early_stop_rank": 1})
+            final = final + verged
         chosen = scorer.rank(final, final_episodes)[0]
     finally:
         scorer.close()
@@ -591,7 +632,7 @@ def _search(env_id: str, agent: str, *, design_seed: int, coarse_episodes: int, 
                          "note": "episode i resets with design_seed + i (the common evaluator's rule); disjoint "
                                  "from the pinned evaluation seeds 0-199 and 200-399"},
         "stages": stages,
-        "rules": {"dead_band_deg": DEAD_BAND_DEG, "fixation_m": DEFAULT_FIXATION_M,
+        "rules": {"dead_band_deg": DEAD_BAND_DEG, "fixation_m": DEFAULT_FIXATION_M, "fixations_m": list(fixations or ()),
                   "ties": "higher success, then the line of sight nearer straight ahead, then the neck nearer "
                           "straight ahead",
                   "early_stop": "a posture stops once successes + remaining episodes < the score of the "
@@ -657,6 +698,21 @@ def _grid_text(stages: list) -> str:
     return "; ".join(parts)
 
 
+def parse_fixations(text: str):
+    """``--fixations``: ``"auto"`` -> None (the search decides), ``"none"`` -> (), else positive metres."""
+    if text == "auto":
+        return None
+    if text == "none":
+        return ()
+    try:
+        values = tuple(float(x) for x in text.split(",") if x.strip())
+    except ValueError:
+        values = ()
+    if not values or not all(math.isfinite(v) and v > 0 for v in values):
+        raise SystemExit(f"--fixations: 'auto', 'none' or comma-separated positive distances in metres, got {text!r}")
+    return values
+
+
 def summary_table(folder: Path) -> str:
     """A markdown table of every search results JSON in ``folder`` (env, agent, posture, rates)."""
     rows = ["# Best static twins (`static_gaze:<agent>`)", "",
@@ -708,6 +764,10 @@ def main(argv=None) -> int:
     s.add_argument("--env-kwargs", type=str, default=None, metavar="JSON",
                    help="constructor arguments laid over the registered id's for the whole search, as a JSON "
                         "object, e.g. '{\"course_distribution\": \"rough\", \"vision_params\": {\"crowding\": true}}'")
+    s.add_argument("--fixations", type=str, default="auto", metavar="auto|none|M,M,...",
+                   help="vergence distances (m) tried at the best posture: 'auto' (the default) tries "
+                        f"{','.join(f'{f:g}' for f in FIXATION_GRID_M)} when the env's vision has the depth law, "
+                        "'none' tries none, or a comma-separated list")
     s.add_argument("--quiet", action="store_true")
     p = sub.add_parser("pinned", help="add the pinned-seed evaluation to an existing results JSON")
     p.add_argument("results")
@@ -752,11 +812,12 @@ def main(argv=None) -> int:
             raise SystemExit(f"--env-kwargs: not JSON ({exc})") from None
         if not isinstance(env_kwargs, dict):
             raise SystemExit(f"--env-kwargs: must be a JSON object of constructor arguments, got {args.env_kwargs!r}")
+    fixations = parse_fixations(args.fixations)
     record = search(args.env, args.agent, design_seed=args.design_seed, coarse_episodes=args.coarse_episodes,
                     final_episodes=args.final_episodes, coarse_step=args.coarse_step,
                     refine_steps=tuple(float(x) for x in args.refine_steps.split(",") if x),
                     refine_top=args.refine_top, finalists=args.finalists, neck_step=args.neck_step,
-                    postures=postures, command=command, log=log, env_kwargs=env_kwargs)
+                    postures=postures, command=command, log=log, env_kwargs=env_kwargs, fixations=fixations)
     if args.pinned:
         evaluate_pinned(record, episodes=args.pinned, workers=args.workers)
     out = Path(args.out)
