@@ -138,13 +138,14 @@ class ObstacleMemory:
 
     def __init__(self, vision: VisionParams,
                  walkway_half_width_m: float = 0.5 * CourseDistribution().walkway_width_m,
-                 height_prior: tuple[float, float] | None = None) -> None:
+                 height_prior: tuple[float, float] | None = None, gate: float | None = None) -> None:
         self.vision = vision
         self.walkway_half_width_m = walkway_half_width_m
         # (mean, std) in metres of a point's height above the floor before any sample, or None: no prior.
         # A top face on the floor is placed by the angle of its line of sight below the horizon, given
         # the eye's height (Ooi, Wu & He 2001, Nature 414:197); see IwaoParams.height_prior_m.
         self.height_prior = height_prior
+        self.gate = gate  # outlier gate (in stds) of add, or None
         self.corners: dict[int, tuple[Corner, ...]] = {}
 
     def reset(self) -> None:
@@ -208,6 +209,18 @@ class ObstacleMemory:
         s_depth, s_lat = _sigmas(d_ref, ecc, slip, self.vision, vergence)[:2]
         if crowded:
             s_depth, s_lat = max(s_depth, crowd_std(d_ref, ecc, self.vision)), max(s_lat, crowd_std(d_ref, ecc, self.vision))
+        if self.gate is not None and prior is not None and corner.n >= 3:
+            # Robust fusion: a sample whose line of sight misses the point's estimate by more than ``gate``
+            # times the combined lateral std is an outlier (a crowded percept pooled with a flanker the
+            # agent could not see: Bouma 1970) and is not fused.
+            px, py, pz = prior.tolist()
+            rx, ry, rz = px - z[0], py - z[1], pz - z[2]
+            along = rx * u[0] + ry * u[1] + rz * u[2]
+            miss2 = rx * rx + ry * ry + rz * rz - along * along
+            est_sd = corner.estimate()[1]
+            var = s_lat * s_lat + float(est_sd[0] ** 2 + est_sd[1] ** 2 + est_sd[2] ** 2)
+            if miss2 > self.gate * self.gate * var:
+                return
         corner.add(z, u, max(s_depth, MIN_STD_M), max(s_lat, MIN_STD_M))
 
     def obstacle(self, index: int) -> ObstacleEstimate | None:
