@@ -145,7 +145,7 @@ class ObstacleMemory:
         # A top face on the floor is placed by the angle of its line of sight below the horizon, given
         # the eye's height (Ooi, Wu & He 2001, Nature 414:197); see IwaoParams.height_prior_m.
         self.height_prior = height_prior
-        self.gate = gate  # outlier gate (in stds) of add, or None
+        self.gate = gate  # outlier gate of add (in stds), or None: every sample fused (iwao v0)
         self.corners: dict[int, tuple[Corner, ...]] = {}
 
     def reset(self) -> None:
@@ -211,8 +211,10 @@ class ObstacleMemory:
             s_depth, s_lat = max(s_depth, crowd_std(d_ref, ecc, self.vision)), max(s_lat, crowd_std(d_ref, ecc, self.vision))
         if self.gate is not None and prior is not None and corner.n >= 3:
             # Robust fusion: a sample whose line of sight misses the point's estimate by more than ``gate``
-            # times the combined lateral std is an outlier (a crowded percept pooled with a flanker the
-            # agent could not see: Bouma 1970) and is not fused.
+            # times sqrt(its lateral variance + the estimate's variance summed over x, y, z) is an outlier
+            # (a crowded percept pooled with a flanker the agent could not flag: Bouma 1970) and is not
+            # fused. (The estimate's variance along the line of sight counts too: a lenient gate while
+            # the point is placed only along one line, modelling choice.)
             px, py, pz = prior.tolist()
             rx, ry, rz = px - z[0], py - z[1], pz - z[2]
             along = rx * u[0] + ry * u[1] + rz * u[2]
