@@ -234,6 +234,7 @@ def test_the_memory_gate_drops_a_sample_off_its_line_of_sight():
     far beyond its noise and the estimate's spread) is not fused with ``gate=2``, and is (moving the
     estimate) without a gate."""
     from visuomotor_gym.baselines.iwao.perception import ObstacleMemory
+
     from visuomotor_gym.vision.foveation import human_periphery
 
     eye_pos = [0.0, 0.0, 0.6]  # eye in the pelvis frame; pelvis height 1.0 in odo: eye at 1.6 m
