@@ -234,6 +234,8 @@ FAMILY = Family(
         video_stride=2,
     ),
     doc_links=(("Stepping stones (Eom et al. 2019, section 7; Patla & Vickers 2003)", "reproductions/stones.md"),),
-    doc_pictures=(("images/steppingstones_record_frame.png", "The lookahead agent on SteppingStones-v0"),
+    doc_pictures=(("reproductions/images/stones_rough_seed3.png",
+                   "The lookahead agent on the rough course (seed 3): stones among loose rocks, gaze two stones ahead"),
+                  ("images/steppingstones_record_frame.png", "The lookahead agent on SteppingStones-v0"),
                   ("reproductions/images/stones_turning.png", "The lookahead agent turning through a 60 deg course")),
 )
