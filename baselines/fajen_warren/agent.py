@@ -89,7 +89,7 @@ from visuomotor_gym.baselines.crowding import crowd_std, crowded
 from visuomotor_gym.body.dodge_body import DodgeBody
 from visuomotor_gym.envs.dodge import DODGE_LAYOUT
 from visuomotor_gym.oculomotor.plant import OculomotorParams
-from visuomotor_gym.registration import env_vision, env_vision_params
+from visuomotor_gym.registration import agent_eye, env_vision
 from visuomotor_gym.tasks.obstacle_dodge import K_SLOTS, NOMINAL_SPEED
 from visuomotor_gym.vision.foveation import DEG, VisionParams, _los_rows, _sigmas
 
@@ -324,10 +324,11 @@ class FajenWarrenAgent:
         if unknown:
             raise TypeError(f"unknown fajen_warren parameter(s) {unknown}; known: {sorted(known)}")
         agent = cls(replace(base, **overrides))
-        if not ({"vision_noise_scale", "foveated"} & set(overrides)):
-            # every constant of the env's eye (the human periphery of the default ObstacleDodge-v0), as
+        vision = agent_eye(env_id, overrides)
+        if vision is not None:
+            # every constant of the env's eye (the human periphery under groups + human_periphery()), as
             # agents.match_vision gives it: the agent models the eye it sees with
-            agent.vision = env_vision_params(env_id)
+            agent.vision = vision
         return agent
 
     def reset(self) -> None:
