@@ -149,6 +149,7 @@ class FarawayAgent:
         self.depth_samples: list[tuple[np.ndarray, np.ndarray, float, float, float]] = []
         self._cached: tuple[np.ndarray, float] | None = None
         self.prev_rot: np.ndarray | None = None
+        self.prev_eye: np.ndarray | None = None
         self.poses: deque = deque(maxlen=self.delay_steps + 1)
         self.saccade_time: float | None = None  # when the first saccade to the object was commanded
         self.search_index = 1  # the gaze starts on tower 0
@@ -243,6 +244,11 @@ class FarawayAgent:
         u = rot @ u_eye
         ecc = math.acos(max(-1.0, min(1.0, float(u_eye[0]))))
         lateral_std = float(foveation.standard_deviations(FAR_SHELF_M, ecc, retinal_speed, self.vision)[1])
+        # The line of sight is the eye-to-sample ray, whose angle errs by the lateral error over the sample's
+        # distance: a sample that depth noise put near the eye (|s| << d) has no direction to speak of.
+        # At the object's distance d <= FAR_SHELF_M the ray is off by d * (d k) / |s| <= lateral_std * FAR / |s|
+        # (k: the angular lateral std), so the lateral std grows by FAR_SHELF_M / |s| below FAR_SHELF_M.
+        lateral_std *= max(1.0, FAR_SHELF_M / dist)
         w = (np.eye(3) - np.outer(u, u)) / max(lateral_std, 1e-9) ** 2
         point = eye + rot @ pos_eye
         self.info += w
@@ -318,11 +324,13 @@ class FarawayAgent:
         if not self.started:
             self.started = True
             self.home = hand.copy()
-        # The eye's turn since the last step (rad/s): the static object's retinal slip (depth-law fusion).
+        # The static object's retinal slip over the last step (rad/s; depth-law fusion), as the retina
+        # computes it (``core.eye.Eye.retinal_speed``) with the object at the current estimate.
         turn = 0.0
         if self.prev_rot is not None:
-            turn = float(np.linalg.norm(np.cross(self.prev_rot[:, 0], rot[:, 0]))) / self.dt
+            turn = self._retinal_slip(rot, eye)
         self.prev_rot = rot.copy()
+        self.prev_eye = eye.copy()
         self.poses.append((rot.copy(), eye.copy(), float(obs[_S["fixation"]][0]), turn))
         if obs[_S["object_visible"]][0] > 0.5 and len(self.poses) == self.delay_steps + 1:
             r0, e0, f0, w0 = self.poses[0]  # the eye pose (and vergence) when the sample was taken
@@ -380,6 +388,22 @@ class FarawayAgent:
                 target = np.array([np.interp(tau * (n - 1), np.arange(n), path[:, k]) for k in range(3)])
             grasp = tau >= p.grasp_at_tau
         return hand_action(target + SEAT_ORIGIN, grasp, gaze, head, fixation, self.gaze_range)
+
+    def _retinal_slip(self, rot: np.ndarray, eye: np.ndarray) -> float:
+        """Speed (rad/s) of the static object's image on the retina over the last step: the angular
+        velocity of its line of sight, from the eye's own translation (the head's turn carries the eye,
+        which sits off the neck's axes), minus the gaze's angular velocity, perpendicular to the line of
+        sight; the object taken at the current estimate (before the first sample: the prior's centre).
+        Counting the gaze's turn alone misses the translation: a head turn with the gaze held in the body
+        frame slips a shelf object 0.7 m away by ~50 deg/s (seed 78 under ``human_periphery()``)."""
+        r = self.estimate() - eye
+        dist2 = max(float(r @ r), 1e-6)
+        rel_vel = -(eye - self.prev_eye) / self.dt  # the object's velocity relative to the eye
+        los = np.cross(r, rel_vel) / dist2
+        gaze = np.cross(self.prev_rot[:, 0], rot[:, 0]) / self.dt
+        slip = los - gaze
+        slip = slip - (slip @ r) / dist2 * r
+        return float(np.linalg.norm(slip))
 
     def _beyond_dead_zone(self, angle: float, k: int) -> float:
         """Head angle (rad) that leaves at most the dead zone to the eye (Eyecatch Eq. 17), within the neck's range."""
