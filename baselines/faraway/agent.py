@@ -147,6 +147,8 @@ class FarawayAgent:
         self.info = np.eye(3) * self.weight_sum
         self.info_vec = self.info @ self.prior_mean
         self.depth_samples: list[tuple[np.ndarray, np.ndarray, float, float, float]] = []
+        self._reference = 0  # the kept sample whose line of sight the candidates run along (least lateral std)
+        self._reference_std = math.inf
         self._cached: tuple[np.ndarray, float] | None = None
         self.prev_rot: np.ndarray | None = None
         self.prev_eye: np.ndarray | None = None
@@ -254,15 +256,19 @@ class FarawayAgent:
         self.info += w
         self.info_vec += w @ point
         self.depth_samples.append((eye.copy(), u, float(u @ (point - eye)), ecc, float(fixation)))
+        if lateral_std <= self._reference_std:  # the surest line of sight so far (ties: the latest)
+            self._reference, self._reference_std = len(self.depth_samples) - 1, lateral_std
         self.samples += 1
         self._cached = None
 
     def _depth_law_estimate(self) -> tuple[np.ndarray, float]:
         """(estimate, std) with the depth law: the posterior over candidate points, one per distance.
 
-        The candidates ``c(lam) = c0 + lam g`` are, for each distance ``lam`` along the latest sample's line
-        of sight ``u0`` from its eye ``e0`` (``lam`` on ``_DEPTH_GRID``, flat prior: the object is on the
-        shelves), the point that best fits the lateral information at that distance (the minimum of the
+        The candidates ``c(lam) = c0 + lam g`` are, for each distance ``lam`` along the line of sight ``u0``
+        from the eye ``e0`` of the kept sample with the least lateral std (the surest direction; ties: the
+        latest. The latest sample's ray, taken before, may be one that depth noise put near the eye, tens
+        of degrees off, and then no candidate lies near the object: seed 73 under ``human_periphery()``)
+        (``lam`` on ``_DEPTH_GRID``, flat prior: the object is on the shelves), the point that best fits the lateral information at that distance (the minimum of the
         lateral quadratic under a stiff constraint ``u0 . (c - e0) = lam``, which is linear in ``lam``).
         A candidate's log-posterior is the lateral quadratic plus, for each kept sample ``i`` (eye ``e_i``,
         line of sight ``u_i``, measured distance ``s_i``), ``log N(s_i; u_i . (c - e_i), sigma_i(c)^2)``
@@ -278,7 +284,7 @@ class FarawayAgent:
         if not self.depth_samples:
             self._cached = (lateral, float(math.sqrt(max(np.linalg.eigvalsh(np.linalg.inv(self.info))[-1], 0.0))))
             return self._cached
-        e0, u0 = self.depth_samples[-1][0], self.depth_samples[-1][1]
+        e0, u0 = self.depth_samples[self._reference][0], self.depth_samples[self._reference][1]
         kappa = 1e4 * float(np.trace(self.info))
         A = self.info + kappa * np.outer(u0, u0)
         c0 = np.linalg.solve(A, self.info_vec + kappa * u0 * float(u0 @ e0))
