@@ -339,3 +339,81 @@ def test_human_periphery_preset_sets_the_four_mechanisms_and_keeps_the_rest():
     assert human_periphery(depth_pedestal_arcmin=None).depth_pedestal_arcmin is None
     with pytest.raises(ValueError, match="position_e2_deg"):
         human_periphery(position_e2_deg=-1.0)
+
+
+# --- 5. positional disarray ---------------------------------------------------------------------
+def test_disarray_field_is_unit_variance_fixed_in_place_and_decorrelates_over_one_zone():
+    vp = VisionParams(position_e2_deg=0.7, position_disarray=0.5)
+    rng = np.random.default_rng(0)
+    # places (eccentricity deg, polar deg): a reference at 10 deg; 10 deg again; one Bouma zone
+    # (l theta) out in u; a quarter turn in polar angle
+    ecc = np.array([10.0, 10.0, 10.0 * math.exp(0.5) + 0.7 * (math.exp(0.5) - 1.0), 10.0]) * DEG
+    phi = np.array([30.0, 30.0, 30.0, 120.0]) * DEG
+    v = np.array([periphery.DisarrayField(vp, rng).values(ecc, phi) for _ in range(4000)])  # (n, 3, 4)
+    assert v.shape == (4000, 3, 4)
+    np.testing.assert_allclose(v[:, :, 0].var(axis=0), 1.0, atol=0.08)  # unit variance, each component
+    np.testing.assert_array_equal(v[:, :, 0], v[:, :, 1])  # one place, one value
+    # squared-exponential correlation: exp(-du^2 / 2 l^2) with du = l (one zone): exp(-1/2) = 0.61
+    assert np.corrcoef(v[:, 1, 0], v[:, 1, 2])[0, 1] == pytest.approx(math.exp(-0.5), abs=0.05)
+    # a polar step of pi/2 = 3.1 l: exp(-4.9) ~ 0.007 (the integer rounding of m adds a little)
+    assert abs(np.corrcoef(v[:, 1, 0], v[:, 1, 3])[0, 1]) < 0.06
+    assert abs(np.corrcoef(v[:, 0, 0], v[:, 1, 0])[0, 1]) < 0.06  # components independent
+
+
+@pytest.mark.parametrize("kwargs", [{"position_disarray": -0.1}, {"position_disarray": 1.5},
+                                    {"disarray_length": 0.0}, {"disarray_length": math.nan}])
+def test_disarray_fields_reject_bad_values_naming_the_field(kwargs):
+    name = next(iter(kwargs))
+    with pytest.raises((ValueError, TypeError), match=f"VisionParams.{name}"):
+        VisionParams(**kwargs)
+
+
+def _still_eye_errors(share, n=400, seed=5):
+    """Lateral errors (m) of ``n`` successive looks of a still eye at a still target 12 deg off its
+    fovea, 2 m away, with ``position_disarray=share``; one episode."""
+    env, u = _env_eye({"position_e2_deg": 0.7, "position_disarray": share})
+    env.reset(seed=seed)
+    eye, data = u.eye, u.unwrapped.data
+    direction = np.array(unit(0.0, -12.0))
+    t = _placed(direction, eye, 2.0, "t")
+    rng = np.random.default_rng(seed)
+    errs = np.array([np.array(u.retina._see_all(data, [t], eye, rng)[0][0]) for _ in range(n)]) - 2.0 * direction
+    env.close()
+    return errs - np.outer(errs @ direction, direction)
+
+
+def test_disarray_keeps_each_looks_std_and_a_still_eye_cannot_average_it_away():
+    sd = 2.0 * ARCMIN * (1.0 + 12.0 / 0.7)  # the position law's lateral std (closed form)
+    off = _still_eye_errors(0.0)
+    assert np.sqrt(np.mean(np.sum(off**2, axis=1)) / 2.0) == pytest.approx(sd, rel=0.1)
+    assert np.linalg.norm(off.mean(axis=0)) < 0.25 * sd  # independent looks average to ~sd / 20
+    # share 0.8: each look still has the law's std across episodes, but within one the looks share
+    # a fixed error whose std is sqrt(0.8) sd: over many episodes the per-episode mean has that std
+    means, spreads = [], []
+    for seed in range(30):
+        e = _still_eye_errors(0.8, n=60, seed=seed)
+        means.append(e.mean(axis=0))
+        spreads.append(np.sqrt(np.mean(np.sum((e - e.mean(axis=0)) ** 2, axis=1)) / 2.0))
+    means = np.array(means)
+    assert np.sqrt(np.mean(np.sum(means**2, axis=1)) / 2.0) == pytest.approx(math.sqrt(0.8) * sd, rel=0.3)
+    assert np.mean(spreads) == pytest.approx(math.sqrt(0.2) * sd, rel=0.15)  # what a frame adds
+
+
+def test_disarray_draws_after_the_scenario_and_only_when_on():
+    base = {"position_e2_deg": 0.7}
+    envs = [gym.make("SteppingStones-v0", vision_params={**base, "position_disarray": s}) for s in (0.0, 0.8)]
+    full = gym.make("SteppingStones-v0", vision="full_view", vision_params={**base, "position_disarray": 0.8})
+    courses = []
+    for env in envs + [full]:
+        env.reset(seed=11)
+        courses.append(np.array([t.state(env.unwrapped.data)[0].copy() for t in env.unwrapped.task.all_targets]))
+    np.testing.assert_array_equal(courses[0], courses[1])  # one seed, one scenario
+    np.testing.assert_array_equal(courses[0], courses[2])
+    assert envs[0].unwrapped.retina._disarray is None and envs[1].unwrapped.retina._disarray is not None
+    assert full.unwrapped.retina._disarray is None  # FullView sees with the fovea everywhere
+    # the field is seeded: the same seed draws the same field
+    f1 = envs[1].unwrapped.retina._disarray.w.copy()
+    envs[1].reset(seed=11)
+    np.testing.assert_array_equal(f1, envs[1].unwrapped.retina._disarray.w)
+    for env in envs + [full]:
+        env.close()

@@ -123,6 +123,12 @@ class VisionParams:
         default=None, metadata={"bounds": (0.0, 600.0), "low_open": True, "optional": True})
     # Interocular distance for the pedestal: mean adult interpupillary distance ~63 mm (Dodgson 2004).
     interocular_m: float = field(default=0.063, metadata={"bounds": (0.0, 0.2), "low_open": True})
+    # Positional disarray (periphery.DisarrayField): the share of each position component's variance
+    # (depth, two lateral) fixed in retinal coordinates for the episode (Hess & Field 1993), the rest
+    # drawn every step; 0: off. The share is a modelling choice (swept); disarray_length: the field's
+    # correlation length in units of eccentricity, one crowding zone (Bouma 1970's 0.5; modelling choice).
+    position_disarray: float = field(default=0.0, metadata={"bounds": (0.0, 1.0)})
+    disarray_length: float = field(default=0.5, metadata={"bounds": (0.0, 4.0), "low_open": True})
     # Set by __post_init__: whether any of the mechanisms above acts (always False without foveation).
     periphery_on: ClassVar[bool] = False
 
@@ -133,7 +139,7 @@ class VisionParams:
         # Whether any peripheral mechanism acts (the retina then bypasses its compiled kernel).
         object.__setattr__(self, "periphery_on", self.foveated and (
             self.field_shape == "human" or self.position_e2_deg is not None or self.crowding
-            or self.depth_pedestal_arcmin is not None))
+            or self.depth_pedestal_arcmin is not None or self.position_disarray > 0.0))
 
     def scaled(self, factor: float) -> VisionParams:
         """A copy with ``noise_scale`` multiplied by ``factor``."""
@@ -276,11 +282,18 @@ def perceive(position_eye, velocity_eye, retinal_speed: float, params: VisionPar
     return pos, vel, True
 
 
-def _draw_at(x, y, z, d, ecc, velocity_eye, retinal_speed, params, rng, fixation=None):
+def _draw_at(x, y, z, d, ecc, velocity_eye, retinal_speed, params, rng, fixation=None, fixed=None):
     """True state + A Sigma eps with eps ~ N(0, I6) (Eyecatch Eq. 1-3) for a point at distance ``d`` > 0
-    and eccentricity ``ecc`` (rad); float lists in and out."""
+    and eccentricity ``ecc`` (rad); float lists in and out. ``fixed``: the positional-disarray field's
+    three values at the point's retinal place (:class:`~visuomotor_gym.vision.periphery.DisarrayField`):
+    the position components of eps are then ``sqrt(s) fixed + sqrt(1 - s) eps``, ``s =
+    params.position_disarray`` (the same unit variance; the same six draws from ``rng``)."""
     s0, s1, s2, s3, s4, s5 = _sigmas(d, ecc, retinal_speed, params, fixation)
     e0, e1, e2, e3, e4, e5 = rng.standard_normal(6).tolist()
+    if fixed is not None:
+        a = math.sqrt(params.position_disarray)
+        c = math.sqrt(1.0 - params.position_disarray)
+        e0, e1, e2 = a * fixed[0] + c * e0, a * fixed[1] + c * e1, a * fixed[2] + c * e2
     n0, n1, n2, n3, n4, n5 = s0 * e0, s1 * e1, s2 * e2, s3 * e3, s4 * e4, s5 * e5
     (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = _los_rows(x / d, y / d, z / d)
     vx, vy, vz = velocity_eye
