@@ -349,8 +349,8 @@ def test_disarray_field_is_unit_variance_fixed_in_place_and_decorrelates_over_on
     # (l theta) out in u; a quarter turn in polar angle
     ecc = np.array([10.0, 10.0, 10.0 * math.exp(0.5) + 0.7 * (math.exp(0.5) - 1.0), 10.0]) * DEG
     phi = np.array([30.0, 30.0, 30.0, 120.0]) * DEG
-    v = np.array([periphery.DisarrayField(vp, rng).values(ecc, phi) for _ in range(4000)])  # (n, 3, 4)
-    assert v.shape == (4000, 3, 4)
+    v = np.array([periphery.DisarrayField(vp, rng).values(ecc, phi) for _ in range(4000)])  # (n, 2, 4)
+    assert v.shape == (4000, 2, 4)
     np.testing.assert_allclose(v[:, :, 0].var(axis=0), 1.0, atol=0.08)  # unit variance, each component
     np.testing.assert_array_equal(v[:, :, 0], v[:, :, 1])  # one place, one value
     # squared-exponential correlation: exp(-du^2 / 2 l^2) with du = l (one zone): exp(-1/2) = 0.61
@@ -368,18 +368,18 @@ def test_disarray_fields_reject_bad_values_naming_the_field(kwargs):
         VisionParams(**kwargs)
 
 
-def _still_eye_errors(share, n=400, seed=5):
-    """Lateral errors (m) of ``n`` successive looks of a still eye at a still target 12 deg off its
-    fovea, 2 m away, with ``position_disarray=share``; one episode."""
+def _still_eye_errors(share, n=400, seed=5, ecc=12.0, depth=False):
+    """Lateral (or, with ``depth``, depth) errors (m) of ``n`` successive looks of a still eye at a
+    still target ``ecc`` deg below its fovea, 2 m away, with ``position_disarray=share``; one episode."""
     env, u = _env_eye({"position_e2_deg": 0.7, "position_disarray": share})
     env.reset(seed=seed)
     eye, data = u.eye, u.unwrapped.data
-    direction = np.array(unit(0.0, -12.0))
+    direction = np.array(unit(0.0, -ecc))
     t = _placed(direction, eye, 2.0, "t")
     rng = np.random.default_rng(seed)
     errs = np.array([np.array(u.retina._see_all(data, [t], eye, rng)[0][0]) for _ in range(n)]) - 2.0 * direction
     env.close()
-    return errs - np.outer(errs @ direction, direction)
+    return errs @ direction if depth else errs - np.outer(errs @ direction, direction)
 
 
 def test_disarray_keeps_each_looks_std_and_a_still_eye_cannot_average_it_away():
@@ -388,15 +388,25 @@ def test_disarray_keeps_each_looks_std_and_a_still_eye_cannot_average_it_away():
     assert np.sqrt(np.mean(np.sum(off**2, axis=1)) / 2.0) == pytest.approx(sd, rel=0.1)
     assert np.linalg.norm(off.mean(axis=0)) < 0.25 * sd  # independent looks average to ~sd / 20
     # share 0.8: each look still has the law's std across episodes, but within one the looks share
-    # a fixed error whose std is sqrt(0.8) sd: over many episodes the per-episode mean has that std
+    # a fixed error: 0.8 of the variance the periphery adds, w = 0.8 (1 - 1/f^2), f = 1 + 12/0.7
+    w = 0.8 * (1.0 - 1.0 / (1.0 + 12.0 / 0.7) ** 2)
     means, spreads = [], []
     for seed in range(30):
         e = _still_eye_errors(0.8, n=60, seed=seed)
         means.append(e.mean(axis=0))
         spreads.append(np.sqrt(np.mean(np.sum((e - e.mean(axis=0)) ** 2, axis=1)) / 2.0))
     means = np.array(means)
-    assert np.sqrt(np.mean(np.sum(means**2, axis=1)) / 2.0) == pytest.approx(math.sqrt(0.8) * sd, rel=0.3)
-    assert np.mean(spreads) == pytest.approx(math.sqrt(0.2) * sd, rel=0.15)  # what a frame adds
+    assert np.sqrt(np.mean(np.sum(means**2, axis=1)) / 2.0) == pytest.approx(math.sqrt(w) * sd, rel=0.3)
+    assert np.mean(spreads) == pytest.approx(math.sqrt(1.0 - w) * sd, rel=0.15)  # what a frame adds
+
+
+def test_disarray_spares_the_fovea_and_depth():
+    # at the fovea the position law adds nothing: no fixed part, the looks average out
+    fovea = _still_eye_errors(1.0, n=400, ecc=0.0)
+    assert np.linalg.norm(fovea.mean(axis=0)) < 0.25 * 2.0 * ARCMIN
+    # depth keeps its per-step noise at any eccentricity (the mean of 400 looks ~ std / 20)
+    depth = _still_eye_errors(1.0, n=400, ecc=12.0, depth=True)
+    assert abs(depth.mean()) < 0.2 * depth.std()
 
 
 def test_disarray_draws_after_the_scenario_and_only_when_on():

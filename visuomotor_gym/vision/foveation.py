@@ -123,9 +123,9 @@ class VisionParams:
         default=None, metadata={"bounds": (0.0, 600.0), "low_open": True, "optional": True})
     # Interocular distance for the pedestal: mean adult interpupillary distance ~63 mm (Dodgson 2004).
     interocular_m: float = field(default=0.063, metadata={"bounds": (0.0, 0.2), "low_open": True})
-    # Positional disarray (periphery.DisarrayField): the share of each position component's variance
-    # (depth, two lateral) fixed in retinal coordinates for the episode (Hess & Field 1993), the rest
-    # drawn every step; 0: off. The share is a modelling choice (swept); disarray_length: the field's
+    # Positional disarray (periphery.DisarrayField): the share of the lateral position variance the
+    # periphery adds to the fovea's that is fixed in retinal coordinates for the episode (Hess & Field
+    # 1993), the rest drawn every step; 0: off. The share is a modelling choice (swept); disarray_length: the field's
     # correlation length in units of eccentricity, one crowding zone (Bouma 1970's 0.5; modelling choice).
     position_disarray: float = field(default=0.0, metadata={"bounds": (0.0, 1.0)})
     disarray_length: float = field(default=0.5, metadata={"bounds": (0.0, 4.0), "low_open": True})
@@ -285,15 +285,18 @@ def perceive(position_eye, velocity_eye, retinal_speed: float, params: VisionPar
 def _draw_at(x, y, z, d, ecc, velocity_eye, retinal_speed, params, rng, fixation=None, fixed=None):
     """True state + A Sigma eps with eps ~ N(0, I6) (Eyecatch Eq. 1-3) for a point at distance ``d`` > 0
     and eccentricity ``ecc`` (rad); float lists in and out. ``fixed``: the positional-disarray field's
-    three values at the point's retinal place (:class:`~visuomotor_gym.vision.periphery.DisarrayField`):
-    the position components of eps are then ``sqrt(s) fixed + sqrt(1 - s) eps``, ``s =
-    params.position_disarray`` (the same unit variance; the same six draws from ``rng``)."""
+    two lateral values at the point's retinal place (:class:`~visuomotor_gym.vision.periphery.DisarrayField`):
+    the lateral position components of eps are then ``sqrt(w) fixed + sqrt(1 - w) eps`` with ``w = s (1 -
+    1 / f**2)``, ``s = params.position_disarray`` and ``f`` the position law's growth at ``ecc``
+    (:func:`~visuomotor_gym.vision.periphery.position_factor`): a share ``s`` of the variance the periphery
+    adds to the fovea's is fixed in place (the same unit variance; the same six draws from ``rng``)."""
     s0, s1, s2, s3, s4, s5 = _sigmas(d, ecc, retinal_speed, params, fixation)
     e0, e1, e2, e3, e4, e5 = rng.standard_normal(6).tolist()
     if fixed is not None:
-        a = math.sqrt(params.position_disarray)
-        c = math.sqrt(1.0 - params.position_disarray)
-        e0, e1, e2 = a * fixed[0] + c * e0, a * fixed[1] + c * e1, a * fixed[2] + c * e2
+        f = periphery.position_factor(ecc, params)
+        w = params.position_disarray * (1.0 - 1.0 / (f * f))
+        a, c = math.sqrt(w), math.sqrt(1.0 - w)
+        e1, e2 = a * fixed[0] + c * e1, a * fixed[1] + c * e2
     n0, n1, n2, n3, n4, n5 = s0 * e0, s1 * e1, s2 * e2, s3 * e3, s4 * e4, s5 * e5
     (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = _los_rows(x / d, y / d, z / d)
     vx, vy, vz = velocity_eye
