@@ -420,6 +420,30 @@ def test_faraway_slip_counts_the_eye_translation_as_the_retina_does():
     assert a._retinal_slip(turned, eye) < 0.03
 
 
+def test_faraway_counts_a_still_peripheral_look_for_less_under_the_disarray():
+    # A still image 30 deg off the fovea: under the positional disarray (share 0.8) a stream of looks reads
+    # one place of the fixed field, so each look's lateral information is foveation.believed_sigmas' (dt =
+    # 20 ms); at the fovea there is no disarray and the information is the same.
+    from visuomotor_gym.vision import foveation
+    from visuomotor_gym.vision.foveation import human_periphery
+
+    eye, rot = np.array([0.1, 0.0, 0.63]), np.eye(3)
+    side = np.array([0.8 * math.cos(math.radians(30)), 0.8 * math.sin(math.radians(30)), 0.0])
+    info = {}
+    for share in (0.0, 0.8):
+        for name, p in (("side", side), ("fovea", np.array([0.8, 0.0, 0.0]))):
+            a = _faraway_with(human_periphery(position_disarray=share))
+            a._fuse_depth_law(p, rot, eye, 0.8, 0.0)
+            info[share, name] = np.trace(a.info) - 3.0 / 0.5**2  # less the prior's
+    v = human_periphery(position_disarray=0.8)
+    ecc = math.radians(30)
+    g2 = (foveation.believed_sigmas(1.2, ecc, 0.0, v, None, 0.02)[1]
+          / foveation.standard_deviations(1.2, ecc, 0.0, v)[1]) ** 2
+    assert g2 > 10.0
+    assert info[0.8, "side"] == pytest.approx(info[0.0, "side"] / g2, rel=1e-6)
+    assert info[0.8, "fovea"] == pytest.approx(info[0.0, "fovea"], rel=1e-9)
+
+
 def test_faraway_without_the_depth_law_keeps_its_isotropic_fusion():
     # The default eye: the depth-law state is never touched and the estimate is the isotropic weighted mean.
     from visuomotor_gym.baselines.faraway import FarawayAgent

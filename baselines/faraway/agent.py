@@ -245,7 +245,10 @@ class FarawayAgent:
             u_eye = -u_eye
         u = rot @ u_eye
         ecc = math.acos(max(-1.0, min(1.0, float(u_eye[0]))))
-        lateral_std = float(foveation.standard_deviations(FAR_SHELF_M, ecc, retinal_speed, self.vision)[1])
+        # dt: under the positional disarray (VisionParams.position_disarray) a stream of looks at one place of
+        # the retina shares its fixed error, so each look counts for less (foveation.believed_sigmas; no effect
+        # without the disarray).
+        lateral_std = float(foveation.believed_sigmas(FAR_SHELF_M, ecc, retinal_speed, self.vision, None, self.dt)[1])
         # The line of sight is the eye-to-sample ray, whose angle errs by the lateral error over the sample's
         # distance: a sample that depth noise put near the eye (|s| << d) has no direction to speak of.
         # At the object's distance d <= FAR_SHELF_M the ray is off by d * (d k) / |s| <= lateral_std * FAR / |s|
