@@ -291,10 +291,16 @@ def test_bezier_mode_follows_its_curve():
 # --- the faraway baseline and its twin -----------------------------------------------------------
 @pytest.mark.slow
 def test_faraway_succeeds_and_beats_its_gaze_blind_twin():
+    # On the former eye (the acuity law alone, VisionParams()): under the default human periphery the held
+    # twin reaches 82.5 % of the pinned seeds (docs/reproductions/faraway.md), so there the claim is not made.
     from visuomotor_gym.bench.evaluate import evaluate
+    from visuomotor_gym.static_gaze import registered_kwargs
+    from visuomotor_gym.vision.foveation import VisionParams
 
-    looking = evaluate("faraway", "ShelfReach-v0", episodes=20, seed=100, workers=1, keep_traces=True)
-    blind = evaluate("faraway:gaze_blind=true", "ShelfReach-v0", episodes=20, seed=100, workers=1, keep_traces=False)
+    with registered_kwargs("ShelfReach-v0", {"vision_params": VisionParams()}):
+        looking = evaluate("faraway", "ShelfReach-v0", episodes=20, seed=100, workers=1, keep_traces=True)
+        blind = evaluate("faraway:gaze_blind=true", "ShelfReach-v0", episodes=20, seed=100, workers=1,
+                         keep_traces=False)
     sl, sb = looking.summary["success_rate"], blind.summary["success_rate"]
     assert sl >= 0.9, sl
     assert sb <= sl - 0.3, (sl, sb)
@@ -328,18 +334,18 @@ def test_faraway_models_the_depth_law_only_when_its_eye_has_it():
 
 
 def test_faraway_for_env_models_the_registered_eye_only_when_it_has_a_periphery_law():
-    # vmgym bench builds the agent through for_env (no match_vision): under human_periphery() it must model
-    # that eye; on today's ids it keeps the VisionParams it always had (golden digests).
+    # vmgym bench builds the agent through for_env (no match_vision): under human_periphery() (ShelfReach-v0's
+    # default eye) it must model that eye; on the former eye it keeps the VisionParams it always had.
     from visuomotor_gym.baselines.faraway import FarawayAgent
 
     from visuomotor_gym.static_gaze import registered_kwargs
-    from visuomotor_gym.vision.foveation import HUMAN_PERIPHERY, VisionParams
+    from visuomotor_gym.vision.foveation import VisionParams, human_periphery
 
-    assert FarawayAgent.for_env("ShelfReach-v0").vision == VisionParams()
-    with registered_kwargs("ShelfReach-v0", {"vision_params": dict(HUMAN_PERIPHERY)}):
-        agent = FarawayAgent.for_env("ShelfReach-v0")
-        assert agent.depth_law and agent.vision.position_e2_deg == 0.7
-        assert not FarawayAgent.for_env("ShelfReach-v0", vision_noise_scale=2.0).depth_law  # the spec's own eye
+    agent = FarawayAgent.for_env("ShelfReach-v0")
+    assert agent.depth_law and agent.vision == human_periphery()
+    assert not FarawayAgent.for_env("ShelfReach-v0", vision_noise_scale=2.0).depth_law  # the spec's own eye
+    with registered_kwargs("ShelfReach-v0", {"vision_params": VisionParams()}):
+        assert FarawayAgent.for_env("ShelfReach-v0").vision == VisionParams()
 
 
 def test_faraway_depth_sigma_hand_computed():
