@@ -41,6 +41,10 @@ __all__ = ["REACH_VISION", "ShelfReachEnv", "reach_observation"]
 # E2 0.7 deg, crowding b = 0.5 after Bouma 1970, the depth pedestal 10 arcmin), in place of the catch
 # family's +-60 deg field with the acuity law alone.
 REACH_VISION = human_periphery()
+# Full shelves: every other target holds a distractor of the object's kind (modelling choice: a stocked shelf,
+# as a cupboard a person fetches one cup from; with the object alone the periphery's position law already
+# guides a reach from a still eye -- docs/reproductions/faraway.md).
+SHELF_CLUTTER = reach_names.N_DISTRACTORS
 
 REWARD_MODES = ("sparse", "shaped")
 RENDER_CAMERAS = ("both", "scene", "eye", "over_shoulder", "top")
@@ -154,6 +158,9 @@ class ShelfReachEnv(VisuomotorEnv):
                               "arriving, not sweeping past)"),
         "vision_params": ("``VisionParams`` or a dict of its fields; the default is the human periphery "
                           "(``vision.foveation.human_periphery()``: human field, position law, crowding, depth law)"),
+        "shelf_clutter": ("how many of the other 29 targets hold a distractor (a cylinder of the object's size, seen "
+                          "as a target of its kind: crowding pools it with the object), drawn per episode; 0 gives "
+                          "the former scene with the object alone"),
         "vision": '``"foveated"``, ``"full_view"`` or ``"oracle"`` (true object position)',
         "render_camera": ('``"both"`` (scene beside eye view), ``"scene"``, ``"eye"``, ``"over_shoulder"``, '
                           '``"top"``'),
@@ -170,6 +177,7 @@ class ShelfReachEnv(VisuomotorEnv):
         reach_radius: float = 0.06,
         grasp_closed_fraction: float = 0.6,
         arrival_speed_m_s: float = 0.5,
+        shelf_clutter: int = SHELF_CLUTTER,
         **shared: Any,
     ):
         self.control = args.choice(control, CONTROL_MODES, "control")
@@ -182,6 +190,7 @@ class ShelfReachEnv(VisuomotorEnv):
                                                low_open=True)
         self.arrival_speed_m_s = args.real(arrival_speed_m_s, "arrival_speed_m_s", low=0.0, high=100.0, low_open=True)
         self.reward_mode = args.choice(reward, REWARD_MODES, "reward")
+        self.shelf_clutter = args.integer(shelf_clutter, "shelf_clutter", low=0, high=reach_names.N_DISTRACTORS)
         super().__init__(render_mode, **shared)
 
     def _default_reward_weights(self) -> dict[str, float]:
@@ -192,7 +201,7 @@ class ShelfReachEnv(VisuomotorEnv):
         task = ReachTask(
             self.model, body, reach_radius=self.reach_radius, grasp_closed_fraction=self.grasp_closed_fraction,
             arrival_speed_m_s=self.arrival_speed_m_s, reward_weights=self.reward_weights, dt=self.dt,
-            visual_delay_s=self.visual_delay_s,
+            visual_delay_s=self.visual_delay_s, clutter=self.shelf_clutter,
         )
         self.hand = body.hand
         return body, task
