@@ -210,10 +210,109 @@ def test_object_truth_is_in_info_only():
     ({"reach_radius": 0.0}, ValueError), ({"reach_radius": float("nan")}, ValueError),
     ({"arrival_speed_m_s": -1.0}, ValueError), ({"reward": "dense"}, ValueError),
     ({"visual_delay_s": 0.03}, ValueError), ({"target": 3}, TypeError), ({"render_camera": "side"}, ValueError),
+    ({"shelf_clutter": 30}, ValueError), ({"shelf_clutter": -1}, ValueError), ({"shelf_clutter": 2.0}, TypeError),
+    ({"shelf_clutter": True}, TypeError),
 ])
 def test_bad_arguments(kwargs, exc):
-    with pytest.raises(exc):
+    with pytest.raises(exc) as err:
         ShelfReachEnv(**kwargs)
+    if "shelf_clutter" in kwargs:
+        assert "shelf_clutter" in str(err.value)
+
+
+# --- the shelf clutter ---------------------------------------------------------------------------
+def test_clutter_keeps_the_scenario_and_fills_the_other_targets():
+    """The default (29 distractors) draws the same object, jitter and gaze jitter as the former scene
+    (shelf_clutter=0) for a seed; the distractors stand on distinct other targets, as MuJoCo bodies."""
+    full, bare = ShelfReachEnv(), ShelfReachEnv(shelf_clutter=0)
+    some = ShelfReachEnv(shelf_clutter=5)
+    layouts = set()
+    for seed in range(12):
+        _, fi = full.reset(seed=seed)
+        _, bi = bare.reset(seed=seed)
+        _, si = some.reset(seed=seed)
+        for info, env in ((bi, bare), (si, some)):
+            assert info["target_index"] == fi["target_index"]
+            np.testing.assert_array_equal(info["object_pos"], fi["object_pos"])
+            np.testing.assert_array_equal(env.task.gaze_offset, full.task.gaze_offset)
+        assert bi["distractor_indices"] == () and len(bare.task.targets) == 1
+        idx = fi["distractor_indices"]
+        assert sorted(idx) == [i for i in range(30) if i != fi["target_index"]]
+        assert len(set(si["distractor_indices"])) == 5 and fi["target_index"] not in si["distractor_indices"]
+        layouts.add(si["distractor_indices"])
+        mujoco.mj_forward(full.model, full.data)
+        for name, k in zip(reach_names.DISTRACTORS, idx):
+            np.testing.assert_allclose(full.data.geom(name).xpos, SHELF_LAYOUT.targets()[k], atol=1e-9)
+        assert all(full.data.geom(n).xpos[2] < 0 for n in reach_names.DISTRACTORS[len(idx):])
+    assert len(layouts) == 12  # drawn per episode
+
+
+@pytest.mark.slow
+def test_same_clutter_on_every_rung():
+    for seed in range(4):
+        layouts = {gym.make(env_id).reset(seed=seed)[1]["distractor_indices"] for env_id in REACH_IDS}
+        assert len(layouts) == 1, (seed, layouts)
+
+
+def _counterfactual_pair(env_id, seed, clutter=12):
+    """Two copies of one episode whose distractors stand on different targets (same count)."""
+    a = gym.make(env_id, shelf_clutter=clutter).unwrapped
+    b = gym.make(env_id, shelf_clutter=clutter).unwrapped
+    a.reset(seed=seed)
+    b.reset(seed=seed)
+    free = [i for i in range(30) if i != b.target_index and i not in b.task.distractor_indices]
+    moved = (free + list(b.task.distractor_indices))[:clutter]
+    for d, k in zip(b.task.distractors, moved):
+        d.place(b.data, SHELF_LAYOUT.targets()[k])
+    assert set(moved) != set(a.task.distractor_indices)
+    return a, b
+
+
+@pytest.mark.parametrize("env_id", ["ShelfReachOracle-v0", "ShelfReachFullView-v0"])
+def test_distractors_do_not_leak_where_the_eye_cannot_tell(env_id):
+    """Oracle and FullView (no crowding) observations are identical whatever the distractors' layout, and the
+    oracle's object slot is always the object's true position (never a distractor's)."""
+    s = ObservationLayout(reach_observation()).slices
+    for seed in (1, 6):
+        a, b = _counterfactual_pair(env_id, seed)
+        for act in _actions(9, seed, 30) * np.array([0.3] * 4 + [1.0] * 5, dtype=np.float32):
+            oa, *_ = a.step(act)
+            ob, *_ = b.step(act)
+            np.testing.assert_array_equal(oa, ob)
+            if env_id == "ShelfReachOracle-v0" and oa[s["object_visible"]][0]:
+                true_eye = a.eye.to_eye(a.task.object_pos, np.zeros(3))[0]
+                np.testing.assert_allclose(oa[s["object_pos"]], true_eye, atol=1e-5)
+
+
+def test_distractors_crowd_the_object_in_the_periphery_only():
+    """Foveated: the distractors reach the object's sample only through crowding. With crowding off the
+    observation is the same whatever their layout; with it on, some peripheral sample differs."""
+    from dataclasses import replace
+
+    from visuomotor_gym.envs.reach import REACH_VISION
+
+    s = ObservationLayout(reach_observation()).slices
+    plain = {"vision_params": replace(REACH_VISION, crowding=False)}
+    a = gym.make("ShelfReach-v0", shelf_clutter=12, **plain).unwrapped
+    b = gym.make("ShelfReach-v0", shelf_clutter=12, **plain).unwrapped
+    differed = 0
+    for seed in (1, 6):
+        a.reset(seed=seed)
+        b.reset(seed=seed)
+        free = [i for i in range(30) if i != b.target_index and i not in b.task.distractor_indices]
+        for d, k in zip(b.task.distractors, (free + list(b.task.distractor_indices))[:12]):
+            d.place(b.data, SHELF_LAYOUT.targets()[k])
+        acts = _actions(9, seed, 30) * np.array([0.3] * 4 + [1.0] * 5, dtype=np.float32)
+        for act in acts:
+            oa, *_ = a.step(act)
+            ob, *_ = b.step(act)
+            np.testing.assert_array_equal(oa, ob)
+        c, d = _counterfactual_pair("ShelfReach-v0", seed)
+        for act in acts:
+            oc, *_ = c.step(act)
+            od, *_ = d.step(act)
+            differed += not np.array_equal(oc[s["object_pos"]], od[s["object_pos"]])
+    assert differed > 0  # crowding on: the layout reaches the object's sample
 
 
 # --- success, panel touches ----------------------------------------------------------------------

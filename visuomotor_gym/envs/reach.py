@@ -70,8 +70,12 @@ class ShelfReachEnv(VisuomotorEnv):
     with the **human periphery** (``vision.foveation.human_periphery``): the human field (60 deg up, 75
     down, 100 to each side; Spector 1990), position precision falling with eccentricity (E2 0.7 deg after
     Levi, Klein & Aitsebaomo 1985), crowding (Bouma 1970) and depth precise only near the vergence
-    distance (the fixation action). The gaze starts on the front tower; a saccade (and for the
-    right-hand tower a head turn) to the object makes its position and depth precise.
+    distance (the fixation action). The shelves are **full**: the other 29 targets each hold a distractor,
+    a cylinder of the object's size (``shelf_clutter``), which the eye sees as objects of the same kind,
+    so that in the periphery crowding pools them with the object (a sample at the mean of the group);
+    the observation carries the object's sample only (the agent knows which object it fetches). The gaze
+    starts on the front tower; a saccade (and for the right-hand tower a head turn) to the object makes
+    its position and depth precise.
 
     Physics 500 Hz, control 50 Hz. The observability ladder (Oracle, FullView, foveated, Delayed,
     PoorVision) is keyword arguments of this class (``visuomotor_gym.registration``).
@@ -108,9 +112,11 @@ class ShelfReachEnv(VisuomotorEnv):
     The body sits upright with the hand at its home posture, in front of the belly near the midline
     (~(0.32, -0.05, 0.74) m: the seated analogue of Faraway et al.'s home shelf). The target is drawn
     uniformly from the 30, with a +-1 cm jitter on its board; the gaze starts on the front tower's middle
-    level between its two depths, with a 2 deg Gaussian jitter. The same seed gives the same target on
-    every rung of the ladder. ``info`` at reset: ``target_index`` (0-29: tower-major, then level, then
-    depth), ``tower``, ``level``, ``depth``, ``object_pos``, ``hand_home``.
+    level between its two depths, with a 2 deg Gaussian jitter. Then ``shelf_clutter`` of the other 29
+    targets (all of them by default) are drawn to hold a distractor, at the target's centre. The same seed
+    gives the same target and the same distractors on every rung of the ladder, and the same target for
+    any ``shelf_clutter``. ``info`` at reset: ``target_index`` (0-29: tower-major, then level, then
+    depth), ``tower``, ``level``, ``depth``, ``object_pos``, ``hand_home``, ``distractor_indices``.
 
     ## Episode End
 
@@ -118,8 +124,10 @@ class ShelfReachEnv(VisuomotorEnv):
     ``reach_radius`` of the catch site with the fingers closed beyond ``grasp_closed_fraction`` and the
     hand slower than ``arrival_speed_m_s``; on a **panel touch** (``info["panel_hit"]``: any contact between
     the body and a tower's back panel, checked every physics substep); or on a physics divergence.
-    Truncated by the registered ``max_episode_steps`` (150 steps = 3 s). The boards under the objects are
-    seen but not touched (see ``envs_assets/README.md``, ShelfReach).
+    Truncated by the registered ``max_episode_steps`` (150 steps = 3 s). The boards under the objects and
+    the distractors are seen but not touched: the hand passes through a distractor (modelling choice: the
+    task is to find and reach the object, not to avoid its neighbours; see ``envs_assets/README.md``,
+    ShelfReach).
 
     ## Arguments
 
