@@ -390,8 +390,9 @@ def test_bezier_mode_follows_its_curve():
 # --- the faraway baseline and its twin -----------------------------------------------------------
 @pytest.mark.slow
 def test_faraway_succeeds_and_beats_its_gaze_blind_twin():
-    # On the former eye (the acuity law alone, VisionParams()): under the default human periphery the held
-    # twin reaches 82.5 % of the pinned seeds (docs/reproductions/faraway.md), so there the claim is not made.
+    # On the former eye (the acuity law alone, VisionParams()), with the default full shelves. (Under the human
+    # periphery with the object alone the held twin reached 82.5 % of the pinned seeds; with full shelves
+    # 23.5 %: docs/reproductions/faraway.md.)
     from visuomotor_gym.bench.evaluate import evaluate
     from visuomotor_gym.static_gaze import registered_kwargs
     from visuomotor_gym.vision.foveation import VisionParams
@@ -573,7 +574,7 @@ def test_faraway_reaches_under_the_human_periphery():
     wins = sum(bool(run_episode(env, agent, seed=s, env_id="ShelfReach-v0", agent="faraway").success)
                for s in range(100, 120))
     env.close()
-    assert wins >= 19, wins  # 100 % on the pinned seeds 0-199 (docs/reproductions/faraway.md)
+    assert wins >= 19, wins  # 99.5 % on the pinned seeds 0-199 with full shelves (docs/reproductions/faraway.md)
 
 
 # --- realism measures ----------------------------------------------------------------------------
