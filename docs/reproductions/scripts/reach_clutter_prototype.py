@@ -1,5 +1,9 @@
 """Prototype, not part of the package: ShelfReach with the other shelf targets occupied (clutter).
 
+Superseded: the clutter is now part of ShelfReach-v0 (``ShelfReachEnv(shelf_clutter=29)``, the default, which
+reproduces this prototype seed for seed). Kept as the record of the prototype's data; it lays its distractors
+over the env's own, so rerun it only with ``shelf_clutter=0`` registered or on a checkout before that change.
+
 ``N`` distractor objects stand on ``N`` of the other 29 shelf targets (all of them with ``N = 29``), as
 still points that the retina sees as targets of the object's kind, so crowding (Bouma 1970; compulsory
 averaging, Parkes et al. 2001) pools them with the object in the periphery; the observation still
