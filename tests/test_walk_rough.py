@@ -273,3 +273,31 @@ def test_iwao_crosses_the_rough_course_under_the_human_periphery_and_its_held_tw
             results[spec] = bool(run_episode(env, policy, seed=seed, env_id="ObstacleWalk-v0", agent=spec).success)
         env.close()
     assert results == {"iwao": True, "gaze_blind:iwao": False}
+
+
+@pytest.mark.parametrize("ecc_deg", [5.0, 25.0])
+def test_the_memory_weights_a_peripheral_sample_as_shared_under_disarray(ecc_deg):
+    """Hand-computed: with positional disarray (share s) a sample's lateral information is divided by
+    1 + (K - 1) w, K = DISARRAY_LOOKS looks sharing one retinal place and w = s (1 - 1/f^2) the fixed
+    share of its lateral variance, f = 1 + theta / 0.7 deg the position law's growth (Hess & Field 1993;
+    VisionParams.position_disarray). The eye at 1.6 m looks level along x; the point lies ``ecc_deg`` below
+    the line of sight, 0.15 m above the floor: its lateral y axis is across the line of sight, so the
+    information matrix's yy entry is the sample's 1 / s_lat^2."""
+    import math
+
+    from visuomotor_gym.baselines.iwao.perception import DISARRAY_LOOKS, ObstacleMemory
+
+    from visuomotor_gym.vision.foveation import human_periphery
+
+    t = math.radians(ecc_deg)
+    d = 1.45 / math.sin(t)  # on the plane 0.15 m above the floor (the memory's first guess of a top)
+    p_eye = (d * math.cos(t), 0.0, -d * math.sin(t))  # eccentricity t from the eye's x axis
+    eye, rot, odo = [0.0, 0.0, 0.6], np.eye(3).tolist(), (0.0, 0.0, 0.0, 1.0)
+    info = {}
+    for share in (0.0, 0.8):
+        mem = ObstacleMemory(human_periphery(position_disarray=share), height_prior=(0.06, 0.1))
+        mem.add(0, 0, p_eye, eye, rot, odo, vergence=d)
+        info[share] = mem.corners[0][0].info[3]
+    f = 1.0 + math.degrees(t) / 0.7
+    w = 0.8 * (1.0 - 1.0 / f**2)
+    assert info[0.0] / info[0.8] == pytest.approx(1.0 + (DISARRAY_LOOKS - 1) * w, rel=1e-9)
