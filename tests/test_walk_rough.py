@@ -6,6 +6,7 @@ its foothold gaze on it, and the static posture search takes the env's arguments
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 
 import gymnasium as gym
 import numpy as np
@@ -22,6 +23,7 @@ from visuomotor_gym.tasks.obstacle_walk import (
     N_POINTS,
     ROUGH_CLEAR_M,
     ROUGH_COURSE,
+    DENSE_ROUGH_COURSE,
     CourseDistribution,
     _overlap,
     sample_course,
@@ -77,8 +79,21 @@ def test_overlap_against_a_hand_computed_case():
     assert not _overlap(0.3, 0.2, -0.6, 0.2, row)
 
 
-def test_rough_courses_follow_their_geometry():
-    d = ROUGH_COURSE
+def test_the_dense_preset_is_the_rough_course_with_hazards_every_045_to_08_m():
+    assert DENSE_ROUGH_COURSE == replace(ROUGH_COURSE, rough_step_m=(0.45, 0.8))
+    assert ObstacleWalkEnv(course_distribution="rough_dense").course_distribution == DENSE_ROUGH_COURSE
+    from visuomotor_gym.agents import make_agent
+
+    with registered_kwargs("ObstacleWalk-v0", {"course_distribution": "rough_dense"}):
+        assert make_agent("iwao", "ObstacleWalk-v0", 8, seed=0).params.gaze_mode == "footholds"
+    # denser: more hazards per course than the rough preset's, seeds 0-59
+    n = {d: sum(len(sample_course(np.random.default_rng(s), d, 16).obstacles) for s in range(60))
+         for d in (ROUGH_COURSE, DENSE_ROUGH_COURSE)}
+    assert n[DENSE_ROUGH_COURSE] > 1.05 * n[ROUGH_COURSE]
+
+
+@pytest.mark.parametrize("d", [ROUGH_COURSE, DENSE_ROUGH_COURSE], ids=["rough", "rough_dense"])
+def test_rough_courses_follow_their_geometry(d):
     half = 0.5 * d.walkway_width_m
     counts = []
     for seed in range(60):
