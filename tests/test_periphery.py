@@ -427,3 +427,27 @@ def test_disarray_draws_after_the_scenario_and_only_when_on():
     np.testing.assert_array_equal(f1, envs[1].unwrapped.retina._disarray.w)
     for env in envs + [full]:
         env.close()
+
+
+def test_believed_sigmas_size_the_disarray_for_a_stream_of_looks():
+    vp = VisionParams(position_e2_deg=0.7, position_disarray=0.8)
+    d, ecc, dt = 3.0, 15.0 * DEG, 0.02
+    base = fov._sigmas(d, ecc, 0.0, vp)
+    assert fov.believed_sigmas(d, ecc, 0.0, vp) == base  # no dt: the eye's own stds
+    assert fov.believed_sigmas(d, ecc, 0.0, VisionParams(position_e2_deg=0.7), None, dt) == \
+        fov._sigmas(d, ecc, 0.0, VisionParams(position_e2_deg=0.7))  # no disarray: unchanged
+    f = 1.0 + 15.0 / 0.7
+    w = 0.8 * (1.0 - 1.0 / f**2)
+    # a still image: one second of looks (50) read the same place
+    assert fov.disarray_looks(ecc, 0.0, vp, dt) == pytest.approx(50.0)
+    still = fov.believed_sigmas(d, ecc, 0.0, vp, None, dt)
+    assert still[1] == pytest.approx(base[1] * math.sqrt(1.0 + w * 49.0))
+    assert still[0] == base[0] and still[3:] == base[3:]  # depth and rates untouched
+    # an image crossing the retina at 20 deg/s leaves the place (0.5 x (15 + 0.7) deg) in 0.39 s
+    k = 1.0 + 0.5 * (15.0 + 0.7) / (20.0 * 0.02)
+    assert fov.disarray_looks(ecc, 20.0 * DEG, vp, dt) == pytest.approx(k)
+    # the covariance agents use carries the same lateral stds
+    u = np.array(unit(0.0, -15.0)) * d
+    cov = fov.covariance(u, 0.0, vp, dt=dt)
+    lat_axis = np.array(unit(0.0, 75.0))  # perpendicular to u, in its vertical plane
+    assert float(lat_axis @ cov[:3, :3] @ lat_axis) == pytest.approx(still[1] ** 2, rel=1e-9)
