@@ -29,7 +29,9 @@ MIN_STD_M = 1e-4  # a floor for the noiseless oracle rung (its information would
 # from one retinal place share that error; the memory counts so many looks per retinal place (modelling
 # choice: the 50 Hz looks of one 0.3 s fixation, during which a point off the fovea keeps its place), so
 # the fixed part of a sample's variance is weighted as if shared by that many samples. Rough course,
-# human_periphery(position_disarray=0.8), iwao, seeds 0-39: 35/40 with 15, 33/40 with 30, 27/40 without.
+# human_periphery(position_disarray=0.8), iwao, seeds 0-39: 35/40 with 15, 33/40 with 30, 27/40 without;
+# foveation.believed_sigmas (k from the predicted slip, up to 1 s of looks) instead: 33/40 (seeds 40-79:
+# 32/40 against 36/40 with 15).
 DISARRAY_LOOKS = 15
 
 
