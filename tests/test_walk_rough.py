@@ -18,12 +18,12 @@ from visuomotor_gym.static_gaze import main as static_gaze_main
 from visuomotor_gym.static_gaze import registered_kwargs
 from visuomotor_gym.tasks.obstacle_walk import (
     BOX,
+    DENSE_ROUGH_COURSE,
     K_SLOTS,
     MAT,
     N_POINTS,
     ROUGH_CLEAR_M,
     ROUGH_COURSE,
-    DENSE_ROUGH_COURSE,
     CourseDistribution,
     _overlap,
     sample_course,
@@ -80,7 +80,7 @@ def test_overlap_against_a_hand_computed_case():
 
 
 def test_the_dense_preset_is_the_rough_course_with_hazards_every_045_to_08_m():
-    assert DENSE_ROUGH_COURSE == replace(ROUGH_COURSE, rough_step_m=(0.45, 0.8))
+    assert replace(ROUGH_COURSE, rough_step_m=(0.45, 0.8)) == DENSE_ROUGH_COURSE
     assert ObstacleWalkEnv(course_distribution="rough_dense").course_distribution == DENSE_ROUGH_COURSE
     from visuomotor_gym.agents import make_agent
 
