@@ -1,4 +1,4 @@
-"""Quick probes of ObstacleWalk-v0 course variants (issue 23): agents on the pinned seeds with a course
+"""Quick probes of ObstacleWalk-v0 course variants: agents on the pinned seeds with a course
 given as fields laid over ``ROUGH_COURSE`` and a vision as ``VisionParams`` fields, one line per agent
 (successes, failure kinds, per-seed outcomes). Not the common evaluator: for design only.
 
