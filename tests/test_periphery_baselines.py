@@ -112,10 +112,14 @@ def test_plane_variance_follows_the_position_law_and_the_field():
 
 def test_dodge_planner_models_the_env_vision():
     env_id = "ObstacleDodge-v0"
-    env = gym.make(env_id, vision_params=dict(HUMAN))
+    env = gym.make(env_id, vision_params=CONE)  # the walk family's cone over the family's eye
     try:
         policy = make_agent("belief_mpc", env_id, int(env.action_space.shape[0]))
+        assert policy.plan_vision.field_shape == "human"  # the registered id's eye (DODGE_VISION)
+        match_vision(policy, env.unwrapped.vision_params)
         assert policy.plan_vision.field_of_view_deg == 20.0 and policy.plan_vision.field_shape == "cone"
+        env.close()
+        env = gym.make(env_id, vision_params=dict(HUMAN))
         before = policy.noise
         match_vision(policy, env.unwrapped.vision_params)
         assert policy.plan_vision is policy.vision is env.unwrapped.vision_params
