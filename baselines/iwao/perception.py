@@ -217,12 +217,9 @@ class ObstacleMemory:
         d_ref = min(max(d_ref, 0.3), 30.0)
         slip = 0.0 if motion is None else still_point_slip(u, d_ref, *motion)
         s_depth, s_lat = _sigmas(d_ref, ecc, slip, self.vision, vergence)[:2]
-        share = self.vision.position_disarray
-        if share > 0.0 and self.vision.foveated:
+        if self.vision.position_disarray > 0.0 and self.vision.foveated:
             # the fixed part w of the lateral variance counts DISARRAY_LOOKS times (see DISARRAY_LOOKS)
-            f = periphery.position_factor(ecc, self.vision)
-            w = share * (1.0 - 1.0 / (f * f))
-            s_lat *= math.sqrt(1.0 + (DISARRAY_LOOKS - 1) * w)
+            s_lat *= math.sqrt(1.0 + (DISARRAY_LOOKS - 1) * periphery.disarray_weight(ecc, self.vision))
         if crowded:
             s_depth, s_lat = max(s_depth, crowd_std(d_ref, ecc, self.vision)), max(s_lat, crowd_std(d_ref, ecc, self.vision))
         if self.gate is not None and prior is not None and corner.n >= 3:

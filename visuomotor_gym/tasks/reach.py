@@ -111,31 +111,17 @@ FOVEATION_WIDTH_DEG = 5.0  # as the catch family's shaping term
 
 
 class ShelfObject(VisualTarget):
-    """The object on its shelf: a mocap body (still; velocity zero)."""
+    """A still mocap body on the shelves (velocity zero): the object (``body_name`` ``reach_names.OBJECT``,
+    shown from the start) or one distractor of the shelf clutter (a body of the object's size and kind, so
+    crowding pools it with the object: modelling choice; ``hidden``, parked below the floor, until
+    :meth:`place` stands it on a target)."""
 
-    name = "object"
-
-    def __init__(self, model: mujoco.MjModel) -> None:
-        body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, reach_names.OBJECT)
-        self.mocap = int(model.body_mocapid[body])
-        self._zero = np.zeros(3)
-
-    def state(self, data: mujoco.MjData) -> tuple[np.ndarray, np.ndarray]:
-        return data.mocap_pos[self.mocap], self._zero
-
-    def place(self, data: mujoco.MjData, position) -> None:
-        data.mocap_pos[self.mocap] = position
-
-
-class ShelfDistractor(VisualTarget):
-    """One distractor of the shelf clutter: a mocap body of the object's size and kind (crowding pools it with
-    the object: modelling choice), hidden (parked below the floor) until :meth:`place` stands it on a target."""
-
-    def __init__(self, model: mujoco.MjModel, body_name: str, name: str) -> None:
+    def __init__(self, model: mujoco.MjModel, body_name: str = reach_names.OBJECT, name: str = "object",
+                 hidden: bool = False) -> None:
         body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, body_name)
         self.name = name
         self.mocap = int(model.body_mocapid[body])
-        self.hidden = True
+        self.hidden = hidden
         self._zero = np.zeros(3)
 
     def state(self, data: mujoco.MjData) -> tuple[np.ndarray, np.ndarray]:
@@ -167,7 +153,7 @@ class ReachTask(Task):
         # The clutter's distractors follow the object in the retina's target list (the observation reads
         # only the first sample, the object's); the unused mocap bodies stay parked below the floor.
         self.clutter = args.integer(clutter, "clutter", low=0, high=reach_names.N_DISTRACTORS)
-        self.distractors = [ShelfDistractor(model, b, f"distractor_{i:02d}")
+        self.distractors = [ShelfObject(model, b, f"distractor_{i:02d}", hidden=True)
                             for i, b in enumerate(reach_names.DISTRACTORS[: self.clutter])]
         self.targets = [self.object, *self.distractors]
         self.distractor_indices: tuple[int, ...] = ()

@@ -192,6 +192,14 @@ def pooled(vectors, group) -> list[float]:
 
 
 # --- 5. positional disarray --------------------------------------------------------------------
+def disarray_weight(eccentricity_rad: float, params) -> float:
+    """The share ``w = s (1 - 1/f**2)`` of the lateral position variance at this eccentricity that the
+    positional disarray fixes in place (``s = position_disarray``, ``f`` = :func:`position_factor`): ``s``
+    of the variance the periphery adds to the fovea's; 0 at the fovea."""
+    f = position_factor(eccentricity_rad, params)
+    return params.position_disarray * (1.0 - 1.0 / (f * f))
+
+
 #: Random Fourier features per position component of :class:`DisarrayField` (modelling choice: enough
 #: for a near-Gaussian field value, 16 x 2 cosines per seen point and step).
 DISARRAY_FEATURES = 16
