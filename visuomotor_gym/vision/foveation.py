@@ -245,8 +245,7 @@ def disarray_looks(eccentricity_rad: float, retinal_speed: float, params: Vision
     ``horizon_s / dt`` (a still image); 1 without the disarray."""
     if params.position_disarray <= 0.0 or not params.foveated:
         return 1.0
-    e2_deg = params.position_e2_deg if params.position_e2_deg is not None else params.fovea_e2_deg
-    span = params.disarray_length * (eccentricity_rad + e2_deg * DEG)
+    span = params.disarray_length * (eccentricity_rad + periphery.position_e2_deg(params) * DEG)
     most = max(1.0, horizon_s / dt)
     speed = abs(retinal_speed)
     return most if speed * most * dt <= span else min(most, 1.0 + span / (speed * dt))
