@@ -89,7 +89,7 @@ CROWD_RULES = {
     "veer_s": Num(0.0, 20.0),
     "min_crossing_m": Num(0.0, 200.0),
     "goal_clear_m": Num(0.0, 200.0),
-    # groups (opt-in): whole members per group, at most the episode's pedestrians; spacings of people
+    # groups: whole members per group, at most the episode's pedestrians; spacings of people
     # walking abreast, short of a street's width (modelling choice)
     "group_size": lambda v, name: _group_size(v, name),
     "group_spacing_m": Pair(Num(0.0, 5.0, low_open=True)),
