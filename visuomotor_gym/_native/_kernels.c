@@ -1073,89 +1073,89 @@ static double angular_separation(const double *u, const double *v)
     return atan2(sqrt(cx * cx + cy * cy + cz * cz), u[0] * v[0] + u[1] * v[1] + u[2] * v[2]);
 }
 
-/* Python's ``a == b`` as a class label: label[k] = the first k' <= k with items[k'] == items[k]. */
+/* Class labels of ``items`` by equality: label[k] = the first k' <= k with items[k'] == items[k], found
+ * through a dict (a kind or an object is a str: hash and == agree, as in crowding_groups' dict). */
 static int labels_of(PyObject *const *items, Py_ssize_t n, Py_ssize_t *label)
 {
+    PyObject *first = PyDict_New();
+    if (first == NULL)
+        return -1;
     for (Py_ssize_t k = 0; k < n; k++) {
-        label[k] = k;
-        for (Py_ssize_t q = 0; q < k; q++) {
-            if (label[q] != q)
-                continue;
-            int eq = PyObject_RichCompareBool(items[k], items[q], Py_EQ);
-            if (eq < 0)
-                return -1;
-            if (eq) {
-                label[k] = q;
-                break;
-            }
+        PyObject *index = PyLong_FromSsize_t(k);
+        PyObject *got = index == NULL ? NULL : PyDict_SetDefault(first, items[k], index);
+        Py_XDECREF(index);
+        if (got == NULL) {
+            Py_DECREF(first);
+            return -1;
         }
+        label[k] = PyLong_AsSsize_t(got); /* borrowed, held by the dict */
     }
+    Py_DECREF(first);
     return 0;
 }
 
-/* periphery.crowding_groups on C arrays. ``dirs`` n x 3, ``eccs`` n, ``kind`` and ``obj`` the labels of
- * the targets' kinds and objects (labels_of). Writes ``elem`` (n x n): elem[i n + j] = the element of
- * i's group that holds j (1, 2, ...: flanking objects in order of first appearance), 0 if none (i's own
- * element [i] is element 0); ``count[i]`` = the number of elements of i's group. */
-static void crowd(const PeripheryConsts *c, Py_ssize_t n, const double *dirs, const double *eccs,
-                  const Py_ssize_t *kind, const Py_ssize_t *obj, Py_ssize_t *elem, Py_ssize_t *count,
-                  Py_ssize_t *first)
+/* periphery.crowding_groups for target i, on C arrays: ``dirs`` n x 3, ``eccs`` n, ``kind`` and ``obj``
+ * the labels (labels_of) of the targets' kinds and objects. Writes elem[j] = the element of i's group
+ * that holds j (1, 2, ...: the flanking objects in order of first appearance), 0 for none (i's own
+ * element [i] is element 0), and returns the number of elements (1: i alone). ``slot`` (n entries,
+ * all -1 on entry and on return): an object label's element. */
+static Py_ssize_t crowd_one(const PeripheryConsts *c, Py_ssize_t n, Py_ssize_t i, const double *dirs,
+                            const double *eccs, const Py_ssize_t *kind, const Py_ssize_t *obj, Py_ssize_t *elem,
+                            Py_ssize_t *slot)
 {
-    memset(elem, 0, (size_t)(n * n) * sizeof(Py_ssize_t));
-    for (Py_ssize_t i = 0; i < n; i++)
-        count[i] = 1;
+    memset(elem, 0, (size_t)n * sizeof(Py_ssize_t));
     if (!(c->crowding && c->foveated))
-        return;
-    double fovea = c->crowd_fovea;
-    for (Py_ssize_t i = 0; i < n; i++) {
-        double theta = eccs[i];
-        if (theta <= fovea)
-            continue;
-        double spacing = c->bouma * theta;
-        Py_ssize_t m = 1; /* first[e]: a point of element e's object */
-        for (Py_ssize_t j = 0; j < n; j++) {
-            if (j != i && kind[j] == kind[i] && obj[j] != obj[i]
-                && angular_separation(dirs + 3 * i, dirs + 3 * j) < spacing) {
-                Py_ssize_t e = 1;
-                while (e < m && obj[first[e]] != obj[j])
-                    e++;
-                if (e == m)
-                    first[m++] = j;
-                elem[i * n + j] = e;
-            }
+        return 1;
+    double theta = eccs[i];
+    if (theta <= c->crowd_fovea)
+        return 1;
+    double spacing = c->bouma * theta;
+    Py_ssize_t m = 1;
+    for (Py_ssize_t j = 0; j < n; j++) {
+        if (j != i && kind[j] == kind[i] && obj[j] != obj[i]
+            && angular_separation(dirs + 3 * i, dirs + 3 * j) < spacing) {
+            if (slot[obj[j]] < 0)
+                slot[obj[j]] = m++;
+            elem[j] = slot[obj[j]];
         }
-        count[i] = m;
     }
+    for (Py_ssize_t j = 0; j < n; j++)
+        if (elem[j])
+            slot[obj[j]] = -1;
+    return m;
 }
 
-/* periphery.pooled of target i's group (crowd's elem, count) over ``vecs`` (n x 3) into out[3]. */
-static void pool(Py_ssize_t n, Py_ssize_t i, const Py_ssize_t *elem, Py_ssize_t count, const double *vecs,
-                 double *out)
+/* periphery.pooled over ``vecs`` (n x 3) of target i's group (crowd_one's elem and m) into out[3]: each
+ * element's sum runs over its points in index order from 0.0, as the Python's does. ``acc``: 4 m
+ * doubles of scratch. */
+static void pool_one(Py_ssize_t n, Py_ssize_t i, const Py_ssize_t *elem, Py_ssize_t m, const double *vecs,
+                     double *acc, double *out)
 {
-    if (count == 1) {
+    if (m == 1) { /* a lone target is itself */
         memcpy(out, vecs + 3 * i, 3 * sizeof(double));
         return;
     }
-    const Py_ssize_t *row = elem + i * n;
-    double sx = 0.0, sy = 0.0, sz = 0.0;
-    for (Py_ssize_t e = 0; e < count; e++) {
-        double ex = 0.0, ey = 0.0, ez = 0.0;
-        Py_ssize_t members = 0;
-        for (Py_ssize_t k = 0; k < n; k++) {
-            if (e == 0 ? k != i : row[k] != e)
-                continue;
-            const double *v = vecs + 3 * k;
-            ex += v[0];
-            ey += v[1];
-            ez += v[2];
-            members++;
-        }
-        sx += ex / (double)members;
-        sy += ey / (double)members;
-        sz += ez / (double)members;
+    for (Py_ssize_t e = 0; e < 4 * m; e++)
+        acc[e] = 0.0;
+    acc[0] += vecs[3 * i], acc[1] += vecs[3 * i + 1], acc[2] += vecs[3 * i + 2], acc[3] = 1.0; /* [i] */
+    for (Py_ssize_t j = 0; j < n; j++) {
+        if (elem[j] == 0)
+            continue;
+        double *a = acc + 4 * elem[j];
+        const double *v = vecs + 3 * j;
+        a[0] += v[0];
+        a[1] += v[1];
+        a[2] += v[2];
+        a[3] += 1.0;
     }
-    sx /= (double)count, sy /= (double)count, sz /= (double)count;
-    out[0] = sx, out[1] = sy, out[2] = sz;
+    double sx = 0.0, sy = 0.0, sz = 0.0;
+    for (Py_ssize_t e = 0; e < m; e++) {
+        const double *a = acc + 4 * e;
+        sx += a[0] / a[3];
+        sy += a[1] / a[3];
+        sz += a[2] / a[3];
+    }
+    out[0] = sx / (double)m, out[1] = sy / (double)m, out[2] = sz / (double)m;
 }
 
 /* n x 3 doubles from a sequence of 3-sequences (lists, tuples or arrays) into a new buffer. */
@@ -1175,20 +1175,23 @@ static double *rows3(PyObject *seq, Py_ssize_t n)
     return out;
 }
 
-/* Scratch arrays of crowd(), in one allocation. */
+/* Scratch arrays of crowd_one and pool_one for n targets, in one allocation (slot all -1). */
 typedef struct {
-    Py_ssize_t *kind, *obj, *elem, *count, *first;
+    Py_ssize_t *kind, *obj, *elem, *slot;
+    double *acc;
 } Crowd;
 
 static int crowd_alloc(Crowd *w, Py_ssize_t n)
 {
     size_t m = (size_t)(n > 0 ? n : 1);
-    w->kind = PyMem_Malloc((5 * m + m * m) * sizeof(Py_ssize_t));
+    w->kind = PyMem_Malloc(4 * m * sizeof(Py_ssize_t) + 4 * m * sizeof(double));
     if (w->kind == NULL) {
         PyErr_NoMemory();
         return -1;
     }
-    w->obj = w->kind + m, w->count = w->obj + m, w->first = w->count + m, w->elem = w->first + m + m;
+    w->obj = w->kind + m, w->elem = w->obj + m, w->slot = w->elem + m, w->acc = (double *)(w->slot + m);
+    for (size_t k = 0; k < m; k++)
+        w->slot[k] = -1;
     return 0;
 }
 
@@ -1236,23 +1239,23 @@ static PyObject *crowding_groups(PyObject *self, PyObject *const *args, Py_ssize
     if (labels_of(PySequence_Fast_ITEMS(kseq), n, w.kind) < 0
         || labels_of(PySequence_Fast_ITEMS(oseq), n, w.obj) < 0)
         goto done;
-    crowd(&c, n, dirs, eccs, w.kind, w.obj, w.elem, w.count, w.first);
     out = PyList_New(n);
     for (Py_ssize_t i = 0; out != NULL && i < n; i++) {
-        PyObject *group = PyList_New(w.count[i]);
+        Py_ssize_t m = crowd_one(&c, n, i, dirs, eccs, w.kind, w.obj, w.elem, w.slot);
+        PyObject *group = PyList_New(m);
         int ok = group != NULL;
-        for (Py_ssize_t e = 0; ok && e < w.count[i]; e++) {
+        for (Py_ssize_t e = 0; ok && e < m; e++) {
             PyObject *element = PyList_New(0);
             ok = element != NULL;
-            for (Py_ssize_t k = 0; ok && k < n; k++) {
-                if (e == 0 ? k == i : w.elem[i * n + k] == e) {
-                    PyObject *index = PyLong_FromSsize_t(k);
-                    ok = index != NULL && PyList_Append(element, index) == 0;
-                    Py_XDECREF(index);
-                }
-            }
-            if (element != NULL)
+            if (ok)
                 PyList_SET_ITEM(group, e, element);
+        }
+        for (Py_ssize_t k = 0; ok && k < n; k++) { /* [i], then each flanking object's points in index order */
+            if (k != i && w.elem[k] == 0)
+                continue;
+            PyObject *index = PyLong_FromSsize_t(k);
+            ok = index != NULL && PyList_Append(PyList_GET_ITEM(group, k == i ? 0 : w.elem[k]), index) == 0;
+            Py_XDECREF(index);
         }
         if (!ok) {
             Py_XDECREF(group);
@@ -1431,7 +1434,7 @@ static PyObject *retina_see_periphery(PyObject *self, PyObject *const *args, Py_
         s->slip = retinal_speed(eye, rx, ry, rz, v[0], v[1], v[2], dt);
     }
     if (c.crowding && m > 1) { /* crowding: each seen target at the mean of its group */
-        dirs = PyMem_Malloc((size_t)(3 * m) * sizeof(double) * 4); /* dirs, eccs, pooled p and v */
+        dirs = PyMem_Malloc((size_t)(16 * m) * sizeof(double)); /* dirs, eccs, pooled p and v, unpooled */
         labels = PyMem_Malloc((size_t)(2 * m) * sizeof(PyObject *));
         if (dirs == NULL || labels == NULL) {
             PyErr_NoMemory();
@@ -1465,17 +1468,17 @@ static PyObject *retina_see_periphery(PyObject *self, PyObject *const *args, Py_
         }
         if (labels_of(labels, m, w.kind) < 0 || labels_of(labels + m, m, w.obj) < 0)
             goto fail;
-        crowd(&c, m, dirs, eccs, w.kind, w.obj, w.elem, w.count, w.first);
         double *pv = pooled_v; /* m pooled positions, then m pooled velocities */
-        double *src = dirs;    /* the unpooled positions and velocities, gathered (reuses dirs) */
-        for (Py_ssize_t k = 0; k < m; k++)
+        double *src = dirs + 4 * m + 6 * m; /* the unpooled positions, then velocities */
+        for (Py_ssize_t k = 0; k < m; k++) {
             memcpy(src + 3 * k, seen[k].p, 3 * sizeof(double));
-        for (Py_ssize_t k = 0; k < m; k++)
-            pool(m, k, w.elem, w.count[k], src, pv + 3 * k);
-        for (Py_ssize_t k = 0; k < m; k++)
-            memcpy(src + 3 * k, seen[k].v, 3 * sizeof(double));
-        for (Py_ssize_t k = 0; k < m; k++)
-            pool(m, k, w.elem, w.count[k], src, pv + 3 * (m + k));
+            memcpy(src + 3 * (m + k), seen[k].v, 3 * sizeof(double));
+        }
+        for (Py_ssize_t k = 0; k < m; k++) {
+            Py_ssize_t count = crowd_one(&c, m, k, dirs, eccs, w.kind, w.obj, w.elem, w.slot);
+            pool_one(m, k, w.elem, count, src, w.acc, pv + 3 * k);
+            pool_one(m, k, w.elem, count, src + 3 * m, w.acc, pv + 3 * (m + k));
+        }
         for (Py_ssize_t k = 0; k < m; k++) {
             memcpy(seen[k].p, pv + 3 * k, 3 * sizeof(double));
             memcpy(seen[k].v, pv + 3 * (m + k), 3 * sizeof(double));
