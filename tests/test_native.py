@@ -315,3 +315,30 @@ def test_the_periphery_families_step_identically_on_both_paths(env_id):
         return out
 
     assert run(True) == run(False)
+
+
+@needs_kernels
+def test_a_pickled_periphery_env_keeps_stepping_identically():
+    """The retina's packed periphery constants and the episode's disarray field travel with the pickle."""
+    import gymnasium as gym
+
+    import visuomotor_gym  # noqa: F401
+
+    env = gym.make("ShelfReach-v0").unwrapped
+    env.reset(seed=2)
+    action = np.full(env.action_space.shape, 0.2, dtype=np.float32)
+    for _ in range(5):
+        env.step(action)
+    twin = pickle.loads(pickle.dumps(env))
+    assert twin.retina._native and twin.retina.params.periphery_on and twin.retina._disarray is not None
+    for _ in range(40):
+        a, b = env.step(action), twin.step(action)
+        assert a[0].tobytes() == b[0].tobytes() and a[1] == b[1]
+
+
+@needs_kernels
+def test_the_periphery_kernels_reject_bad_constants_by_name():
+    with pytest.raises(TypeError, match="periphery_constants"):
+        _native.kernels.crowding_groups([], [], [], [], b"short")
+    with pytest.raises(ValueError, match="same length"):
+        _native.kernels.crowding_groups([[1.0, 0.0, 0.0]], [], [], [], periphery_constants(human_periphery()))
