@@ -228,7 +228,7 @@ def test_throw_prior_matches_its_monte_carlo():
 
 def test_eyecatch_expects_the_throw_only_under_the_human_periphery():
     rot, eye = np.eye(3), np.array([0.1, -0.2, 1.2])
-    plain = _eyecatch()
+    plain = _eyecatch({})  # an eye without the human periphery
     plain._set_thrower_prior(rot, eye)
     np.testing.assert_allclose(np.diag(plain.filter.P)[3:], [100.0] * 3)  # the paper agent: uninformative
     for spec, expects in (("eyecatch", True), ("eyecatch:periphery_model=False", False)):
