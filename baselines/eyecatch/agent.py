@@ -56,6 +56,10 @@ follows (docs/reproductions/gaze_default.md, "EyeCatch-v0 under the one eye"):
 7. **The first saccade at the saccadic latency** (0.18 s): with the throw expected, the estimate where the
    saccade would land is as good as a still eye can make it (the ball slips off the fovea at ~60 deg/s,
    where the position law leaves each look worth little).
+8. **The head pursues the ball's believed motion**, not the eye's achieved one: the head's share of
+   pursuit (Eyecatch 4.2) is driven by the target motion that drives the eye's pursuit, so an eye held at
+   its orbital limit (+27.7 deg up: rising throws reach it) no longer stops the head, which then leaves
+   the ball 10-20 deg off the fovea (modelling choice).
 """
 
 from __future__ import annotations
@@ -139,8 +143,9 @@ class EyecatchParams:
     thrower_distance_std_m: float = 1.0  # modelling choice: ~ the std of a 3-6 m uniform range (0.87)
     thrower_lateral_std_m: float = 0.3  # modelling choice: ~4 deg at 4.5 m (the reset gaze jitter is 2 deg)
     periphery_model: bool = True  # under an eye with the human periphery (VisionParams.periphery_on), the
-    # adaptations 5-7 of the module docstring: the throw expected (throw_prior), the expected sample noise,
-    # the first saccade at the saccadic latency. No effect on other eyes. False: the agent as before them
+    # adaptations 5-8 of the module docstring: the throw expected (throw_prior), the expected sample noise,
+    # the first saccade at the saccadic latency, the head pursuing the believed ball. No effect on other
+    # eyes. False: the agent as before them
     # Gaze (Eyecatch 4.1).
     first_saccade_min_latency_s: float = 0.18  # the first saccade's decision signal needs this long to
     # reach its criterion: human saccadic latency 180-200 ms (REFERENCES.md, Eyecatch's criterion is
@@ -372,7 +377,11 @@ class EyecatchAgent:
 
         # --- visuomotor update: every ~200 ms, re-synchronised to saccade onsets --------------
         if p.head_pursuit_gain > 0.0:
-            self._head_pursuit(rot[:, 0], in_saccade)
+            if self.periphery_adapted:  # the head follows the ball's believed motion (module docstring, 8)
+                to_ball = ball_now - eye
+                self._head_pursuit(to_ball / max(float(np.linalg.norm(to_ball)), 1e-9), in_saccade)
+            else:
+                self._head_pursuit(rot[:, 0], in_saccade)
         if in_saccade and since_onset < self.dt * 0.5 + 1e-9:
             self.next_update = t  # a saccade just started: update with it
         if math.isinf(self.next_update) and self.first_saccade_released:
@@ -390,6 +399,8 @@ class EyecatchAgent:
         The eye's pursuit over the last step is the change of its line of sight (world azimuth and
         elevation) when no saccade flew during it; the head's whole plan (its submovements' start and
         destination) is shifted by the same change, so pursuit does not use up the eye's orbital range.
+        Under the human periphery ``gaze_dir`` is the direction of the believed ball instead (module
+        docstring, 8).
         """
         p = self.params
         prev, pursued = self.prev_gaze_dir, not (in_saccade or self.prev_in_saccade)
@@ -421,7 +432,7 @@ class EyecatchAgent:
 
     @property
     def periphery_adapted(self) -> bool:
-        """Whether the agent models the human periphery of its eye (module docstring, 5-7)."""
+        """Whether the agent models the human periphery of its eye (module docstring, 5-8)."""
         return self.params.periphery_model and self.vision.periphery_on
 
     def _fuse(self, obs: np.ndarray) -> None:
