@@ -205,6 +205,7 @@ def _eyecatch(vision_params=None, spec="eyecatch"):
 def test_throw_prior_matches_its_monte_carlo():
     """The closed-form moments of the expected throw against 400k draws of the same generative model."""
     from visuomotor_gym.baselines.eyecatch.agent import throw_prior
+
     from visuomotor_gym.scenarios.throws import GRAVITY, ThrowDistribution
 
     mean0, cov0 = np.array([4.5, 0.3, 1.6]), np.diag([1.0, 0.09, 0.09])
