@@ -850,6 +850,29 @@ static void perceive_prepare(const VisionConsts *c, const double *pe, const doub
 }
 
 /* The sample of a look (foveation._draw_at with the six standard normals ``e``). */
+/* rng.standard_normal(6 n) (one six-vector per look, in look order) into *draw (a new reference) and
+ * *normals (its buffer, held): 0; -1 with an exception set and *normals not held (buf NULL). */
+static int draw_normals(PyObject *rng, Py_ssize_t n, PyObject **draw, Py_buffer *normals)
+{
+    PyObject *size = PyLong_FromSsize_t(6 * n);
+    if (size == NULL)
+        return -1;
+    PyObject *call[2] = {rng, size};
+    *draw = PyObject_VectorcallMethod(s_standard_normal, call, 2 | PY_VECTORCALL_ARGUMENTS_OFFSET, NULL);
+    Py_DECREF(size);
+    if (*draw == NULL || f64_buffer(*draw, normals, 0) < 0) {
+        normals->buf = NULL;
+        return -1;
+    }
+    if (normals->len != 48 * n) {
+        PyBuffer_Release(normals);
+        normals->buf = NULL;
+        PyErr_SetString(PyExc_ValueError, "rng.standard_normal gave the wrong size");
+        return -1;
+    }
+    return 0;
+}
+
 /* A VisualTarget's world position b and velocity v (its ``state(data)``): 1 when shown, 0 when hidden
  * (b, v untouched), -1 with an exception set. */
 static int target_state(PyObject *target, PyObject *data, double *b, double *v)
@@ -948,20 +971,9 @@ static PyObject *retina_see_all(PyObject *self, PyObject *const *args, Py_ssize_
     }
     const double *e = NULL;
     Py_buffer normals = {.buf = NULL};
-    if (seen > 0) { /* rng.standard_normal(6 * seen) */
-        PyObject *size = PyLong_FromSsize_t(6 * seen);
-        if (size == NULL)
+    if (seen > 0) {
+        if (draw_normals(rng, seen, &draw, &normals) < 0)
             goto fail;
-        PyObject *call[2] = {rng, size};
-        draw = PyObject_VectorcallMethod(s_standard_normal, call, 2 | PY_VECTORCALL_ARGUMENTS_OFFSET, NULL);
-        Py_DECREF(size);
-        if (draw == NULL || f64_buffer(draw, &normals, 0) < 0)
-            goto fail;
-        if (normals.len != 48 * seen) {
-            PyBuffer_Release(&normals);
-            PyErr_SetString(PyExc_ValueError, "rng.standard_normal gave the wrong size");
-            goto fail;
-        }
         e = (const double *)normals.buf;
     }
     out = PyList_New(n);
@@ -1517,19 +1529,9 @@ static PyObject *retina_see_periphery(PyObject *self, PyObject *const *args, Py_
         }
     }
     const double *e = NULL;
-    if (draws > 0) { /* rng.standard_normal(6 * draws) */
-        PyObject *size = PyLong_FromSsize_t(6 * draws);
-        if (size == NULL)
+    if (draws > 0) {
+        if (draw_normals(rng, draws, &draw, &normals) < 0)
             goto fail;
-        PyObject *call[2] = {rng, size};
-        draw = PyObject_VectorcallMethod(s_standard_normal, call, 2 | PY_VECTORCALL_ARGUMENTS_OFFSET, NULL);
-        Py_DECREF(size);
-        if (draw == NULL || f64_buffer(draw, &normals, 0) < 0)
-            goto fail;
-        if (normals.len != 48 * draws) {
-            PyErr_SetString(PyExc_ValueError, "rng.standard_normal gave the wrong size");
-            goto fail;
-        }
         e = (const double *)normals.buf;
     }
     out = PyList_New(n);
