@@ -509,23 +509,19 @@ class EyecatchAgent:
             u_s = -u_s
         dm = math.sqrt(float(mean @ mean))
         direction = u_s
-        if self.filter.initialised and dm > 1e-6 and self.periphery_adapted:
-            # The RMS eccentricity under the prior, in the prior's polar direction (module docstring, 6).
+        if self.filter.initialised and dm > 1e-6:
             u_p = mean / dm
             depth_var = float(u_p @ P @ u_p)
             d_noise = math.sqrt(dm * dm + depth_var)
             var_p = max(float(np.trace(P)) - depth_var, 0.0) / 2.0 / (dm * dm + depth_var)
-            direction = _at_eccentricity(u_p, math.sqrt(foveation.eccentricity(u_p) ** 2 + 2.0 * var_p))
-        elif self.filter.initialised and dm > 1e-6:
-            u_p = mean / dm
-            depth_var = float(u_p @ P @ u_p)
-            d_noise = math.sqrt(dm * dm + depth_var)
-            lateral = foveation.standard_deviations(d_noise, foveation.eccentricity(u_s), speed, self.vision)[1]
-            var_s = (lateral / max(ds, 1e-9)) ** 2
-            var_p = max(float(np.trace(P)) - depth_var, 0.0) / 2.0 / (dm * dm + depth_var)
-            w = u_s / max(var_s, 1e-18) + u_p / max(var_p, 1e-18)
-            direction = w / max(float(np.linalg.norm(w)), 1e-12)
-
+            if self.periphery_adapted:
+                # The RMS eccentricity under the prior, in the prior's polar direction (module docstring, 6).
+                direction = _at_eccentricity(u_p, math.sqrt(foveation.eccentricity(u_p) ** 2 + 2.0 * var_p))
+            else:
+                lateral = foveation.standard_deviations(d_noise, foveation.eccentricity(u_s), speed, self.vision)[1]
+                var_s = (lateral / max(ds, 1e-9)) ** 2
+                w = u_s / max(var_s, 1e-18) + u_p / max(var_p, 1e-18)
+                direction = w / max(float(np.linalg.norm(w)), 1e-12)
         else:
             d_noise = math.sqrt(dm * dm + float(u_s @ P @ u_s))
         return direction * d_noise
