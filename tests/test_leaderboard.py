@@ -922,3 +922,36 @@ def test_belief_mpc_file_without_later_default_fields_is_the_same_policy():
     assert not _belief_mpc_same(dump(changed), fresh, env_id)
     extra = {**obj, "params": {**obj["params"], "not_a_field": 1}}
     assert not _belief_mpc_same(dump(extra), fresh, env_id)
+
+
+# ---------------------------------------------------------------- the eyecatch policy file and the env's eye
+
+
+def test_eyecatch_policy_file_loads_with_the_envs_eye():
+    """A replayed Eyecatch file models the eye of its env, as the spec path does: on EyeCatchPaper-v0 (whose
+    vision_params differ from the ones the params alone imply) the loaded agent's VisionParams are the env's;
+    a spec that overrides the assumed eye keeps its own. A file written before the loader did this (the
+    former note) is the same policy only where the two eyes agree."""
+    from visuomotor_gym.agents import make_agent
+    from visuomotor_gym.leaderboard.policies import (
+        EYECATCH_NOTE,
+        EYECATCH_NOTE_BEFORE_EYE,
+        _eyecatch_export,
+        _eyecatch_load,
+        _eyecatch_same,
+    )
+    from visuomotor_gym.registration import env_vision_params
+
+    for env_id, changes_eye in (("EyeCatchPaper-v0", True), ("EyeCatch-v0", False)):
+        data = _eyecatch_export("eyecatch", env_id)
+        assert json.loads(data)["note"] == EYECATCH_NOTE
+        agent = _eyecatch_load(data, env_id)
+        assert agent.vision == env_vision_params(env_id) == make_agent("eyecatch", env_id, 13).vision
+        own = _eyecatch_load(_eyecatch_export("eyecatch", env_id), env_id)
+        own.vision = type(own.vision)(noise_scale=own.params.vision_noise_scale, foveated=own.params.foveated)
+        assert (own.vision != agent.vision) == changes_eye
+        before = json.dumps({**json.loads(data), "note": EYECATCH_NOTE_BEFORE_EYE}, indent=2) + "\n"
+        assert _eyecatch_same(before.encode(), data, env_id) == (not changes_eye)
+    data = _eyecatch_export("eyecatch:vision_noise_scale=3.0", "EyeCatchPaper-v0")
+    agent = _eyecatch_load(data, "EyeCatchPaper-v0")
+    assert agent.vision.noise_scale == 3.0 and agent.vision != env_vision_params("EyeCatchPaper-v0")

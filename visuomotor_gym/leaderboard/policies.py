@@ -144,6 +144,13 @@ def sha256_bytes(data: bytes) -> str:
 # ------------------------------------------------------------------ eyecatch-params
 
 EYECATCH_FORMAT = "eyecatch-params"
+# What the file means. Files written before the loader gave the agent its env's eye carry the first note:
+# they load the same agent wherever the env's eye is the one the params imply (:func:`_eyecatch_same`).
+EYECATCH_NOTE = ("Every EyecatchParams field as EyecatchAgent.for_env(env_id, **overrides) resolves it; the policy "
+                 "is EyecatchAgent(EyecatchParams(**params)) with the env's eye, as the spec in 'agent' builds it "
+                 "(visuomotor_gym.agents.match_vision(agent, agent_eye(env_id, overrides))).")
+EYECATCH_NOTE_BEFORE_EYE = ("Every EyecatchParams field as EyecatchAgent.for_env(env_id, **overrides) resolves it; "
+                            "the policy is EyecatchAgent(EyecatchParams(**params)).")
 
 
 def _eyecatch_export(spec: str, env_id: str) -> bytes:
@@ -163,8 +170,7 @@ def _eyecatch_export(spec: str, env_id: str) -> bytes:
         "format_version": 1,
         "agent": spec,
         "env_id": env_id,
-        "note": "Every EyecatchParams field as EyecatchAgent.for_env(env_id, **overrides) resolves it; "
-        "the policy is EyecatchAgent(EyecatchParams(**params)).",
+        "note": EYECATCH_NOTE,
         "params": asdict(params),
     }
     return (json.dumps(obj, indent=2, allow_nan=False) + "\n").encode("utf-8")
@@ -175,14 +181,49 @@ def _eyecatch_load(data: bytes, env_id: str) -> Policy:
 
     obj = _read_json_policy(data, EYECATCH_FORMAT, env_id)
     params = _typed_params(obj["params"], EyecatchParams, "EyecatchParams", fill_defaults=True)
-    return EyecatchAgent(EyecatchParams(**params))
+    agent = EyecatchAgent(EyecatchParams(**params))
+    eye = _eyecatch_env_eye(obj["agent"], env_id)
+    if eye is not None:
+        # every constant of the env's eye (the human periphery, the paper conditions' vision_params), as
+        # the spec path gives it (agents._with_env_vision): the replayed policy is the one that was scored
+        from visuomotor_gym.agents import match_vision
+
+        match_vision(agent, eye)
+    return agent
+
+
+def _eyecatch_env_eye(spec, env_id: str):
+    """The ``VisionParams`` the agent spec ``spec`` models on ``env_id`` (None when the spec overrides the
+    eye it assumes, :func:`visuomotor_gym.registration.agent_eye`)."""
+    from visuomotor_gym.agents import parse_agent_spec
+    from visuomotor_gym.registration import agent_eye
+
+    if not isinstance(spec, str):
+        raise ValueError(f"agent must be an agent spec string, got {spec!r}")
+    name, overrides = parse_agent_spec(spec)
+    if name != "eyecatch":
+        raise ValueError(f"the {EYECATCH_FORMAT} format serves the eyecatch agent, not {name!r}")
+    return agent_eye(env_id, overrides)
 
 
 def _eyecatch_same(committed: bytes, fresh: bytes, env_id: str) -> bool:
     """A committed Eyecatch file written before some parameters existed (``periphery_model``) is the same
-    policy when the fresh export adds only fields at their default (:func:`_same_but_defaults`)."""
-    from visuomotor_gym.baselines.eyecatch import EyecatchParams
+    policy when the fresh export adds only fields at their default (:func:`_same_but_defaults`); one written
+    before the loader gave the agent its env's eye (:data:`EYECATCH_NOTE_BEFORE_EYE`) is the same policy
+    where that eye is the one its params build alone."""
+    from visuomotor_gym.baselines.eyecatch import EyecatchAgent, EyecatchParams
 
+    old = json.loads(committed)
+    if isinstance(old, dict) and old.get("note") == EYECATCH_NOTE_BEFORE_EYE:
+        # written before the loader gave the agent its env's eye: the same policy only where that eye is
+        # the one the params alone build (EyecatchAgent's own VisionParams from noise scale and foveation)
+        params = _typed_params(old.get("params"), EyecatchParams, "EyecatchParams", fill_defaults=True)
+        eye = _eyecatch_env_eye(old.get("agent"), env_id)
+        if eye is not None and eye != EyecatchAgent(EyecatchParams(**params)).vision:
+            return False
+        committed = (json.dumps({**old, "note": EYECATCH_NOTE}, indent=2, allow_nan=False) + "\n").encode("utf-8")
+        if committed == fresh:
+            return True
     return _same_but_defaults(committed, fresh, EyecatchParams)
 
 
