@@ -49,6 +49,7 @@ from visuomotor_gym.baselines.eyecatch.agent import EyecatchAgent
 from visuomotor_gym.core.frames import SEAT_ORIGIN
 from visuomotor_gym.envs.actions import hand_target_action
 from visuomotor_gym.envs.observation import ObservationLayout
+from visuomotor_gym.registration import env_vision_params
 
 N_BELIEF = 10
 N_INTERCEPT = 4
@@ -81,7 +82,10 @@ class BeliefFeatures:
             raise ValueError(f"gaze_residual_deg must be a number of degrees >= 0, got {gaze_residual_deg!r}")
         # The Eyecatch agent owns the filter plumbing (delay, covariance from the prior, resets);
         # only its perception half and its interception geometry are used.
+        # Given every constant of the registered env's eye (the human periphery, the paper conditions'
+        # vision_params), as the eyecatch spec gets it (agents.match_vision).
         self._agent = EyecatchAgent.for_env(env_id)
+        self._agent.vision = env_vision_params(env_id)
         self.hand_action = hand_action
         self.residual_m = float(residual_m)
         self.gaze_action = gaze_action
