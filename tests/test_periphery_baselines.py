@@ -277,3 +277,71 @@ def test_eyecatch_rms_pedestal_and_retinal_speed():
     speed = agent._expected_retinal_speed(np.array([2.0, 0.0, 0.0]), np.zeros(3), np.diag([1.0, 0.25, 0.25]),
                                           np.zeros(3))
     assert speed == pytest.approx(math.sqrt(0.5) / 2.0)
+
+
+def _fixation_lag(spec: str, seed: int = 16, steps: int = 45) -> list[float]:
+    """Per step of a throw: the eye's vergence distance over the ball's true distance when the sample is
+    taken (the env's info), with the agent's vergence command of the step before."""
+    from visuomotor_gym.core.frames import SEAT_ORIGIN
+    from visuomotor_gym.envs.observation import ObservationLayout
+
+    s = ObservationLayout().slices
+    env = gym.make("EyeCatch-v0", vision_params={**HUMAN, "position_disarray": 0.8})
+    policy = make_agent(spec, "EyeCatch-v0", int(env.action_space.shape[0]), seed=seed)
+    match_vision(policy, env.unwrapped.vision_params)
+    obs, info = env.reset(seed=seed)
+    ratios = []
+    for _ in range(steps):
+        obs, _, term, trunc, info = env.step(policy.predict(obs)[0])
+        if term or trunc:
+            break
+        eye = obs[s["eye_pos"]] + SEAT_ORIGIN
+        ratios.append(float(obs[s["fixation"]][0]) / float(np.linalg.norm(info["ball_pos"] - eye)))
+    env.close()
+    return ratios
+
+
+def test_eyecatch_verges_where_the_next_sample_is_taken():
+    """Under the depth law the fixation command is the believed ball one step ahead (module docstring, 9):
+    late in the throw (0.5-0.9 s, the ball approaching at several m/s) the vergence sits on the ball when
+    the sample is taken; commanding the present distance leaves it one step behind, beyond the ball."""
+    ahead = np.median(_fixation_lag("eyecatch", seed=5)[25:])
+    behind = np.median(_fixation_lag("eyecatch:vergence_lead_s=0", seed=5)[25:])
+    assert abs(ahead - 1.0) < 0.01  # 0.996
+    assert behind > 1.03  # 1.051
+
+
+def test_retinal_bias_filter_reads_a_fixed_bias_as_a_place_not_a_motion():
+    """RetinalBiasFilter (opt-in): a still ball seen through a constant retinal bias. With the bias in the
+    model (rho 1: one retinal place) the ball's lateral std stays at the bias's prior std while the plain
+    filter, fed the same samples as white noise, grows confident about the biased position; a saccade to
+    another place (rho 0) re-draws the bias and the two places' samples together find the ball."""
+    from visuomotor_gym.baselines.eyecatch.kalman import BallKalmanFilter, KalmanParams, RetinalBiasFilter
+
+    kp = KalmanParams(process_noise_acc_m_s2=0.0, reset_mahalanobis=1e9)
+    true = np.array([2.0, 0.0, 1.0])
+    a, white = 0.02, 0.005  # the fixed part's std (m), the white part's
+    plain, biased = BallKalmanFilter(0.02, kp), RetinalBiasFilter(0.02, kp)
+    for f in (plain, biased):
+        f.x, f.P, f.initialised = np.concatenate([true + [0.0, 0.05, 0.0], np.zeros(3)]), np.eye(6) * 0.01, True
+    rot, eye = np.eye(3), np.zeros(3)
+    M = np.zeros((6, 2))
+    M[1, 0] = M[2, 1] = a  # the field's two values along the eye frame's y and z
+    R = np.diag([1e-4, white**2, white**2, 1e-4, 1e-4, 1e-4])
+    rng = np.random.default_rng(0)
+    for place in (np.array([1.0, -0.5]), np.array([-0.8, 0.3])):  # field values at two retinal places
+        for k in range(50):
+            z = np.concatenate([true + np.concatenate([[0.0], a * place]) + rng.normal(0.0, white, 3) * [0, 1, 1],
+                                np.zeros(3)])
+            plain.x[3:] = biased.x[3:] = 0.0  # a still ball: no velocity to learn
+            plain.update(z, R + np.diag([0, a * a, a * a, 0, 0, 0]) / 50.0, rot, eye)
+            biased.update(z, R, rot, eye, bias=(0.0 if k == 0 else 1.0, M))
+        if place[0] == 1.0:  # one place only: the plain filter is sure of the wrong position
+            assert math.sqrt(plain.P[1, 1]) < 0.005 and abs(plain.x[1] - true[1]) > 0.015
+            assert math.sqrt(biased.P[1, 1]) > 0.5 * a
+    # two places: the bias filter's error is within its own 2 std on both lateral axes
+    err = biased.x[1:3] - true[1:3]
+    assert np.all(np.abs(err) < 2.0 * np.sqrt(np.diag(biased.P)[1:3]))
+    assert biased.x.shape == (6,) and biased.P.shape == (6, 6) and biased.xa.shape == (8,)
+    with pytest.raises(ValueError, match="rho"):
+        biased.update(z, R, rot, eye, bias=(1.5, M))

@@ -129,7 +129,7 @@ class BallKalmanFilter:
         """Eq. 12-14: the posterior of (x, P) given innovation ``y`` with covariance ``S``."""
         K = np.linalg.solve(S.T, (P @ H.T).T).T  # Eq. 12: P H^T S^-1
         x = x + K @ y  # Eq. 13
-        P = (np.eye(6) - K @ H) @ P  # Eq. 14
+        P = (np.eye(len(x)) - K @ H) @ P  # Eq. 14
         return x, 0.5 * (P + P.T)
 
     def extrapolate(self, horizon_s: float) -> tuple[np.ndarray, np.ndarray]:
@@ -141,3 +141,92 @@ class BallKalmanFilter:
         """Mean positions at ``times`` (s from now), shape (len(times), 3)."""
         t = np.asarray(times, dtype=float)[:, None]
         return self.x[:3] + self.x[3:] * t + 0.5 * GRAVITY * t * t
+
+
+class RetinalBiasFilter(BallKalmanFilter):
+    """:class:`BallKalmanFilter` with a **retinal-bias state** for an eye with the positional disarray
+    (``vision/periphery.py``, mechanism 5): the augmented state ``(p, p_dot, g)`` adds ``g``, the two
+    unit-variance values of the disarray field (:class:`~visuomotor_gym.vision.periphery.DisarrayField`)
+    at the ball's retinal place. A sample's lateral position error is ``s sqrt(w) g`` (fixed in retinal
+    place) plus white noise of std ``s sqrt(1 - w)`` (``s`` the lateral std, ``w`` the disarray's share):
+    the caller passes ``bias=(rho, M)`` to :meth:`update`, ``M`` (6 x 2) the map of ``g`` into the sample
+    (eye frame) and ``rho`` the field's correlation between the last fused sample's retinal place and
+    this one's (1: the same place, 0: independent, as after a saccade); between samples
+    ``g <- rho g + sqrt(1 - rho^2) xi``, ``xi ~ N(0, I)`` (the field's prior). So a bias that stays with
+    the ball's retinal place is not read as motion or depth, and a saccade that moves the ball to
+    another place re-draws it.
+
+    ``x`` and ``P`` are the ball's part (views of the augmented ``xa``, ``Pa``): every reader of the
+    6-D filter reads them unchanged. Assigning ``x`` sets the ball's mean; assigning ``P`` starts a new
+    prior (the bias forgotten: mean 0, covariance I, uncorrelated with the ball).
+    """
+
+    BIAS_DIM = 2
+
+    @property
+    def x(self) -> np.ndarray:
+        return self.xa[:6]
+
+    @x.setter
+    def x(self, value) -> None:
+        if not hasattr(self, "xa"):
+            self.xa = np.zeros(6 + self.BIAS_DIM)
+        self.xa[:6] = value
+
+    @property
+    def P(self) -> np.ndarray:
+        return self.Pa[:6, :6]
+
+    @P.setter
+    def P(self, value) -> None:
+        if not hasattr(self, "Pa"):
+            self.Pa = np.eye(6 + self.BIAS_DIM)
+        self.Pa[:6, :6] = value
+        self.Pa[:6, 6:] = 0.0
+        self.Pa[6:, :6] = 0.0
+        self.Pa[6:, 6:] = np.eye(self.BIAS_DIM)
+        self.xa[6:] = 0.0
+
+    def predict(self) -> None:
+        """Eq. 8-9 on the ball's part; the bias is a property of the retinal place, unchanged."""
+        self.xa[:6] = self.F @ self.xa[:6] + self.b
+        Pa = self.Pa
+        Pa[:6, :6] = self.F @ Pa[:6, :6] @ self.F.T + self.Q
+        Pa[:6, 6:] = self.F @ Pa[:6, 6:]
+        Pa[6:, :6] = Pa[:6, 6:].T
+
+    def update(self, z: np.ndarray, R_meas: np.ndarray, rot: np.ndarray, pos: np.ndarray,
+               bias: tuple[float, np.ndarray] | None = None) -> float:
+        """Eq. 10-14 on the augmented state, with the adaptive reset. ``bias=(rho, M)``: see the class
+        docstring; None: the sample carries no bias (``M = 0``) and the place is unchanged."""
+        rho, M = (1.0, np.zeros((6, self.BIAS_DIM))) if bias is None else (float(bias[0]), np.asarray(bias[1]))
+        if not 0.0 <= rho <= 1.0:
+            raise ValueError(f"bias correlation rho must be in [0, 1], got {rho!r}")
+        if rho < 1.0:  # the ball moved to another retinal place: g <- rho g + sqrt(1 - rho^2) xi
+            self.xa[6:] *= rho
+            self.Pa[:, 6:] *= rho
+            self.Pa[6:, :] *= rho
+            self.Pa[6:, 6:] += np.eye(self.BIAS_DIM) * (1.0 - rho * rho)
+        H6, h = self.observation_model(rot, pos)
+        H = np.hstack([H6, M])
+        R_meas = R_meas + np.eye(6) * self.params.measurement_floor_m**2
+        y = z - H @ self.xa - h  # Eq. 10
+        S = H @ self.Pa @ H.T + R_meas  # Eq. 11
+        maha = float(y @ np.linalg.solve(S, y))
+        confident = float(np.trace(self.Pa[:3, :3])) < 3.0 * self.params.reset_when_position_std_below_m**2
+        abnormal = self.initialised and confident and maha > self.params.reset_mahalanobis
+        self.abnormal_run = self.abnormal_run + 1 if abnormal else 0
+        if abnormal and self.abnormal_run < self.params.reset_after_abnormal_samples:
+            self.rejected += 1
+            self.last_mahalanobis = maha
+            return maha
+        if abnormal:
+            self.P = self._initial_covariance()  # the bias forgotten too
+            self.resets += 1
+            self.abnormal_run = 0
+            S = H @ self.Pa @ H.T + R_meas
+        self.xa, self.Pa = self.correct(self.xa, self.Pa, y, S, H)
+        self.initialised = True
+        self.last_mahalanobis = maha
+        self.last_S = S
+        return maha
