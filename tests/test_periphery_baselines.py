@@ -345,3 +345,29 @@ def test_retinal_bias_filter_reads_a_fixed_bias_as_a_place_not_a_motion():
     assert biased.x.shape == (6,) and biased.P.shape == (6, 6) and biased.xa.shape == (8,)
     with pytest.raises(ValueError, match="rho"):
         biased.update(z, R, rot, eye, bias=(1.5, M))
+
+
+def test_eyecatch_first_saccade_aims_half_a_pursuit_latency_further_ahead():
+    """Under the human periphery the first saccade's request is the believed ball saccade_lead_s +
+    pursuit_latency_s / 2 ahead (module docstring, 10); the agent without its periphery model aims
+    saccade_lead_s ahead."""
+    from visuomotor_gym.core.frames import SEAT_ORIGIN
+    from visuomotor_gym.envs.observation import ObservationLayout
+
+    s = ObservationLayout().slices
+    for spec, lead in (("eyecatch", 0.06 + 0.075), ("eyecatch:periphery_model=False", 0.06)):
+        env = gym.make("EyeCatch-v0", vision_params={**HUMAN, "position_disarray": 0.8})
+        policy = make_agent(spec, "EyeCatch-v0", int(env.action_space.shape[0]), seed=16)
+        match_vision(policy, env.unwrapped.vision_params)
+        agent = _inner(policy)
+        obs, _ = env.reset(seed=16)
+        for _ in range(40):
+            action = policy.predict(obs)[0]
+            if agent.saccade_requested:
+                break
+            obs, *_ = env.step(action)
+        env.close()
+        rot, eye = obs[s["eye_rot"]].reshape(3, 3), obs[s["eye_pos"]] + SEAT_ORIGIN
+        aimed = agent._retinal_angles(rot, eye, agent.filter.extrapolate(lead)[0])
+        np.testing.assert_allclose(np.asarray(action[4:6]) * 60.0 * DEG, aimed, atol=1e-6)
+        assert math.hypot(*aimed) > 3.0 * DEG  # beyond the plant's saccade threshold
