@@ -52,7 +52,8 @@ follows (docs/reproductions/gaze_default.md, "EyeCatch-v0 under the one eye"):
    eccentricity under the prior (``sqrt(theta_p^2 + 2 sigma_theta^2)``, not the sample's own direction,
    whose noise would make a foveal-looking sample look precise); the disparity pedestal as the RMS inverse-
    distance gap under the prior's depth variance; the retinal speed as the RMS under the prior's angular-
-   velocity variance.
+   velocity variance. Under a visual latency, with the vergence and the eye's rotation of the step the
+   sample was taken at (the sample of 0.1 s ago was not seen with today's vergence).
 7. **The first saccade at the saccadic latency** (0.18 s): with the throw expected, the estimate where the
    saccade would land is as good as a still eye can make it (the ball slips off the fovea at ~60 deg/s,
    where the position law leaves each look worth little).
@@ -337,6 +338,7 @@ class EyecatchAgent:
         self.hand: _Superposition | None = None
         self.head: _Superposition | None = None
         self.pose_history: list[tuple[np.ndarray, np.ndarray]] = []
+        self.look_history: list[tuple[np.ndarray, float]] = []  # (line of sight, vergence distance) per step
         self.prev_gaze = None
         self.prev_gaze_dir = None
         self.prev_in_saccade = True  # no pursuit measured before the first step
@@ -373,6 +375,9 @@ class EyecatchAgent:
         self.pose_history.append((rot.copy(), eye.copy()))
         if len(self.pose_history) > self.delay_steps + 1:
             self.pose_history.pop(0)
+        self.look_history.append((rot[:, 0].copy(), float(obs[_S["fixation"]][0])))
+        if len(self.look_history) > self.delay_steps + 2:
+            self.look_history.pop(0)
         if obs[_S["ball_visible"]][0] > 0.5:
             self._fuse(obs)
         self.prev_gaze = rot[:, 0].copy()
@@ -494,6 +499,10 @@ class EyecatchAgent:
         # underestimated noise locks in a wrong estimate; an overestimated one only slows learning).
         near = rot.T @ (self.filter.x[:3] - eye) if self.filter.initialised else z[:3]
         adapted = self.periphery_adapted and self.filter.initialised
+        look = max(0, len(self.look_history) - 1 - self.delay_steps)  # the step the sample was taken at
+        if adapted and self.delay_steps:  # the eye's own rotation when the (delayed) sample was taken
+            eye_turn = np.zeros(3) if look == 0 else \
+                rot.T @ (np.cross(self.look_history[look - 1][0], rot[:, 0]) / self.dt)
         if adapted:  # the RMS retinal speed under the prior (module docstring, 6)
             speed = self._expected_retinal_speed(near, vel, rot.T @ self.filter.P[3:, 3:] @ rot, eye_turn)
         else:
@@ -503,8 +512,8 @@ class EyecatchAgent:
         # VisionParams.depth_pedestal_arcmin (no effect without it)
         # dt: the positional disarray, if the eye has it, is sized for a stream of looks (no effect without)
         fixation = float(obs[_S["fixation"]][0])
-        if adapted:
-            fixation = self._pedestal_fixation(pos, fixation, eye)
+        if adapted:  # the vergence when the (delayed) sample was taken, and the RMS pedestal (docstring, 6)
+            fixation = self._pedestal_fixation(pos, self.look_history[look][1], eye)
         before = self.filter.resets
         if adapted and isinstance(self.filter, RetinalBiasFilter):
             R_meas, bias = self._disarray_model(pos, speed, fixation, rot, eye)
