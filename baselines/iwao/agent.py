@@ -163,7 +163,11 @@ class IwaoAgent:
         mine = {"vision_noise_scale": "noise_scale", "foveated": "foveated",
                 "position_slip_knee_deg_s": "position_slip_knee_deg_s"}
         vision = replace(vision, **{mine[k]: getattr(params, k) for k in overrides if k in mine})
-        return cls(params, vision=vision)
+        planner = None
+        if params.gaze_mode == "footholds" and _registered_layout(env_id) == "rows":
+            # Rows with gaps: the corridor through the nearest row's free interval (PlannerParams.rows).
+            planner = PlannerParams(fallback_sigmas=FOOTHOLDS_FALLBACK_SIGMAS, rows=True)
+        return cls(params, vision=vision, planner=planner)
 
     @property
     def vision(self) -> VisionParams:
@@ -465,22 +469,32 @@ class IwaoAgent:
 
 
 def _registered_course_is_rough(env_id: str) -> bool:
-    """Whether ``env_id`` is registered (in this process) with the rough course of ObstacleWalk."""
+    """Whether ``env_id`` is registered (in this process) with the rough course of ObstacleWalk or another
+    course with labelled slots (the rows with gaps)."""
+    from visuomotor_gym.tasks.obstacle_walk import ROUGH_LAYOUTS
+
+    return _registered_layout(env_id) in ROUGH_LAYOUTS
+
+
+def _registered_layout(env_id: str) -> str | None:
+    """The ``CourseDistribution.layout`` ``env_id`` is registered with (in this process), None when it is
+    not an ObstacleWalk id."""
     import gymnasium as gym
 
-    from visuomotor_gym.tasks.obstacle_walk import CourseDistribution
+    from visuomotor_gym.tasks.obstacle_walk import COURSE_PRESETS, CourseDistribution
 
     try:
-        course = (gym.spec(env_id).kwargs or {}).get("course_distribution")
+        spec = gym.spec(env_id)
     except gym.error.Error:
-        return False
+        return None
+    course = (spec.kwargs or {}).get("course_distribution")
+    if course is None:  # the env's default: the walkway course (ObstacleWalkEnv)
+        return "walkway" if str(spec.entry_point).endswith("envs.walk:ObstacleWalkEnv") else None
     if isinstance(course, str):
-        from visuomotor_gym.tasks.obstacle_walk import COURSE_PRESETS
-
-        return course in COURSE_PRESETS and COURSE_PRESETS[course].rough
+        return COURSE_PRESETS[course].layout if course in COURSE_PRESETS else None
     if isinstance(course, dict):
-        return course.get("layout") == "rough"
-    return isinstance(course, CourseDistribution) and course.rough
+        return course.get("layout", "walkway")
+    return course.layout if isinstance(course, CourseDistribution) else None
 
 
 def _fixation_action(distance: float) -> float:

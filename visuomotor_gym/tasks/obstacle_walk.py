@@ -44,6 +44,15 @@ the slots carry no hidden truth: an obstacle is sampled by the eye only within `
 pelvis, its slot id is a *label* given in the order the eye first saw it (never a course index), and the
 slots hold the labelled obstacles not yet passed, lowest label first: an obstacle that was never seen
 takes no slot and changes no id when it is passed.
+
+**Rows with gaps** (opt-in, ``course_distribution="rows"``: :data:`ROWS_COURSE`, a design probe for the
+moving-eye redefinition, not a default): every 2-2.6 m a row of two flat patches spans the walkway edge to
+edge, 60-70 cm deep (deeper than the planner's longest stride clears: one foot must land inside the row),
+with ONE gap 30-40 cm wide (about one and a half feet: a foothold that needs its place to a few cm)
+whose centre lies anywhere within 0.4 m of the centre line, drawn anew for every row: the walker
+must step through each gap. Sizes and spacings are modelling choices; labelled slots and the sight range
+as on the rough course. Measured: it does not need a moving eye (a fixed posture 30 deg down crosses as
+often as iwao; docs/reproductions/data/terrain/obstacle_walk.md, fifth session).
 """
 
 from __future__ import annotations
@@ -76,7 +85,8 @@ KINDS = ("bar", "box", "mat")
 BAR, BOX, MAT = 0, 1, 2
 REWARD_TERMS = ("finish", "trip", "misstep", "off_path", "progress")
 DEFAULT_REWARD_WEIGHTS = {"finish": 1.0, "trip": -1.0, "misstep": -1.0, "off_path": -1.0, "progress": 0.0}
-LAYOUTS = ("walkway", "rough")  # CourseDistribution.layout: today's course, the rough one (module docstring)
+LAYOUTS = ("walkway", "rough", "rows")  # CourseDistribution.layout: today's course, the rough one, rows with gaps
+ROUGH_LAYOUTS = ("rough", "rows")  # labelled slots and a sight range (module docstring)
 OBSTACLE_RGBA = {BAR: (0.80, 0.25, 0.20, 1.0), BOX: (0.85, 0.55, 0.15, 1.0), MAT: (0.08, 0.08, 0.08, 1.0)}
 
 
@@ -103,6 +113,10 @@ COURSE_RULES = {
     "rough_lateral_m": Pair(Num(-2.0, 2.0)),
     "rough_patch_m": Pair(Num(0.0, 5.0, low_open=True)),
     "sight_range_m": Num(0.5, 200.0),
+    "row_step_m": Pair(Num(0.05, 10.0)),
+    "row_depth_m": Pair(Num(0.0, 5.0, low_open=True)),
+    "row_gap_m": Pair(Num(0.0, 5.0, low_open=True)),
+    "row_gap_lateral_m": Pair(Num(-2.0, 2.0)),
 }
 
 
@@ -133,13 +147,26 @@ class CourseDistribution:
     rough_lateral_m: tuple[float, float] = (-0.5, 0.5)  # modelling choice: anywhere on the 1.5 m walkway
     rough_patch_m: tuple[float, float] = (0.2, 0.35)  # modelling choice: smaller than a step, ~a foot long
     sight_range_m: float = 5.0  # modelling choice: ~4 s of walking; beyond the 2-3 steps humans fixate
+    # Rows with gaps (layout="rows", opt-in, :func:`_sample_rows`): rows of flat patches spanning the
+    # walkway every row_step_m (near edge to near edge), each row_depth_m deep (deeper than a stride can
+    # clear with the planner's foot box: one foot must land inside the row) and split by ONE free gap
+    # row_gap_m wide whose centre lies row_gap_lateral_m from the centre line, drawn anew for every row.
+    # Modelling choices: a gap about one and a half foot wide, placed anywhere the walker's feet can reach;
+    # 2-2.6 m between rows so the scripted gait (at most ~0.36 m sideways per two steps) can line up with the
+    # next gap: with 1.4-1.8 m the planner with true footprints crossed 37/40 of seeds 0-39, with 1.2-1.5 m
+    # 21/40 (docs/reproductions/data/terrain/obstacle_walk.md, fifth session).
+    row_step_m: tuple[float, float] = (2.0, 2.6)
+    row_depth_m: tuple[float, float] = (0.6, 0.7)
+    row_gap_m: tuple[float, float] = (0.3, 0.4)
+    row_gap_lateral_m: tuple[float, float] = (-0.4, 0.4)
 
     def __post_init__(self) -> None:
         args.check_fields(self, COURSE_RULES)
 
     @property
     def rough(self) -> bool:
-        return self.layout == "rough"
+        """Labelled slots and a sight range (the rough course and the rows with gaps)."""
+        return self.layout in ROUGH_LAYOUTS
 
 
 # The opt-in rough course (module docstring): 12-14 m, the first hazard 2.5-3.5 m ahead, no bars,
@@ -156,7 +183,10 @@ ROUGH_COURSE = CourseDistribution(layout="rough", length_m=(12.0, 14.0), first_m
 # pool of 16 obstacles ends a quarter of these courses early (seeds 0-199: 26 %, the last hazard then
 # up to 1.25 m before the finish's clear zone). docs/reproductions/data/terrain/obstacle_walk.md.
 DENSE_ROUGH_COURSE = replace(ROUGH_COURSE, rough_step_m=(0.45, 0.8))
-COURSE_PRESETS = {"walkway": CourseDistribution(), "rough": ROUGH_COURSE, "rough_dense": DENSE_ROUGH_COURSE}
+# Rows with gaps (opt-in, preset "rows"): ROUGH_COURSE's length and start with the rows of _sample_rows.
+ROWS_COURSE = replace(ROUGH_COURSE, layout="rows")
+COURSE_PRESETS = {"walkway": CourseDistribution(), "rough": ROUGH_COURSE, "rough_dense": DENSE_ROUGH_COURSE,
+                  "rows": ROWS_COURSE}
 
 
 @dataclass(frozen=True)
@@ -169,6 +199,8 @@ def sample_course(rng: np.random.Generator, dist: CourseDistribution, max_obstac
     """One course: obstacles in path order, free gaps between them, none near the finish."""
     if not dist.walkway_width_m > 0.0:
         raise ValueError(f"course_distribution.walkway_width_m must be > 0 m, got {dist.walkway_width_m!r}")
+    if dist.layout == "rows":
+        return _sample_rows(rng, dist, max_obstacles)
     if dist.rough:
         return _sample_rough(rng, dist, max_obstacles)
     length = float(rng.uniform(*dist.length_m))
@@ -228,6 +260,30 @@ def _sample_rough(rng: np.random.Generator, dist: CourseDistribution, max_obstac
         rows.append((near + 0.5 * depth, y, depth, width, height, kind))
         near += float(rng.uniform(*dist.rough_step_m))
     rows.sort(key=lambda r: r[0] - 0.5 * r[2])  # path order of the near edges
+    return Course(length, np.array(rows, dtype=float).reshape(-1, 6))
+
+
+def _sample_rows(rng: np.random.Generator, dist: CourseDistribution, max_obstacles: int) -> Course:
+    """Rows with gaps (``layout="rows"``): every ``row_step_m`` a row of two flat patches (misstep)
+    spanning the walkway edge to edge, ``row_depth_m`` deep, with one gap ``row_gap_m`` wide between
+    them centred ``row_gap_lateral_m`` off the centre line. Two obstacles per row (the scene's pool
+    bounds the number of rows)."""
+    length = float(rng.uniform(*dist.length_m))
+    half = 0.5 * dist.walkway_width_m
+    rows: list[tuple] = []
+    near = float(rng.uniform(*dist.first_m))
+    while len(rows) + 2 <= max_obstacles:
+        depth = float(rng.uniform(*dist.row_depth_m))
+        gap = float(rng.uniform(*dist.row_gap_m))
+        g = float(rng.uniform(*dist.row_gap_lateral_m))
+        if near + depth > length - dist.finish_clear_m:
+            break
+        lo, hi = g - 0.5 * gap, g + 0.5 * gap
+        x = near + 0.5 * depth
+        for y0, y1 in ((-half, lo), (hi, half)):  # right of the gap, left of it (path order within the row)
+            if y1 - y0 > 1e-3:
+                rows.append((x, 0.5 * (y0 + y1), depth, y1 - y0, dist.mat_height_m, MAT))
+        near += float(rng.uniform(*dist.row_step_m))
     return Course(length, np.array(rows, dtype=float).reshape(-1, 6))
 
 
