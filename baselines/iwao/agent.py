@@ -34,7 +34,7 @@ from visuomotor_gym.vision.foveation import VisionParams
 
 from .gaze import DEG, IwaoGazeParams, peak_angles, pitch_at
 from .perception import ObstacleMemory, eye_motion
-from .planner import FootstepPlanner, PlannerParams
+from .planner import HALF_WIDTH_M, HEEL_M, TOE_M, FootstepPlanner, PlannerParams
 
 _S = WALK_LAYOUT.slices
 # Where the blocks the agent reads start in the flat observation (read from a list of floats each step).
@@ -55,6 +55,11 @@ FOOTHOLDS_PLAN_MAX_SD_M = 0.1
 # With gaze_mode="footholds", when no foothold is clear of the 2-std zones, the planner tries 1 std, then
 # the estimates themselves (PlannerParams.fallback_sigmas; modelling choice), before the blind nominal step.
 FOOTHOLDS_FALLBACK_SIGMAS = (1.0, 0.0)
+# On the winding walkway the planner's lateral margin (PlannerParams.lateral_margin_m, 4 cm) is widened to this: the
+# feet point along the pelvis's yaw, which in a turn lags the foothold's heading (TurningGait: by up to ~40 % of the
+# step's turn at landing) and the foothold's heading is the step's chord (_winding_footstep), so a 20 cm toe swings
+# a few cm across the path (modelling choice; WINDING_MARGIN_M env var for probes).
+WINDING_LATERAL_MARGIN_M = float(__import__("os").environ.get("WINDING_MARGIN_M", "0.06"))
 NECK_PITCH_DOWN_DEG = 50.0  # the head action's -1 (envs_assets/common/head_eye.xml: neck_pitch -50 .. 40)
 
 
@@ -178,6 +183,8 @@ class IwaoAgent:
         planner = None
         if "winding" not in overrides and _registered_layout(env_id) == "winding":
             params = replace(params, winding=True)
+        if params.gaze_mode == "footholds" and params.winding:
+            planner = PlannerParams(fallback_sigmas=FOOTHOLDS_FALLBACK_SIGMAS, lateral_margin_m=WINDING_LATERAL_MARGIN_M)
         if params.gaze_mode == "footholds" and _registered_layout(env_id) == "rows":
             # Rows with gaps: the corridor through the nearest row's free interval (PlannerParams.rows).
             planner = PlannerParams(fallback_sigmas=FOOTHOLDS_FALLBACK_SIGMAS, rows=True)
@@ -295,27 +302,47 @@ class IwaoAgent:
                      for o in ahead]
         length, lateral, clearance = self.planner.plan(footholds, ahead)
         if self.path is not None:
-            return self._winding_footstep(obs, odo, footholds, world, length, lateral, clearance)
+            return self._winding_footstep(obs, odo, footholds, world, length, lateral, clearance, ahead)
         return WalkerBody.action_from_footstep(length, lateral, clearance, self.gait)
 
-    def _winding_footstep(self, obs, odo, footholds, world, length, lateral, clearance) -> list[float]:
+    def _winding_footstep(self, obs, odo, footholds, world, length, lateral, clearance, ahead) -> list[float]:
         """The turning footstep that puts the planned foothold (``length``, ``lateral`` from the last one in
-        path coordinates) on the walkway: its heading the path's there, its length and lateral offset in that
-        heading's frame from the last foothold (TurningGait.place_foothold inverted)."""
+        path coordinates) on the walkway (TurningGait.place_foothold inverted). Its heading is the path's
+        halfway between the last foothold and the new one, the direction of the step's chord: in that frame
+        the step's lateral offset is the change of the path coordinate n, so the gait's minimum step width
+        holds where the planner's rule holds (with the heading at the new foothold, a step along a 20 deg/m
+        arc would lie ~12 cm across its own frame and be clamped to the other side; modelling choice: the
+        foot then points within half a step's turn of the path). The toe clearance is raised for any zone
+        under the swing's straight world path, which cuts the inside of a turn (:meth:`_swing_clearance`)."""
         g = self.gait
         u_b, v_b, side_b = footholds[-1]
         side = 1 - int(side_b)
         sign = 1.0 if side == 0 else -1.0
         v1 = v_b + sign * max(g.step_width_m + sign * lateral, g.min_step_width_m)
         wx, wy = self.path.to_world(u_b + length, v1)
-        h = self.path.heading_at(u_b + length)
+        h = self.path.heading_at(u_b + 0.5 * length)
         h_last = odo[2] + float(obs[_SW["foothold_headings"].stop - 1])
         c, s_ = math.cos(h), math.sin(h)
         dx, dy = wx - world[-1][0], wy - world[-1][1]
         step, width = c * dx + s_ * dy, -s_ * dx + c * dy
         turn = math.remainder(h - h_last, 2.0 * math.pi)
+        clearance = max(clearance, self._swing_clearance(world[-2][:2], (wx, wy), ahead))
         return (WalkerBody.action_from_footstep(step, width - sign * g.step_width_m, clearance, g)
                 + [TurningWalkerBody.action_from_turn(turn, g)])
+
+    def _swing_clearance(self, start, end, ahead) -> float:
+        """The planner's clearance rule (the highest keep-out zone under the swing plus a margin) along the
+        swing's straight path in the world, sampled at 11 points taken into path coordinates."""
+        arr, _ = self.planner._zones(ahead)
+        c = 0.0
+        if len(arr) == 0:
+            return c
+        pts = [self.path.project(start[0] + t * (end[0] - start[0]), start[1] + t * (end[1] - start[1]))[:2]
+               for t in np.linspace(0.0, 1.0, 11).tolist()]
+        for x0, x1, y0, y1, hz in arr.tolist():
+            if any(x0 - TOE_M < ps < x1 + HEEL_M and y0 - HALF_WIDTH_M < pn < y1 + HALF_WIDTH_M for ps, pn in pts):
+                c = max(c, hz + self.planner.p.clearance_margin_m)
+        return min(c, self.gait.clearance_range_m[1])
 
     # --- gaze (Iwao Eq. 1-10) -----------------------------------------------------------------
     def _choose_target(self, obs: np.ndarray, pose):
