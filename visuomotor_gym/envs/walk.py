@@ -191,7 +191,9 @@ class ObstacleWalkEnv(WalkerEnv):
         "course_distribution": ('``CourseDistribution``, dict, or a preset name: ``"walkway"`` (the default) or '
                                 '``"rough"`` (``ROUGH_COURSE``: small hazards on most footholds, opt-in) or ``"rough_dense"`` '
                                 '(``DENSE_ROUGH_COURSE``: the same, a hazard every 0.45-0.8 m, opt-in) or ``"rows"`` '
-                                '(``ROWS_COURSE``: rows of patches across the walkway, one gap each, opt-in)'),
+                                '(``ROWS_COURSE``: rows of patches across the walkway, one gap each, opt-in) or ``"winding"`` '
+                                '(``WINDING_COURSE``: the rough course on a walkway that turns left and right, the turning '
+                                'walker (9 actions) and the centre line ahead (``path_ahead``), opt-in)'),
         "vision": ('``"foveated"``, ``"full_view"`` (foveal noise everywhere, no field-of-view limit, no saccadic '
                    'blindness) or ``"oracle"`` (true corners)'),
         "vision_params": ("``VisionParams`` or a dict of its fields; the default is the catch family's except "

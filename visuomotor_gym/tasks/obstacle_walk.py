@@ -53,6 +53,25 @@ whose centre lies anywhere within 0.4 m of the centre line, drawn anew for every
 must step through each gap. Sizes and spacings are modelling choices; labelled slots and the sight range
 as on the rough course. Measured: it does not need a moving eye (a fixed posture 30 deg down crosses as
 often as iwao; docs/reproductions/data/terrain/obstacle_walk.md, fifth session).
+
+**The winding walkway** (opt-in, ``course_distribution="winding"``: :data:`WINDING_COURSE`, a design probe for
+the moving-eye redefinition): the rough course's hazards laid in *path coordinates* (``s`` along the centre
+line, ``n`` across it, each obstacle turned to the path's heading at its centre) on a walkway whose centre
+line runs 2 m straight from the start, then alternates arcs (25-50 deg of heading over 2-3.5 m, to the left
+or right at random, the heading kept within +-60 deg of the start's) and straights of 0.5-1.5 m
+(:func:`sample_path`). On a straight walkway a posture fixed in the body frame sweeps every hazard past its
+fovea 1-3 steps ahead (fifth session); in a turn the footholds 2-3 steps ahead (Matthis, Yates & Hayhoe
+2018) lie 10-30 deg off the body's heading, to a side that changes from turn to turn, and humans' gaze
+leads the turn by 0.2-1 s (Grasso et al. 1998; Imai et al. 2001). The walker is the turning walker of
+SteppingStones (``TurningWalkerBody``: a fourth footstep value, the turn, and the ``foothold_headings``
+block); off path, the finish, the slots and ``to_finish`` count along the centre line (the pelvis's arc
+length, a foothold's distance across it). The painted edges of the straight walkway cannot bend, so they
+are put away and the centre line ahead is *given* in a ``path_ahead`` block (13 points, 0-6 m ahead,
+pelvis frame): a shortcut until the walkway's edges are drawn as seen targets. The arcs' sizes are
+modelling choices within ALLSTEPS' +-30 deg per step (Xie et al. 2020) and the gait's 45 deg
+(``GaitParams.max_turn_deg``). On the curve the hazards keep their path-coordinate sizes (drawn apart by
+``ROUGH_CLEAR_M`` along ``s``; on the inside of the sharpest arcs, 0.6 m from the centre line, the world gap
+shrinks by about a quarter).
 """
 
 from __future__ import annotations
@@ -542,7 +561,12 @@ class ObstacleWalkTask(Task):
 
     # --- what the evaluator records ----------------------------------------------------------
     def trace_episode_fields(self) -> dict:
-        return {"course_length": float(self.course.length), "obstacles": self.course.obstacles.copy()}
+        out = {"course_length": float(self.course.length), "obstacles": self.course.obstacles.copy()}
+        path = self.course.path
+        if path is not None:  # the winding walkway: its centre line (x, y, heading) and the obstacles along it
+            out["path"] = np.column_stack((path.xy, path.heading))
+            out["obstacles_path"] = self.course.local.copy()
+        return out
 
     @staticmethod
     def trace_final_fields(info: dict) -> dict:
