@@ -152,3 +152,34 @@ def test_the_planner_with_true_footprints_walks_a_winding_course():
         assert info["is_success"] and not info["off_path"]
         assert np.hypot(*(info["pelvis_pos"][:2] - np.array(end))) < 0.8  # at the finish, not on a straight line
         env.close()
+
+
+def test_walk_realism_reads_the_winding_walkway_in_path_coordinates():
+    from types import SimpleNamespace
+
+    from visuomotor_gym.metrics.walk_realism import distance_left, on_walkway
+
+    # The centre line turns 90 deg left on a 2 m arc after 1 m straight (as in test_path_coordinates_by_hand).
+    s = np.arange(0.0, 8.0 + 1e-9, PATH_DS_M)
+    h = np.clip((s - 1.0) / 2.0, 0.0, 0.5 * math.pi)
+    xy = np.zeros((len(s), 2))
+    mid = h[:-1] + 0.5 * np.diff(h)
+    xy[1:, 0] = np.cumsum(np.cos(mid) * PATH_DS_M)
+    xy[1:, 1] = np.cumsum(np.sin(mid) * PATH_DS_M)
+    path = WindingPath(xy, h)
+    eye = np.array([[*path.to_world(2.0, 0.0), 1.6]])
+    ground = np.array(path.to_world(4.5, 0.1))  # on the walkway 2.5 m further along it, 1.5 m beside the x axis
+    d = np.array([*(ground - eye[0, :2]), -1.6])
+    trace = SimpleNamespace(eye_pos=eye, gaze_dir=d[None] / np.linalg.norm(d), obstacles=np.zeros((0, 6)),
+                            obstacles_path=np.zeros((0, 6)), course_length=10.0,
+                            pelvis_pos=np.array([[*path.to_world(7.0, 0.0), 0.9]]),
+                            task={"path": np.column_stack((path.xy, path.heading))})
+    assert abs(ground[1]) > 1.0 and on_walkway(trace).tolist() == [True]
+    assert distance_left(trace) == pytest.approx(3.0, abs=0.02)
+    off = np.array(path.to_world(4.5, 1.2))  # beside the walkway
+    d = np.array([*(off - eye[0, :2]), -1.6])
+    trace.gaze_dir = d[None] / np.linalg.norm(d)
+    assert on_walkway(trace).tolist() == [False]
+    trace.task = {}  # the straight walkway's reading: the arc's point lies 1.5 m beside y = 0
+    trace.gaze_dir = np.array([[*(ground - eye[0, :2]), -1.6]]) / np.linalg.norm([*(ground - eye[0, :2]), -1.6])
+    assert on_walkway(trace).tolist() == [False]
