@@ -25,8 +25,8 @@ import numpy as np
 from visuomotor_gym.baselines.crowding import crowded
 
 from visuomotor_gym.body.walker import GaitParams
-from visuomotor_gym.body.walker_body import WalkerBody
-from visuomotor_gym.envs.walk import WALK_LAYOUT
+from visuomotor_gym.body.walker_body import TurningWalkerBody, WalkerBody
+from visuomotor_gym.envs.walk import WALK_LAYOUT, WINDING_LAYOUT
 from visuomotor_gym.oculomotor.plant import OculomotorParams
 from visuomotor_gym.registration import env_vision, env_vision_params
 from visuomotor_gym.tasks.obstacle_walk import K_SLOTS, N_POINTS
@@ -34,7 +34,7 @@ from visuomotor_gym.vision.foveation import VisionParams
 
 from .gaze import DEG, IwaoGazeParams, peak_angles, pitch_at
 from .perception import ObstacleMemory, eye_motion
-from .planner import FootstepPlanner, PlannerParams
+from .planner import HALF_WIDTH_M, HEEL_M, TOE_M, FootstepPlanner, PlannerParams
 
 _S = WALK_LAYOUT.slices
 # Where the blocks the agent reads start in the flat observation (read from a list of floats each step).
@@ -44,6 +44,10 @@ _FIXATION = _S["fixation"].start  # the eye's vergence distance (m): propriocept
 _LOG_FIX = tuple(math.log(x) for x in OculomotorParams().fixation_range_m)
 _GAIT_PHASE, _FOOTHOLDS, _TIME = _S["gait_phase"].start, _S["footholds"].start, _S["time"].start
 _SLOTS = tuple(_S[f"obstacle_{k}"].start for k in range(K_SLOTS))
+# The winding walkway (course layout "winding"): the same blocks up to the footholds; odometry and time after the
+# turning walker's foothold_headings; the centre line ahead last.
+_SW = WINDING_LAYOUT.slices
+assert all(_SW[b].start == _S[b].start for b in ("eye_pos", "eye_rot", "fixation", "gait_phase", "pelvis", "footholds"))
 # With gaze_mode="footholds" the planner sees an obstacle's footprint std capped at this (m): a far, crowded
 # glimpse (its keep-out zone grown by 2 std would close the walkway) keeps a zone of its estimate's size plus
 # 2 caps; the gaze fixates it before a foothold near it is chosen (modelling choice).
@@ -51,6 +55,11 @@ FOOTHOLDS_PLAN_MAX_SD_M = 0.1
 # With gaze_mode="footholds", when no foothold is clear of the 2-std zones, the planner tries 1 std, then
 # the estimates themselves (PlannerParams.fallback_sigmas; modelling choice), before the blind nominal step.
 FOOTHOLDS_FALLBACK_SIGMAS = (1.0, 0.0)
+# On the winding walkway the planner's lateral margin (PlannerParams.lateral_margin_m, 4 cm) is widened to this: the
+# feet point along the pelvis's yaw, which in a turn lags the foothold's heading (TurningGait: by up to ~40 % of the
+# step's turn at landing) and the foothold's heading is the step's chord (_winding_footstep), so a 20 cm toe swings
+# a few cm across the path (modelling choice; WINDING_MARGIN_M env var for probes).
+WINDING_LATERAL_MARGIN_M = float(__import__("os").environ.get("WINDING_MARGIN_M", "0.06"))
 NECK_PITCH_DOWN_DEG = 50.0  # the head action's -1 (envs_assets/common/head_eye.xml: neck_pitch -50 .. 40)
 
 
@@ -120,6 +129,11 @@ class IwaoParams:
     # choice: 2 (rough course, human periphery, seeds 0-39: 38/40 against 36/40 without, 1.5: 31/40; seeds
     # 40-79: 36/40).
     sample_gate: float | None = 2.0
+    # The winding walkway (tasks.obstacle_walk: layout "winding"; set by ``for_env``): the observation has
+    # the turning walker's blocks and the centre line ahead (path_ahead); the planner and the choice of
+    # fixation work in path coordinates (along / across the centre line), the footstep turns each foothold
+    # to the path's heading there.
+    winding: bool = False
 
 
 class IwaoAgent:
@@ -142,6 +156,9 @@ class IwaoAgent:
         self.gaze_range = p.gaze_action_range_deg * DEG
         self.period_steps = round(self.gait.step_s / p.control_dt)
         self.lead_steps = min(round(p.pursuit_lead_s / p.control_dt), self.period_steps)
+        layout = WINDING_LAYOUT if p.winding else WALK_LAYOUT
+        self.layout = layout
+        self._odometry, self._time = layout.slices["odometry"].start, layout.slices["time"].start
         self.reset()
 
     @classmethod
@@ -163,7 +180,15 @@ class IwaoAgent:
         mine = {"vision_noise_scale": "noise_scale", "foveated": "foveated",
                 "position_slip_knee_deg_s": "position_slip_knee_deg_s"}
         vision = replace(vision, **{mine[k]: getattr(params, k) for k in overrides if k in mine})
-        return cls(params, vision=vision)
+        planner = None
+        if "winding" not in overrides and _registered_layout(env_id) == "winding":
+            params = replace(params, winding=True)
+        if params.gaze_mode == "footholds" and params.winding:
+            planner = PlannerParams(fallback_sigmas=FOOTHOLDS_FALLBACK_SIGMAS, lateral_margin_m=WINDING_LATERAL_MARGIN_M)
+        if params.gaze_mode == "footholds" and _registered_layout(env_id) == "rows":
+            # Rows with gaps: the corridor through the nearest row's free interval (PlannerParams.rows).
+            planner = PlannerParams(fallback_sigmas=FOOTHOLDS_FALLBACK_SIGMAS, rows=True)
+        return cls(params, vision=vision, planner=planner)
 
     @property
     def vision(self) -> VisionParams:
@@ -191,12 +216,16 @@ class IwaoAgent:
         self.footstep = WalkerBody.action_from_footstep(self.gait.nominal_step_m, 0.0, self.gait.nominal_clearance_m,
                                                         self.gait)
         self.log: list[tuple] = []  # (time, target id, theta_H, theta_E) per step, for plots
+        self.path = AgentPath() if self.params.winding else None  # the winding walkway's centre line, path frame
+        self.memory.to_path = None if self.path is None else self.path.project
+        if self.path is not None:
+            self.footstep = self.footstep + [0.0]
 
     # ------------------------------------------------------------------------------------------
     def predict(self, observation, state=None, episode_start=None, deterministic=True):
         obs = np.asarray(observation, dtype=float)
-        if obs.shape != (WALK_LAYOUT.size,):
-            raise ValueError(f"IwaoAgent expects the flat ObstacleWalk observation of size {WALK_LAYOUT.size}, "
+        if obs.shape != (self.layout.size,):
+            raise ValueError(f"IwaoAgent expects the flat ObstacleWalk observation of size {self.layout.size}, "
                              f"got shape {obs.shape}")
         if episode_start is not None and bool(np.asarray(episode_start).reshape(-1)[0]) and self.started:
             self.reset()
@@ -205,10 +234,13 @@ class IwaoAgent:
 
     def _act(self, obs: np.ndarray) -> np.ndarray:
         ol = obs.tolist()
-        e0, r0, o0, p0 = _EYE_POS, _EYE_ROT, _ODOMETRY, _PELVIS
+        e0, r0, o0, p0 = _EYE_POS, _EYE_ROT, self._odometry, _PELVIS
         eye_pos = ol[e0:e0 + 3]
         rot = [ol[r0:r0 + 3], ol[r0 + 3:r0 + 6], ol[r0 + 6:r0 + 9]]
         odo = ol[o0:o0 + 3]
+        if self.path is not None:
+            b = _SW["path_ahead"]
+            self.path.update(ol[b.start:b.stop], odo)
         pose = (eye_pos, rot, (odo[0], odo[1], odo[2], ol[p0]))
         self.poses.append(pose)
         if len(self.poses) > self.delay_steps + 1:
@@ -259,6 +291,9 @@ class IwaoAgent:
 
     def _plan(self, obs: np.ndarray, odo) -> list[float]:
         footholds = self._footholds(obs, odo)
+        if self.path is not None:
+            world = footholds
+            footholds = [(*self.path.project(x, y)[:2], side) for x, y, side in world]
         u_last = footholds[-1][0]
         ahead = [o for o in self.memory.known() if o.x1 > footholds[0][0] - 0.3 and o.x0 < u_last + 6.0]
         if self.params.gaze_mode == "footholds":
@@ -266,7 +301,48 @@ class IwaoAgent:
             ahead = [o if max(o.sx, o.sy, o.sz) <= cap else replace(o, sx=min(o.sx, cap), sy=min(o.sy, cap), sz=min(o.sz, cap))
                      for o in ahead]
         length, lateral, clearance = self.planner.plan(footholds, ahead)
+        if self.path is not None:
+            return self._winding_footstep(obs, odo, footholds, world, length, lateral, clearance, ahead)
         return WalkerBody.action_from_footstep(length, lateral, clearance, self.gait)
+
+    def _winding_footstep(self, obs, odo, footholds, world, length, lateral, clearance, ahead) -> list[float]:
+        """The turning footstep that puts the planned foothold (``length``, ``lateral`` from the last one in
+        path coordinates) on the walkway (TurningGait.place_foothold inverted). Its heading is the path's
+        halfway between the last foothold and the new one, the direction of the step's chord: in that frame
+        the step's lateral offset is the change of the path coordinate n, so the gait's minimum step width
+        holds where the planner's rule holds (with the heading at the new foothold, a step along a 20 deg/m
+        arc would lie ~12 cm across its own frame and be clamped to the other side; modelling choice: the
+        foot then points within half a step's turn of the path). The toe clearance is raised for any zone
+        under the swing's straight world path, which cuts the inside of a turn (:meth:`_swing_clearance`)."""
+        g = self.gait
+        u_b, v_b, side_b = footholds[-1]
+        side = 1 - int(side_b)
+        sign = 1.0 if side == 0 else -1.0
+        v1 = v_b + sign * max(g.step_width_m + sign * lateral, g.min_step_width_m)
+        wx, wy = self.path.to_world(u_b + length, v1)
+        h = self.path.heading_at(u_b + 0.5 * length)
+        h_last = odo[2] + float(obs[_SW["foothold_headings"].stop - 1])
+        c, s_ = math.cos(h), math.sin(h)
+        dx, dy = wx - world[-1][0], wy - world[-1][1]
+        step, width = c * dx + s_ * dy, -s_ * dx + c * dy
+        turn = math.remainder(h - h_last, 2.0 * math.pi)
+        clearance = max(clearance, self._swing_clearance(world[-2][:2], (wx, wy), ahead))
+        return (WalkerBody.action_from_footstep(step, width - sign * g.step_width_m, clearance, g)
+                + [TurningWalkerBody.action_from_turn(turn, g)])
+
+    def _swing_clearance(self, start, end, ahead) -> float:
+        """The planner's clearance rule (the highest keep-out zone under the swing plus a margin) along the
+        swing's straight path in the world, sampled at 11 points taken into path coordinates."""
+        arr, _ = self.planner._zones(ahead)
+        c = 0.0
+        if len(arr) == 0:
+            return c
+        pts = [self.path.project(start[0] + t * (end[0] - start[0]), start[1] + t * (end[1] - start[1]))[:2]
+               for t in np.linspace(0.0, 1.0, 11).tolist()]
+        for x0, x1, y0, y1, hz in arr.tolist():
+            if any(x0 - TOE_M < ps < x1 + HEEL_M and y0 - HALF_WIDTH_M < pn < y1 + HALF_WIDTH_M for ps, pn in pts):
+                c = max(c, hz + self.planner.p.clearance_margin_m)
+        return min(c, self.gait.clearance_range_m[1])
 
     # --- gaze (Iwao Eq. 1-10) -----------------------------------------------------------------
     def _choose_target(self, obs: np.ndarray, pose):
@@ -292,6 +368,9 @@ class IwaoAgent:
         of that foothold, on the centre line."""
         p = self.params
         footholds = self._footholds(obs, pose[2])
+        path = self.path
+        if path is not None:
+            footholds = [(*path.project(x, y)[:2], side) for x, y, side in footholds]
         u_last = footholds[-1][0]
         step = self.gait.nominal_step_m
         reach = u_last + p.foothold_look_steps * step
@@ -310,6 +389,8 @@ class IwaoAgent:
                 if not seen:
                     continue
                 centre = tuple(float(c) for c in seen[0])
+                if path is not None:
+                    centre = (*path.project(centre[0], centre[1])[:2], centre[2])
                 if centre[0] <= u_last or centre[0] > reach:
                     continue
                 sd = math.inf
@@ -317,12 +398,15 @@ class IwaoAgent:
                 unsure, unsure_sd = (centre, index), sd
             elif o is not None and o.x0 >= u_last + p.foothold_ahead_steps * step:
                 sure.append((self.fix_count.get(index, 0), centre[0], centre, index))
-        if unsure is not None:
-            return unsure
-        if sure:
+        if sure and unsure is None:
             _, _, centre, index = min(sure)
-            return centre, index
-        return (u_last + p.foothold_travel_steps * step, 0.0, 0.0), -1
+            unsure = centre, index
+        if unsure is None:
+            unsure = (u_last + p.foothold_travel_steps * step, 0.0, 0.0), -1
+        if path is not None:  # path coordinates to the path frame
+            (cs, cn, cz), index = unsure
+            return (*path.to_world(cs, cn), cz), index
+        return unsure
 
     def _look_footholds(self, obs: np.ndarray, phase: float, pose) -> list:
         """The rough course's gaze (``gaze_mode="footholds"``): at each step's start a saccade to
@@ -354,7 +438,7 @@ class IwaoAgent:
         az, el = _angles(fx - ex, fy - ey, fz - ez)
         a = self.gaze_params.alpha
         head = max(-el, 0.0) * a / (1.0 + a)
-        self.log.append((float(obs[_TIME]), self.target_id, head, max(-el, 0.0) - head))
+        self.log.append((float(obs[self._time]), self.target_id, head, max(-el, 0.0) - head))
         ce = math.cos(el)
         wx, wy, wz = ce * math.cos(az), ce * math.sin(az), math.sin(el)
         return self._gaze_request(wx, wy, wz, odo, rot, (ex, ey, ez), head, True)
@@ -408,7 +492,7 @@ class IwaoAgent:
         ex, ey, ez = _eye_in_path(pose)[0]
         sigma = gp.sigma_fraction * T
         fixating = abs(t - 0.5 * T) <= self.params.fixation_window_sigma * sigma
-        self.log.append((float(obs[_TIME]), self.target_id, head, eye))
+        self.log.append((float(obs[self._time]), self.target_id, head, eye))
         self.eye_history.append((ex, ey, ez))
         n = len(self.eye_history)
         if n > self.period_steps + 1:
@@ -464,23 +548,114 @@ class IwaoAgent:
                 min(max(-head / (NECK_PITCH_DOWN_DEG * DEG), -1.0), 0.0)]
 
 
+class AgentPath:
+    """The winding walkway's centre line as the agent has been shown it (the ``path_ahead`` block), in the
+    path frame (odometry): points about every ``AgentPath.SPACING_M`` or more, extended as they come into
+    view; path coordinates ``(s, n)`` from the first point."""
+
+    SPACING_M = 0.1
+
+    def __init__(self) -> None:
+        self.pts: list[tuple[float, float]] = []
+        self._arrays = None
+
+    def update(self, block: list, odo) -> None:
+        """Add the points of a ``path_ahead`` block (pelvis frame; ``odo`` the odometry): beyond the last
+        point kept, or between two kept points at least ``SPACING_M`` from both (the first block's 0.5 m
+        spacing is filled in as the walker moves on)."""
+        c, s = math.cos(odo[2]), math.sin(odo[2])
+        world = [(odo[0] + c * block[2 * k] - s * block[2 * k + 1], odo[1] + s * block[2 * k] + c * block[2 * k + 1])
+                 for k in range(len(block) // 2)]
+        if self._arrays is None:
+            self.pts = world
+            self._rebuild()
+            return
+        s0 = self._arrays[3]
+        inserts = []
+        for x, y in world:
+            sp, n, _ = self.project(x, y)
+            if abs(n) > 0.05:  # not on the kept line (a kink's far side): left out
+                continue
+            if sp > s0[-1] + self.SPACING_M:
+                inserts.append((sp, x, y))
+            elif sp > s0[0]:
+                i = int(np.searchsorted(s0, sp))
+                if sp - s0[i - 1] >= self.SPACING_M and s0[i] - sp >= self.SPACING_M:
+                    inserts.append((sp, x, y))
+        if not inserts:
+            return
+        keyed = [(float(v), pt) for v, pt in zip(s0.tolist(), self.pts)] + [(sp, (x, y)) for sp, x, y in inserts]
+        keyed.sort(key=lambda e: e[0])
+        self.pts = [pt for _, pt in keyed]
+        self._rebuild()
+
+    def _rebuild(self) -> None:
+        xy = np.array(self.pts, dtype=float)
+        seg = np.diff(xy, axis=0)
+        seg_len = np.maximum(np.hypot(seg[:, 0], seg[:, 1]), 1e-9)
+        s0 = np.concatenate(([0.0], np.cumsum(seg_len)))
+        self._arrays = (xy, seg / seg_len[:, None], seg_len, s0)
+
+    def project(self, x: float, y: float) -> tuple[float, float, float]:
+        """``(s, n, heading)`` of the path-frame point (x, y): its nearest point on the polyline."""
+        xy, t, seg_len, s0 = self._arrays
+        d = np.array([x, y]) - xy[:-1]
+        a = np.clip(np.einsum("ij,ij->i", d, t), 0.0, seg_len)
+        px = d[:, 0] - a * t[:, 0]
+        py = d[:, 1] - a * t[:, 1]
+        i = int(np.argmin(px * px + py * py))
+        if i == len(seg_len) - 1:  # beyond the end: along the last segment
+            a_i = float(d[i, 0] * t[i, 0] + d[i, 1] * t[i, 1])
+        elif i == 0:
+            a_i = float(d[0, 0] * t[0, 0] + d[0, 1] * t[0, 1])
+        else:
+            a_i = float(a[i])
+        n = float(-t[i, 1] * d[i, 0] + t[i, 0] * d[i, 1])
+        return float(s0[i] + a_i), n, math.atan2(t[i, 1], t[i, 0])
+
+    def _seg(self, s: float) -> int:
+        _, _, _, s0 = self._arrays
+        return int(min(max(np.searchsorted(s0, s, side="right") - 1, 0), len(s0) - 2))
+
+    def heading_at(self, s: float) -> float:
+        xy, t, _, _ = self._arrays
+        i = self._seg(s)
+        return math.atan2(t[i, 1], t[i, 0])
+
+    def to_world(self, s: float, n: float) -> tuple[float, float]:
+        xy, t, _, s0 = self._arrays
+        i = self._seg(s)
+        a = s - s0[i]
+        return (float(xy[i, 0] + a * t[i, 0] - n * t[i, 1]), float(xy[i, 1] + a * t[i, 1] + n * t[i, 0]))
+
+
 def _registered_course_is_rough(env_id: str) -> bool:
-    """Whether ``env_id`` is registered (in this process) with the rough course of ObstacleWalk."""
+    """Whether ``env_id`` is registered (in this process) with the rough course of ObstacleWalk or another
+    course with labelled slots (the rows with gaps)."""
+    from visuomotor_gym.tasks.obstacle_walk import ROUGH_LAYOUTS
+
+    return _registered_layout(env_id) in ROUGH_LAYOUTS
+
+
+def _registered_layout(env_id: str) -> str | None:
+    """The ``CourseDistribution.layout`` ``env_id`` is registered with (in this process), None when it is
+    not an ObstacleWalk id."""
     import gymnasium as gym
 
-    from visuomotor_gym.tasks.obstacle_walk import CourseDistribution
+    from visuomotor_gym.tasks.obstacle_walk import COURSE_PRESETS, CourseDistribution
 
     try:
-        course = (gym.spec(env_id).kwargs or {}).get("course_distribution")
+        spec = gym.spec(env_id)
     except gym.error.Error:
-        return False
+        return None
+    course = (spec.kwargs or {}).get("course_distribution")
+    if course is None:  # the env's default: the walkway course (ObstacleWalkEnv)
+        return "walkway" if str(spec.entry_point).endswith("envs.walk:ObstacleWalkEnv") else None
     if isinstance(course, str):
-        from visuomotor_gym.tasks.obstacle_walk import COURSE_PRESETS
-
-        return course in COURSE_PRESETS and COURSE_PRESETS[course].rough
+        return COURSE_PRESETS[course].layout if course in COURSE_PRESETS else None
     if isinstance(course, dict):
-        return course.get("layout") == "rough"
-    return isinstance(course, CourseDistribution) and course.rough
+        return course.get("layout", "walkway")
+    return course.layout if isinstance(course, CourseDistribution) else None
 
 
 def _fixation_action(distance: float) -> float:

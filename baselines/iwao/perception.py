@@ -142,6 +142,17 @@ def _fused(estimates: list, axis: int) -> tuple[float, float]:
     return sum(wi * float(p[axis]) for wi, (p, _) in zip(w, estimates)) / total, math.sqrt(1.0 / total)
 
 
+def _in_path(estimate, to_path):
+    """A fused point ``(position, stds)`` of the path frame in path coordinates (s, n, z), its x and y stds
+    turned into the path's heading at the point (their covariance taken as diagonal)."""
+    pos, sd = estimate
+    s, n, h = to_path(float(pos[0]), float(pos[1]))
+    c2, s2 = math.cos(h) ** 2, math.sin(h) ** 2
+    vx, vy = float(sd[0]) ** 2, float(sd[1]) ** 2
+    return (np.array([s, n, float(pos[2])]),
+            np.array([math.sqrt(c2 * vx + s2 * vy), math.sqrt(s2 * vx + c2 * vy), float(sd[2])]))
+
+
 class ObstacleMemory:
     """Fused points of every obstacle seen so far, by course index. ``walkway_half_width_m``: the
     lateral extent assumed for a side whose corner was not seen (the obstacle may span the walkway)."""
@@ -157,6 +168,10 @@ class ObstacleMemory:
         self.height_prior = height_prior
         self.gate = gate  # outlier gate of add (in stds), or None: every sample fused (iwao v0)
         self.corners: dict[int, tuple[Corner, ...]] = {}
+        # The winding walkway: a map from the path frame (x, y) to path coordinates (s, n, heading), or None.
+        # With it, :meth:`obstacle` gives boxes in path coordinates (the points fused in the path frame, each
+        # mapped with its stds turned into the path's heading there).
+        self.to_path = None
 
     def reset(self) -> None:
         self.corners = {}
@@ -245,6 +260,8 @@ class ObstacleMemory:
         if points is None:
             return None
         est = [pt.estimate() if pt.n else None for pt in points]
+        if self.to_path is not None:
+            est = [None if e is None else _in_path(e, self.to_path) for e in est]
         near = [e for e in (est[NEAR_LEFT], est[NEAR_MID]) if e is not None]
         far = [e for e in (est[FAR_RIGHT], est[FAR_MID]) if e is not None]
         if not near or not far:

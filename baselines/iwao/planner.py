@@ -58,6 +58,12 @@ class PlannerParams:
     # step although the best estimates leave room (modelling choice: a walker who must step somewhere
     # steps where the hazards are least likely to be; IwaoAgent sets (1, 0) with gaze_mode="footholds").
     fallback_sigmas: tuple[float, ...] = ()
+    # The corridor through rows (True: :meth:`FootstepPlanner.row_corridor`): the nearest row of obstacles
+    # too long to step over is passed through the free interval (a gap between them, or beside them)
+    # nearest the pelvis's lateral position, not only beside the first obstacle that blocks the centre
+    # line (False: iwao v0 and the rough course, their golden digests). Modelling choice; IwaoAgent sets
+    # it on the rows-with-gaps course (tasks.obstacle_walk: layout "rows").
+    rows: bool = False
 
 
 class FootstepPlanner:
@@ -121,6 +127,8 @@ class FootstepPlanner:
         """The pelvis's lateral target: 0 (the path's centre line) unless an obstacle ahead is too long
         to step over; then beside it, on the side nearer the pelvis's lateral position ``y_now``."""
         p = self.p
+        if p.rows:  # from the best estimates: the footholds' own tests keep the stds' margins
+            return self.row_corridor(u_last, y_now, *self._zones(obstacles, 0.0))
         for _o, zone, gf, gb in zip(obstacles, arr.tolist(), gap[0].tolist(), gap[1].tolist()):
             if zone[1] < u_last - p.corridor_release_m or zone[0] > u_last + p.look_ahead_m:
                 continue
@@ -134,6 +142,40 @@ class FootstepPlanner:
                     continue  # no room beside it: stepped over (the footholds' own tests decide how)
                 return float(min(sides, key=lambda c: abs(c - y_now)))
         return 0.0
+
+    def row_corridor(self, u_last: float, y_now: float, arr, gap) -> float:
+        """The corridor with ``PlannerParams.rows``: the obstacles too long to step over whose keep-out
+        zone begins ahead of the last foothold's toe and within the look-ahead (a row the last foothold
+        has entered is the footholds' own tests' business: the corridor turns to the next) form rows (those overlapping the nearest one along the path); the feet's centres are
+        free outside every zone of that row grown by the foot's half width, inside the walkway; the
+        corridor is the point of the free interval nearest ``y_now`` kept ``corridor_margin_m`` plus
+        half a step width from its ends (its middle when it is narrower than that). 0 when no such row."""
+        p = self.p
+        long = [z for z, gf, gb in zip(arr.tolist(), gap[0].tolist(), gap[1].tolist())
+                if u_last + TOE_M + gf <= z[0] <= u_last + p.look_ahead_m and (z[1] - z[0]) + TOE_M + HEEL_M + gf + gb > p.max_step_over_m]
+        if not long:
+            return 0.0
+        first = min(long, key=lambda z: z[0])
+        blocked = sorted((z[2] - HALF_WIDTH_M, z[3] + HALF_WIDTH_M) for z in long if z[0] < first[1] and z[1] > first[0])
+        lim = self._v_limit
+        free, lo = [], -lim
+        for b0, b1 in blocked:
+            if b0 > lo:
+                free.append((lo, min(b0, lim)))
+            lo = max(lo, b1)
+        if lo < lim:
+            free.append((lo, lim))
+        free = [(a, b) for a, b in free if b > a]
+        if not free:
+            return 0.0
+        keep = p.corridor_margin_m + 0.5 * self.g.step_width_m
+        best = None
+        for a, b in free:
+            m = min(keep, 0.5 * (b - a))
+            c = min(max(y_now, a + m), b - m)
+            if best is None or abs(c - y_now) < abs(best - y_now):
+                best = c
+        return float(best)
 
     def plan(self, footholds, obstacles) -> tuple[float, float, float]:
         """(length, lateral, clearance) of the next footstep. ``footholds``: the last three latched ones

@@ -13,7 +13,7 @@ from typing import Any, ClassVar
 from visuomotor_gym.body import names
 from visuomotor_gym.body import walker_names as wn
 from visuomotor_gym.body.walker import GaitParams
-from visuomotor_gym.body.walker_body import WALKER_BLOCKS, WalkerBody
+from visuomotor_gym.body.walker_body import TURNING_WALKER_BLOCKS, WALKER_BLOCKS, TurningWalkerBody, WalkerBody
 from visuomotor_gym.core import args
 from visuomotor_gym.core.env import MAX_VISION_NOISE_SCALE, MAX_VISUAL_DELAY_S, VisuomotorEnv  # noqa: F401 (re-exported)
 from visuomotor_gym.core.eye import EYE_BLOCKS
@@ -27,12 +27,13 @@ from visuomotor_gym.tasks.obstacle_walk import (
     PERCEPT_BLOCKS,
     REWARD_TERMS,
     TRAILING_BLOCKS,
+    WINDING_TRAILING_BLOCKS,
     CourseDistribution,
     ObstacleWalkTask,
 )
 from visuomotor_gym.vision.foveation import VisionParams
 
-__all__ = ["OBSTACLE_VIEW_ANGLE_DEG", "WALK_LAYOUT", "WALK_VISION", "ObstacleWalkEnv", "WalkerEnv"]
+__all__ = ["OBSTACLE_VIEW_ANGLE_DEG", "WALK_LAYOUT", "WALK_VISION", "WINDING_LAYOUT", "ObstacleWalkEnv", "WalkerEnv"]
 
 RENDER_CAMERAS = ("both", "side", "follow", "scene", "eye")
 # The field in which an obstacle is seen at all: Iwao et al.'s view angle for obstacle recognition
@@ -44,6 +45,10 @@ RENDER_CAMERAS = ("both", "side", "follow", "scene", "eye")
 OBSTACLE_VIEW_ANGLE_DEG = 20.0
 WALK_VISION = VisionParams(field_of_view_deg=OBSTACLE_VIEW_ANGLE_DEG)
 WALK_LAYOUT = ObservationLayout(PERCEPT_BLOCKS + EYE_BLOCKS + HEAD_BLOCKS + WALKER_BLOCKS + TRAILING_BLOCKS)
+# The winding walkway's observation (course_distribution="winding", opt-in): the turning walker's blocks and the
+# centre line ahead.
+WINDING_LAYOUT = ObservationLayout(PERCEPT_BLOCKS + EYE_BLOCKS + HEAD_BLOCKS + TURNING_WALKER_BLOCKS
+                                   + WINDING_TRAILING_BLOCKS)
 
 
 class WalkerEnv(VisuomotorEnv):
@@ -185,7 +190,10 @@ class ObstacleWalkEnv(WalkerEnv):
     argument_meanings = {  # noqa: RUF012  (read only: the generated Arguments table)
         "course_distribution": ('``CourseDistribution``, dict, or a preset name: ``"walkway"`` (the default) or '
                                 '``"rough"`` (``ROUGH_COURSE``: small hazards on most footholds, opt-in) or ``"rough_dense"`` '
-                                '(``DENSE_ROUGH_COURSE``: the same, a hazard every 0.45-0.8 m, opt-in)'),
+                                '(``DENSE_ROUGH_COURSE``: the same, a hazard every 0.45-0.8 m, opt-in) or ``"rows"`` '
+                                '(``ROWS_COURSE``: rows of patches across the walkway, one gap each, opt-in) or ``"winding"`` '
+                                '(``WINDING_COURSE``: the rough course on a walkway that turns left and right, the turning '
+                                'walker (9 actions) and the centre line ahead (``path_ahead``), opt-in)'),
         "vision": ('``"foveated"``, ``"full_view"`` (foveal noise everywhere, no field-of-view limit, no saccadic '
                    'blindness) or ``"oracle"`` (true corners)'),
         "vision_params": ("``VisionParams`` or a dict of its fields; the default is the catch family's except "
@@ -205,6 +213,10 @@ class ObstacleWalkEnv(WalkerEnv):
             course_distribution = COURSE_PRESETS[args.choice(course_distribution, tuple(COURSE_PRESETS),
                                                              "course_distribution")]
         self.course_distribution = args.coerce(CourseDistribution, course_distribution, "course_distribution")
+        if self.course_distribution.layout == "winding":
+            # The winding walkway (opt-in): the turning walker of SteppingStones (a fourth footstep value, the
+            # turn; the foothold_headings block) and the centre line ahead (path_ahead): WINDING_LAYOUT.
+            self.body_class = TurningWalkerBody
         super().__init__(render_mode, **shared)
 
     def _build_task(self, body: WalkerBody) -> ObstacleWalkTask:

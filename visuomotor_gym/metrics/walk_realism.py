@@ -121,6 +121,30 @@ def _gaze_hits(eye: np.ndarray, gaze: np.ndarray, z: float) -> np.ndarray:
     return eye[:, :2] + s[:, None] * gaze[:, :2]
 
 
+def _frame(trace):
+    """(obstacles, to_path) of a trace: on the winding walkway (the trace's ``path``) the obstacles in path
+    coordinates (s along the centre line, n across it) and a map of (T, 2) world points into them; else the
+    obstacles as recorded and None (the straight walkway's x and y are its path coordinates)."""
+    path = trace.task.get("path") if isinstance(getattr(trace, "task", None), dict) else None
+    if path is None:
+        return np.asarray(trace.obstacles, dtype=float).reshape(-1, 6), None
+    path = np.asarray(path, dtype=float)
+    ds = float(np.hypot(*(path[1, :2] - path[0, :2])))
+    tx, ty = np.cos(path[:, 2]), np.sin(path[:, 2])
+
+    def to_path(points: np.ndarray) -> np.ndarray:
+        pts = np.asarray(points, dtype=float)[:, :2]
+        out = np.full(pts.shape, np.nan)
+        ok = np.all(np.isfinite(pts), axis=1)
+        for k in np.flatnonzero(ok).tolist():
+            dx, dy = pts[k, 0] - path[:, 0], pts[k, 1] - path[:, 1]
+            i = int(np.argmin(dx * dx + dy * dy))
+            out[k] = (i * ds + tx[i] * dx[i] + ty[i] * dy[i], -ty[i] * dx[i] + tx[i] * dy[i])
+        return out
+
+    return np.asarray(trace.obstacles_path, dtype=float).reshape(-1, 6), to_path
+
+
 def _on(points: np.ndarray, ob: np.ndarray, tol: float) -> np.ndarray:
     x, y, depth, width = ob[0], ob[1], ob[2], ob[3]
     inside_x = np.abs(points[:, 0] - x) <= 0.5 * depth + tol
@@ -132,16 +156,18 @@ def obstacle_shares(trace) -> tuple[float, float]:
     """(mean approach fixation share over the obstacles approached, mean crossing fixation share over the
     obstacles crossed that had been fixated during their approach); a row fixates an obstacle when gaze
     is on it and its gaze point moves slower than ``STABLE_GAZE_M_S``."""
-    obstacles = np.asarray(trace.obstacles, dtype=float).reshape(-1, 6)
+    obstacles, to_path = _frame(trace)
     eye, gaze, pelvis = np.asarray(trace.eye_pos), np.asarray(trace.gaze_dir), np.asarray(trace.pelvis_pos)
     approach, crossing = [], []
     dt = float(trace.dt)
+    px = pelvis[:, 0] if to_path is None else to_path(pelvis)[:, 0]
     for ob in obstacles:
         near, far = ob[0] - 0.5 * ob[2], ob[0] + 0.5 * ob[2]
         hits = _gaze_hits(eye, gaze, ob[4])
         speed = np.r_[np.inf, np.linalg.norm(np.diff(hits, axis=0), axis=1) / dt]
+        if to_path is not None:
+            hits = to_path(hits)
         on = _on(hits, ob, ON_OBSTACLE_M) & (np.nan_to_num(speed, nan=np.inf) <= STABLE_GAZE_M_S)
-        px = pelvis[:, 0]
         a = (px >= near - APPROACH_START_M) & (px < near - CROSSING_M)
         c = (px >= near - CROSSING_M) & (px <= far + CROSSING_M)
         looked = False
@@ -156,14 +182,19 @@ def obstacle_shares(trace) -> tuple[float, float]:
 def on_walkway(trace) -> np.ndarray:
     """(T,) rows whose gaze lands on an obstacle or on the walkway floor ``PATH_NEAR_M``-``PATH_FAR_M``
     ahead of the eye (within ``PATH_HALF_WIDTH_M`` of the centre line y = 0)."""
-    obstacles = np.asarray(trace.obstacles, dtype=float).reshape(-1, 6)
+    obstacles, to_path = _frame(trace)
     eye, gaze = np.asarray(trace.eye_pos, dtype=float), np.asarray(trace.gaze_dir, dtype=float)
     ground = _gaze_hits(eye, gaze, 0.0)
-    ahead = ground[:, 0] - eye[:, 0]
+    if to_path is None:
+        ahead = ground[:, 0] - eye[:, 0]
+    else:  # along the winding walkway's centre line
+        ground = to_path(ground)
+        ahead = ground[:, 0] - to_path(eye)[:, 0]
     with np.errstate(invalid="ignore"):
         out = (ahead >= PATH_NEAR_M) & (ahead <= PATH_FAR_M) & (np.abs(ground[:, 1]) <= PATH_HALF_WIDTH_M)
     for ob in obstacles:
-        out |= _on(_gaze_hits(eye, gaze, ob[4]), ob, ON_OBSTACLE_M)
+        hits = _gaze_hits(eye, gaze, ob[4])
+        out |= _on(hits if to_path is None else to_path(hits), ob, ON_OBSTACLE_M)
     return out
 
 
@@ -173,12 +204,17 @@ def path_fixation_share(trace) -> float:
 
 
 def travel_fixation_distance(trace) -> float:
-    obstacles = np.asarray(trace.obstacles, dtype=float).reshape(-1, 6)
+    obstacles, to_path = _frame(trace)
     eye, gaze = np.asarray(trace.eye_pos), np.asarray(trace.gaze_dir)
     ground = _gaze_hits(eye, gaze, 0.0)
-    free = np.isfinite(ground[:, 0]) & (ground[:, 0] > eye[:, 0])
+    if to_path is None:
+        free = np.isfinite(ground[:, 0]) & (ground[:, 0] > eye[:, 0])
+    else:
+        with np.errstate(invalid="ignore"):
+            free = np.isfinite(ground[:, 0]) & (to_path(ground)[:, 0] > to_path(eye)[:, 0])
     for ob in obstacles:
-        free &= ~_on(_gaze_hits(eye, gaze, ob[4]), ob, ON_OBSTACLE_M)
+        hits = _gaze_hits(eye, gaze, ob[4])
+        free &= ~_on(hits if to_path is None else to_path(hits), ob, ON_OBSTACLE_M)
     if free.sum() < 10:
         return float("nan")
     return float(np.median(np.hypot(*(ground[free] - eye[free, :2]).T)))
@@ -212,7 +248,10 @@ def walk_gaze_realism(traces: Sequence, reference: dict | None = None) -> dict:
 
 def distance_left(tr) -> float:
     """How far from the goal an episode ended: the distance (m) left to the finish line (its ``miss_distance_m``)."""
-    return max(float(tr.course_length) - float(np.asarray(tr.pelvis_pos)[-1, 0]), 0.0)
+    _, to_path = _frame(tr)
+    end = np.asarray(tr.pelvis_pos)[-1:]
+    along = float(end[0, 0]) if to_path is None else float(to_path(end)[0, 0])
+    return max(float(tr.course_length) - along, 0.0)
 
 
 def walk_summary(traces: Sequence) -> dict:

@@ -44,10 +44,39 @@ the slots carry no hidden truth: an obstacle is sampled by the eye only within `
 pelvis, its slot id is a *label* given in the order the eye first saw it (never a course index), and the
 slots hold the labelled obstacles not yet passed, lowest label first: an obstacle that was never seen
 takes no slot and changes no id when it is passed.
+
+**Rows with gaps** (opt-in, ``course_distribution="rows"``: :data:`ROWS_COURSE`, a design probe for the
+moving-eye redefinition, not a default): every 2-2.6 m a row of two flat patches spans the walkway edge to
+edge, 60-70 cm deep (deeper than the planner's longest stride clears: one foot must land inside the row),
+with ONE gap 30-40 cm wide (about one and a half feet: a foothold that needs its place to a few cm)
+whose centre lies anywhere within 0.4 m of the centre line, drawn anew for every row: the walker
+must step through each gap. Sizes and spacings are modelling choices; labelled slots and the sight range
+as on the rough course. Measured: it does not need a moving eye (a fixed posture 30 deg down crosses as
+often as iwao; docs/reproductions/data/terrain/obstacle_walk.md, fifth session).
+
+**The winding walkway** (opt-in, ``course_distribution="winding"``: :data:`WINDING_COURSE`, a design probe for
+the moving-eye redefinition): the rough course's hazards laid in *path coordinates* (``s`` along the centre
+line, ``n`` across it, each obstacle turned to the path's heading at its centre) on a walkway whose centre
+line runs 2 m straight from the start, then alternates arcs (25-50 deg of heading over 2-3.5 m, to the left
+or right at random, the heading kept within +-60 deg of the start's) and straights of 0.5-1.5 m
+(:func:`sample_path`). On a straight walkway a posture fixed in the body frame sweeps every hazard past its
+fovea 1-3 steps ahead (fifth session); in a turn the footholds 2-3 steps ahead (Matthis, Yates & Hayhoe
+2018) lie 10-30 deg off the body's heading, to a side that changes from turn to turn, and humans' gaze
+leads the turn by 0.2-1 s (Grasso et al. 1998; Imai et al. 2001). The walker is the turning walker of
+SteppingStones (``TurningWalkerBody``: a fourth footstep value, the turn, and the ``foothold_headings``
+block); off path, the finish, the slots and ``to_finish`` count along the centre line (the pelvis's arc
+length, a foothold's distance across it). The painted edges of the straight walkway cannot bend, so they
+are put away and the centre line ahead is *given* in a ``path_ahead`` block (13 points, 0-6 m ahead,
+pelvis frame): a shortcut until the walkway's edges are drawn as seen targets. The arcs' sizes are
+modelling choices within ALLSTEPS' +-30 deg per step (Xie et al. 2020) and the gait's 45 deg
+(``GaitParams.max_turn_deg``). On the curve the hazards keep their path-coordinate sizes (drawn apart by
+``ROUGH_CLEAR_M`` along ``s``; on the inside of the sharpest arcs, 0.6 m from the centre line, the world gap
+shrinks by about a quarter).
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 
 import mujoco
@@ -76,7 +105,9 @@ KINDS = ("bar", "box", "mat")
 BAR, BOX, MAT = 0, 1, 2
 REWARD_TERMS = ("finish", "trip", "misstep", "off_path", "progress")
 DEFAULT_REWARD_WEIGHTS = {"finish": 1.0, "trip": -1.0, "misstep": -1.0, "off_path": -1.0, "progress": 0.0}
-LAYOUTS = ("walkway", "rough")  # CourseDistribution.layout: today's course, the rough one (module docstring)
+# CourseDistribution.layout: today's course, the rough one, rows with gaps, the rough course on a winding walkway
+LAYOUTS = ("walkway", "rough", "rows", "winding")
+ROUGH_LAYOUTS = ("rough", "rows", "winding")  # labelled slots and a sight range (module docstring)
 OBSTACLE_RGBA = {BAR: (0.80, 0.25, 0.20, 1.0), BOX: (0.85, 0.55, 0.15, 1.0), MAT: (0.08, 0.08, 0.08, 1.0)}
 
 
@@ -103,6 +134,15 @@ COURSE_RULES = {
     "rough_lateral_m": Pair(Num(-2.0, 2.0)),
     "rough_patch_m": Pair(Num(0.0, 5.0, low_open=True)),
     "sight_range_m": Num(0.5, 200.0),
+    "row_step_m": Pair(Num(0.05, 10.0)),
+    "row_depth_m": Pair(Num(0.0, 5.0, low_open=True)),
+    "row_gap_m": Pair(Num(0.0, 5.0, low_open=True)),
+    "row_gap_lateral_m": Pair(Num(-2.0, 2.0)),
+    "winding_straight_start_m": Num(0.0, 50.0),
+    "winding_turn_deg": Pair(Num(0.0, 90.0)),
+    "winding_turn_m": Pair(Num(0.1, 50.0)),
+    "winding_straight_m": Pair(Num(0.0, 50.0)),
+    "winding_max_heading_deg": Num(0.0, 80.0),
 }
 
 
@@ -133,13 +173,41 @@ class CourseDistribution:
     rough_lateral_m: tuple[float, float] = (-0.5, 0.5)  # modelling choice: anywhere on the 1.5 m walkway
     rough_patch_m: tuple[float, float] = (0.2, 0.35)  # modelling choice: smaller than a step, ~a foot long
     sight_range_m: float = 5.0  # modelling choice: ~4 s of walking; beyond the 2-3 steps humans fixate
+    # Rows with gaps (layout="rows", opt-in, :func:`_sample_rows`): rows of flat patches spanning the
+    # walkway every row_step_m (near edge to near edge), each row_depth_m deep (deeper than a stride can
+    # clear with the planner's foot box: one foot must land inside the row) and split by ONE free gap
+    # row_gap_m wide whose centre lies row_gap_lateral_m from the centre line, drawn anew for every row.
+    # Modelling choices: a gap about one and a half foot wide, placed anywhere the walker's feet can reach;
+    # 2-2.6 m between rows so the scripted gait (at most ~0.36 m sideways per two steps) can line up with the
+    # next gap: with 1.4-1.8 m the planner with true footprints crossed 37/40 of seeds 0-39, with 1.2-1.5 m
+    # 21/40 (docs/reproductions/data/terrain/obstacle_walk.md, fifth session).
+    row_step_m: tuple[float, float] = (2.0, 2.6)
+    row_depth_m: tuple[float, float] = (0.6, 0.7)
+    row_gap_m: tuple[float, float] = (0.3, 0.4)
+    row_gap_lateral_m: tuple[float, float] = (-0.4, 0.4)
+    # The winding walkway (layout="winding", opt-in, :func:`sample_path`): the rough course's hazards laid
+    # in path coordinates (along / across the centre line) on a walkway whose centre line runs straight for
+    # winding_straight_start_m, then alternates arcs (a heading change of winding_turn_deg, left or right
+    # at random, spread evenly over winding_turn_m of path) and straights (winding_straight_m); a turn
+    # that would take the heading beyond +-winding_max_heading_deg from the start's goes the other way
+    # (the walkway never folds back on itself). Modelling choices: 25-50 deg over 2-3.5 m is 5-16 deg
+    # per 0.65 m step, inside ALLSTEPS' +-30 deg per step (Xie et al. 2020) and the gait's 45 deg
+    # (GaitParams.max_turn_deg); humans' gaze leads such turns by 0.2-1 s (Grasso et al. 1998; Imai et
+    # al. 2001), so the footholds 2-3 steps ahead (Matthis, Yates & Hayhoe 2018) lie 10-30 deg off the
+    # body's heading, to a side that changes from turn to turn.
+    winding_straight_start_m: float = 2.0
+    winding_turn_deg: tuple[float, float] = (25.0, 50.0)
+    winding_turn_m: tuple[float, float] = (2.0, 3.5)
+    winding_straight_m: tuple[float, float] = (0.5, 1.5)
+    winding_max_heading_deg: float = 60.0
 
     def __post_init__(self) -> None:
         args.check_fields(self, COURSE_RULES)
 
     @property
     def rough(self) -> bool:
-        return self.layout == "rough"
+        """Labelled slots and a sight range (the rough course and the rows with gaps)."""
+        return self.layout in ROUGH_LAYOUTS
 
 
 # The opt-in rough course (module docstring): 12-14 m, the first hazard 2.5-3.5 m ahead, no bars,
@@ -156,19 +224,107 @@ ROUGH_COURSE = CourseDistribution(layout="rough", length_m=(12.0, 14.0), first_m
 # pool of 16 obstacles ends a quarter of these courses early (seeds 0-199: 26 %, the last hazard then
 # up to 1.25 m before the finish's clear zone). docs/reproductions/data/terrain/obstacle_walk.md.
 DENSE_ROUGH_COURSE = replace(ROUGH_COURSE, rough_step_m=(0.45, 0.8))
-COURSE_PRESETS = {"walkway": CourseDistribution(), "rough": ROUGH_COURSE, "rough_dense": DENSE_ROUGH_COURSE}
+# Rows with gaps (opt-in, preset "rows"): ROUGH_COURSE's length and start with the rows of _sample_rows.
+ROWS_COURSE = replace(ROUGH_COURSE, layout="rows")
+# The winding walkway (opt-in, preset "winding"): ROUGH_COURSE's hazards in path coordinates on a centre line of
+# arcs and straights (sample_path).
+WINDING_COURSE = replace(ROUGH_COURSE, layout="winding")
+COURSE_PRESETS = {"walkway": CourseDistribution(), "rough": ROUGH_COURSE, "rough_dense": DENSE_ROUGH_COURSE,
+                  "rows": ROWS_COURSE, "winding": WINDING_COURSE}
+PATH_DS_M = 0.02  # spacing of the centre line's sampled points (m)
+
+
+class WindingPath:
+    """A walkway's centre line sampled every :data:`PATH_DS_M` from its start (the origin, heading +x):
+    ``xy`` (M, 2) points, ``heading`` (M,) radians. Path coordinates ``(s, n)``: arc length along the
+    centre line and offset across it (+ = left)."""
+
+    def __init__(self, xy: np.ndarray, heading: np.ndarray) -> None:
+        self.xy = np.asarray(xy, dtype=float)
+        self.heading = np.asarray(heading, dtype=float)
+        self.tx, self.ty = np.cos(self.heading), np.sin(self.heading)
+        self.length = PATH_DS_M * (len(self.xy) - 1)
+
+    def _index(self, s: float) -> tuple[int, float]:
+        f = min(max(s / PATH_DS_M, 0.0), len(self.xy) - 1.0)
+        i = min(int(f), len(self.xy) - 2)
+        return i, f - i
+
+    def heading_at(self, s: float) -> float:
+        i, t = self._index(s)
+        return float(self.heading[i] + t * (self.heading[i + 1] - self.heading[i]))
+
+    def to_world(self, s: float, n: float) -> tuple[float, float]:
+        """World (x, y) of the path point ``(s, n)`` (beyond the sampled ends: along the end's tangent)."""
+        i, t = self._index(s)
+        extra = s - (i + t) * PATH_DS_M
+        x = self.xy[i, 0] + t * (self.xy[i + 1, 0] - self.xy[i, 0])
+        y = self.xy[i, 1] + t * (self.xy[i + 1, 1] - self.xy[i, 1])
+        h = self.heading_at(s)
+        c, si = math.cos(h), math.sin(h)
+        return float(x + c * extra - si * n), float(y + si * extra + c * n)
+
+    def project(self, x: float, y: float) -> tuple[float, float]:
+        """Path coordinates ``(s, n)`` of the world point ``(x, y)``: the nearest sampled point's arc length
+        plus the offset along its tangent, and the offset across it."""
+        d2 = (self.xy[:, 0] - x) ** 2 + (self.xy[:, 1] - y) ** 2
+        i = int(np.argmin(d2))
+        dx, dy = x - self.xy[i, 0], y - self.xy[i, 1]
+        return float(i * PATH_DS_M + self.tx[i] * dx + self.ty[i] * dy), float(-self.ty[i] * dx + self.tx[i] * dy)
+
+
+def sample_path(rng: np.random.Generator, dist: CourseDistribution, length: float) -> WindingPath:
+    """The winding walkway's centre line (``CourseDistribution.winding_*``), sampled to ``length`` m."""
+    n = int(math.ceil(length / PATH_DS_M)) + 1
+    kappa = np.zeros(n)  # curvature (1/m) of each sample's segment
+    s = dist.winding_straight_start_m
+    h = 0.0  # heading at s (rad)
+    h_max = math.radians(dist.winding_max_heading_deg)
+    while s < length:
+        turn = math.radians(float(rng.uniform(*dist.winding_turn_deg)))
+        sign = 1.0 if rng.uniform() < 0.5 else -1.0
+        if abs(h + sign * turn) > h_max:
+            sign = -sign
+        if abs(h + sign * turn) > h_max:  # either way too far: turn back to the start's heading
+            turn, sign = abs(h), -math.copysign(1.0, h) if h else 1.0
+        arc = float(rng.uniform(*dist.winding_turn_m))
+        i0, i1 = int(round(s / PATH_DS_M)), int(round((s + arc) / PATH_DS_M))
+        kappa[i0:min(i1, n)] = sign * turn / max(arc, 1e-9)
+        h += sign * turn
+        s += arc + float(rng.uniform(*dist.winding_straight_m))
+    heading = np.concatenate(([0.0], np.cumsum(kappa[:-1] * PATH_DS_M)))
+    mid = heading[:-1] + 0.5 * np.diff(heading)
+    xy = np.zeros((n, 2))
+    xy[1:, 0] = np.cumsum(np.cos(mid) * PATH_DS_M)
+    xy[1:, 1] = np.cumsum(np.sin(mid) * PATH_DS_M)
+    return WindingPath(xy, heading)
 
 
 @dataclass(frozen=True)
 class Course:
     length: float
     obstacles: np.ndarray  # (N, 6): centre x, centre y, depth (along x), width, height, kind
+    # The winding walkway (layout "winding"): its centre line, each obstacle's yaw (its depth runs along
+    # the path's heading at its centre) and the obstacles in path coordinates (centre s, n, ...). None else.
+    path: WindingPath | None = None
+    yaw: np.ndarray | None = None
+    local: np.ndarray | None = None
 
 
 def sample_course(rng: np.random.Generator, dist: CourseDistribution, max_obstacles: int) -> Course:
     """One course: obstacles in path order, free gaps between them, none near the finish."""
     if not dist.walkway_width_m > 0.0:
         raise ValueError(f"course_distribution.walkway_width_m must be > 0 m, got {dist.walkway_width_m!r}")
+    if dist.layout == "rows":
+        return _sample_rows(rng, dist, max_obstacles)
+    if dist.layout == "winding":
+        local = _sample_rough(rng, dist, max_obstacles)
+        path = sample_path(rng, dist, local.length + 3.0)
+        world, yaw = local.obstacles.copy(), np.zeros(len(local.obstacles))
+        for k, row in enumerate(local.obstacles.tolist()):
+            world[k, 0], world[k, 1] = path.to_world(row[0], row[1])
+            yaw[k] = path.heading_at(row[0])
+        return Course(local.length, world, path, yaw, local.obstacles)
     if dist.rough:
         return _sample_rough(rng, dist, max_obstacles)
     length = float(rng.uniform(*dist.length_m))
@@ -231,6 +387,30 @@ def _sample_rough(rng: np.random.Generator, dist: CourseDistribution, max_obstac
     return Course(length, np.array(rows, dtype=float).reshape(-1, 6))
 
 
+def _sample_rows(rng: np.random.Generator, dist: CourseDistribution, max_obstacles: int) -> Course:
+    """Rows with gaps (``layout="rows"``): every ``row_step_m`` a row of two flat patches (misstep)
+    spanning the walkway edge to edge, ``row_depth_m`` deep, with one gap ``row_gap_m`` wide between
+    them centred ``row_gap_lateral_m`` off the centre line. Two obstacles per row (the scene's pool
+    bounds the number of rows)."""
+    length = float(rng.uniform(*dist.length_m))
+    half = 0.5 * dist.walkway_width_m
+    rows: list[tuple] = []
+    near = float(rng.uniform(*dist.first_m))
+    while len(rows) + 2 <= max_obstacles:
+        depth = float(rng.uniform(*dist.row_depth_m))
+        gap = float(rng.uniform(*dist.row_gap_m))
+        g = float(rng.uniform(*dist.row_gap_lateral_m))
+        if near + depth > length - dist.finish_clear_m:
+            break
+        lo, hi = g - 0.5 * gap, g + 0.5 * gap
+        x = near + 0.5 * depth
+        for y0, y1 in ((-half, lo), (hi, half)):  # right of the gap, left of it (path order within the row)
+            if y1 - y0 > 1e-3:
+                rows.append((x, 0.5 * (y0 + y1), depth, y1 - y0, dist.mat_height_m, MAT))
+        near += float(rng.uniform(*dist.row_step_m))
+    return Course(length, np.array(rows, dtype=float).reshape(-1, 6))
+
+
 def _overlap(near: float, depth: float, y: float, width: float, row: tuple) -> bool:
     """Whether a footprint (near edge, depth, centre y, width) comes within ``ROUGH_CLEAR_M`` of ``row``'s."""
     x, ry, d, w = row[:4]
@@ -251,6 +431,14 @@ TRAILING_BLOCKS = (
     Block("to_finish", 1, "m", "distance from the pelvis to the finish line along the path"),
     Block("time", 1, "s", "time since the start"),
 )
+# The winding walkway (layout "winding"): the centre line ahead, given (not seen: the painted edges of the straight
+# walkway cannot bend; a modelling shortcut until the walkway's edges are drawn and seen).
+PATH_AHEAD_POINTS = 13
+PATH_AHEAD_STEP_M = 0.5
+PATH_BLOCK = Block("path_ahead", 2 * PATH_AHEAD_POINTS, "m",
+                   "the walkway's centre line at 0, 0.5, ..., 6 m of path ahead of the pelvis's nearest point on it, "
+                   "(x, y) in the pelvis heading frame (winding walkway only)")
+WINDING_TRAILING_BLOCKS = (*TRAILING_BLOCKS, PATH_BLOCK)
 
 
 class ObstacleWalkTask(Task):
@@ -286,6 +474,9 @@ class ObstacleWalkTask(Task):
         self.half_width = 0.5 * course_distribution.walkway_width_m
         self.rough = course_distribution.rough  # labelled slots, sight range (module docstring)
         self.sight_range = course_distribution.sight_range_m
+        self.winding = course_distribution.layout == "winding"
+        if self.winding:
+            self.trailing_blocks = WINDING_TRAILING_BLOCKS
         self.course = Course(0.0, np.zeros((0, 6)))
         self.reset_state()
 
@@ -302,6 +493,7 @@ class ObstacleWalkTask(Task):
         self._slots_set = False
         self._n_events = 0
         self._prev_x = 0.0
+        self._s = (0.0, 0.0, -1.0)  # winding walkway: pelvis (s, n) and the time they were computed at
         self.seen = [False] * K_SLOTS
         self.labels: dict[int, int] = {}  # rough course: course index -> label (order of first sighting)
         self._passed: list[bool] = []  # rough course: each obstacle passed by the pelvis
@@ -314,14 +506,45 @@ class ObstacleWalkTask(Task):
         for t in self.all_targets:
             t.hidden = True
         self.targets = self.all_targets[: N_POINTS * len(course.obstacles)]  # what the retina samples
+        if course.path is not None:  # the winding walkway: obstacles turned to the path's heading
+            for i, (x, y, depth, width, height, kind) in enumerate(course.obstacles.tolist()):
+                yaw = float(course.yaw[i])
+                self.pool.place(m, d, i, x, y, depth, width, height, yaw=yaw, rgba=OBSTACLE_RGBA[int(kind)])
+                for t, point in zip(self.targets[N_POINTS * i: N_POINTS * (i + 1)],
+                                    top_points(x, y, depth, width, height, yaw)):
+                    t.place(*point)
+            fx, fy = course.path.to_world(course.length, 0.0)
+            fh = course.path.heading_at(course.length)
+            d.mocap_pos[self._finish_mocap] = (fx, fy, 0.0)
+            d.mocap_quat[self._finish_mocap] = (math.cos(0.5 * fh), 0.0, 0.0, math.sin(0.5 * fh))
+            for mocap in self._edge_mocaps:  # the straight painted edges do not fit a winding walkway: below the floor
+                d.mocap_pos[mocap] = (10.0, 0.0, -5.0)
+            self._prev_x = 0.0
+            self._s = (0.0, 0.0, -1.0)
+            return
         for i, (x, y, depth, width, height, kind) in enumerate(course.obstacles.tolist()):
             self.pool.place(m, d, i, x, y, depth, width, height, rgba=OBSTACLE_RGBA[int(kind)])
             for t, point in zip(self.targets[N_POINTS * i: N_POINTS * (i + 1)], top_points(x, y, depth, width, height)):
                 t.place(*point)
         d.mocap_pos[self._finish_mocap] = (course.length, 0.0, 0.0)
+        d.mocap_quat[self._finish_mocap] = (1.0, 0.0, 0.0, 0.0)
         for mocap, sign in zip(self._edge_mocaps, (1.0, -1.0)):  # the painted edges (walker.xml: 30 m from x = -5 m)
             d.mocap_pos[mocap] = (10.0, sign * self.half_width, 0.0)
         self._prev_x = float(d.qpos[0])
+
+    def along(self, data: mujoco.MjData) -> float:
+        """How far the pelvis has come along the path: x on the straight walkway, the arc length of its
+        nearest centre-line point on the winding one (relative to the start)."""
+        if self.course.path is None:
+            return float(data.qpos[0])
+        return self._pelvis_sn(data)[0]
+
+    def _pelvis_sn(self, data: mujoco.MjData) -> tuple[float, float]:
+        if self._s[2] != data.time:
+            sx, sy = self.body.start_xy
+            s, n = self.course.path.project(float(data.qpos[0]) - sx, float(data.qpos[1]) - sy)
+            self._s = (s, n, data.time)
+        return self._s[0], self._s[1]
 
     def initial_gaze(self) -> tuple[np.ndarray, tuple[float, float]]:
         """Gaze starts level, straight ahead along the path (at the finish line, at eye height)."""
@@ -338,7 +561,12 @@ class ObstacleWalkTask(Task):
 
     # --- what the evaluator records ----------------------------------------------------------
     def trace_episode_fields(self) -> dict:
-        return {"course_length": float(self.course.length), "obstacles": self.course.obstacles.copy()}
+        out = {"course_length": float(self.course.length), "obstacles": self.course.obstacles.copy()}
+        path = self.course.path
+        if path is not None:  # the winding walkway: its centre line (x, y, heading) and the obstacles along it
+            out["path"] = np.column_stack((path.xy, path.heading))
+            out["obstacles_path"] = self.course.local.copy()
+        return out
 
     @staticmethod
     def trace_final_fields(info: dict) -> dict:
@@ -365,8 +593,8 @@ class ObstacleWalkTask(Task):
     # --- observation --------------------------------------------------------------------------
     def before_observe(self, data: mujoco.MjData) -> None:
         """Advance the first slot past obstacles the pelvis has left behind (before the retina samples)."""
-        obs = self.course.obstacles
-        x = float(data.qpos[0])
+        obs = self.course.obstacles if self.course.local is None else self.course.local
+        x = self.along(data)
         n0 = self.n_passed
         while self.n_passed < len(obs) and obs[self.n_passed, 0] + 0.5 * obs[self.n_passed, 2] < x - PASSED_M:
             self.n_passed += 1
@@ -435,7 +663,16 @@ class ObstacleWalkTask(Task):
         d = data
         sx, sy = self.body.start_xy
         x, y, _, yaw = d.qpos[:4].tolist()
-        values += (x - sx, y - sy, yaw - self.body.start_yaw, self.course.length - (x - sx), d.time)
+        if self.course.path is None:
+            values += (x - sx, y - sy, yaw - self.body.start_yaw, self.course.length - (x - sx), d.time)
+            return
+        s, _ = self._pelvis_sn(d)
+        values += (x - sx, y - sy, yaw - self.body.start_yaw, self.course.length - s, d.time)
+        c, si = math.cos(yaw), math.sin(yaw)
+        px, py = x - sx, y - sy
+        for k in range(PATH_AHEAD_POINTS):
+            wx, wy = self.course.path.to_world(s + k * PATH_AHEAD_STEP_M, 0.0)
+            values += (c * (wx - px) + si * (wy - py), -si * (wx - px) + c * (wy - py))
 
     # --- outcome ------------------------------------------------------------------------------
     def _check_footholds(self, data: mujoco.MjData) -> bool:
@@ -443,10 +680,16 @@ class ObstacleWalkTask(Task):
         True when a sole's centre lies beyond one (the walker left the walkway)."""
         g = self.gait
         y0 = self.body.start_xy[1]
+        path = self.course.path
         while not self.off_path and self._next_check * g.T + g.T_ds <= g.tick:
             side = self._next_check % 2  # g.side_of
             self._next_check += 1
-            if abs(float(data.site_xpos[self._sole_sites[side], 1]) - y0) > self.half_width:
+            if path is not None:
+                sx, sy = self.body.start_xy
+                sole = data.site_xpos[self._sole_sites[side]]
+                if abs(path.project(float(sole[0]) - sx, float(sole[1]) - sy)[1]) > self.half_width:
+                    self.off_path = True
+            elif abs(float(data.site_xpos[self._sole_sites[side], 1]) - y0) > self.half_width:
                 self.off_path = True
         return self.off_path
 
@@ -462,8 +705,12 @@ class ObstacleWalkTask(Task):
         self.misstepped = g.misstepped
         was_off = self.off_path
         self._check_footholds(d)
-        x = float(d.qpos[0])
-        arrived = not self.finished and not self.off_path and x - self.body.start_xy[0] >= self.course.length
+        if self.course.path is None:
+            x = float(d.qpos[0])
+            arrived = not self.finished and not self.off_path and x - self.body.start_xy[0] >= self.course.length
+        else:
+            x = self.along(d)
+            arrived = not self.finished and not self.off_path and x >= self.course.length
         self.finished = self.finished or arrived
         self.success = self.finished and not self.tripped and not self.misstepped
         values = {"finish": 1.0 if (arrived and self.success) else 0.0, "trip": 1.0 if new_trip else 0.0,
@@ -492,10 +739,17 @@ class ObstacleWalkTask(Task):
         }
 
 
-def top_points(x: float, y: float, depth: float, width: float, height: float) -> tuple:
-    """The :data:`TOP_POINTS` of an obstacle's top face (centre x, y; extents along x and y; height)."""
-    x0, x1, y0, y1 = x - 0.5 * depth, x + 0.5 * depth, y - 0.5 * width, y + 0.5 * width
-    return (x0, y1, height), (x1, y0, height), (x0, y, height), (x1, y, height)
+def top_points(x: float, y: float, depth: float, width: float, height: float, yaw: float = 0.0) -> tuple:
+    """The :data:`TOP_POINTS` of an obstacle's top face (centre x, y; extents along and across its
+    heading ``yaw``, rad; height)."""
+    if yaw == 0.0:
+        x0, x1, y0, y1 = x - 0.5 * depth, x + 0.5 * depth, y - 0.5 * width, y + 0.5 * width
+        return (x0, y1, height), (x1, y0, height), (x0, y, height), (x1, y, height)
+    c, s = math.cos(yaw), math.sin(yaw)
+    out = []
+    for a, b in ((-0.5 * depth, 0.5 * width), (0.5 * depth, -0.5 * width), (-0.5 * depth, 0.0), (0.5 * depth, 0.0)):
+        out.append((x + c * a - s * b, y + s * a + c * b, height))
+    return tuple(out)
 
 
 def top_points_of(obstacles: np.ndarray) -> np.ndarray:
@@ -506,6 +760,7 @@ def top_points_of(obstacles: np.ndarray) -> np.ndarray:
 _UNSEEN_SLOT = [0.0] * (4 * N_POINTS)
 
 
-__all__ = ["COURSE_PRESETS", "DENSE_ROUGH_COURSE", "KINDS", "K_SLOTS", "LAYOUTS", "N_POINTS", "ROUGH_COURSE", "TOP_POINTS", "Course",
+__all__ = ["COURSE_PRESETS", "DENSE_ROUGH_COURSE", "KINDS", "K_SLOTS", "LAYOUTS", "N_POINTS", "ROUGH_COURSE", "TOP_POINTS", "WINDING_COURSE", "Course",
+           "WindingPath", "sample_path",
            "CourseDistribution", "ObstacleWalkTask",
            "sample_course", "top_points", "top_points_of"]

@@ -41,6 +41,10 @@ CONDITIONS = {
     # the denser rough course (preset "rough_dense": hazards every 0.45-0.8 m) under the same eye
     "rough dense, all four + disarray 0.8": ("rough_dense", {**HUMAN_FIELD, **POSITION_E2, **CROWDING, **DEPTH,
                                                              **DISARRAY}),
+    # the opt-in rows with gaps (preset "rows": tasks.obstacle_walk.ROWS_COURSE) under the same eye
+    "rows, all four + disarray 0.8": ("rows", {**HUMAN_FIELD, **POSITION_E2, **CROWDING, **DEPTH, **DISARRAY}),
+    # the opt-in winding walkway (preset "winding": tasks.obstacle_walk.WINDING_COURSE) under the same eye
+    "winding, all four + disarray 0.8": ("winding", {**HUMAN_FIELD, **POSITION_E2, **CROWDING, **DEPTH, **DISARRAY}),
     # a variant: the rough course with flat patches only (no rocks), ROUGH_COURSE with kind_p = (0, 0, 1)
     "rough patches only, field + E2 + crowding": ("rough patches", {**HUMAN_FIELD, **POSITION_E2, **CROWDING}),
 }

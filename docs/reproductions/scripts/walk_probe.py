@@ -9,7 +9,7 @@ given as fields laid over ``ROUGH_COURSE`` and a vision as ``VisionParams`` fiel
         --agents "iwao;static_gaze:az=-5,el=-30,neck_yaw=-5,neck_pitch=-10,fix=4:iwao"
 
 ``--env`` picks a rung (e.g. ObstacleWalkOracle-v0); ``PLANNER='{"lateral_margin_m": 0.06}'`` in the
-environment lays fields over iwao's ``PlannerParams``.
+environment lays fields over iwao's ``PlannerParams``, ``IWAO='{"sample_gate": null}'`` over its ``IwaoParams``.
 """
 
 from __future__ import annotations
@@ -51,6 +51,15 @@ def main(argv=None) -> int:
             init(self, gait, params or pl.PlannerParams(**over))
 
         pl.FootstepPlanner.__init__ = patched
+    if os.environ.get("IWAO"):  # fields laid over IwaoParams (probes only)
+        ag = importlib.import_module("visuomotor_gym.baselines.iwao.agent")
+        over_i = json.loads(os.environ["IWAO"])
+        init_i = ag.IwaoAgent.__init__
+
+        def patched_i(self, params=None, *a, **k):
+            init_i(self, dataclasses.replace(params or ag.IwaoParams(), **over_i), *a, **k)
+
+        ag.IwaoAgent.__init__ = patched_i
     course = dataclasses.asdict(dataclasses.replace(ROUGH_COURSE, **json.loads(a.course)))
     kwargs = {"course_distribution": course, "vision_params": json.loads(a.vision)}
     lo, hi = map(int, a.seeds.split(":"))
