@@ -123,7 +123,7 @@ def test_the_agent_path_follows_the_centre_line():
     for s_true in (1.0, 4.0, 7.5, 12.0):
         for n_true in (-0.5, 0.0, 0.4):
             x, y = course.path.to_world(s_true, n_true)
-            s_, n_, h_ = ap.project(x, y)
+            s_, n_, _ = ap.project(x, y)
             assert (s_, n_) == pytest.approx((s_true, n_true), abs=0.03)
             assert ap.to_world(s_, n_) == pytest.approx((x, y), abs=0.01)  # a polyline: 1 cm at its kinks
 

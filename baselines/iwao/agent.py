@@ -618,7 +618,7 @@ class AgentPath:
         return int(min(max(np.searchsorted(s0, s, side="right") - 1, 0), len(s0) - 2))
 
     def heading_at(self, s: float) -> float:
-        xy, t, _, _ = self._arrays
+        _, t, _, _ = self._arrays
         i = self._seg(s)
         return math.atan2(t[i, 1], t[i, 0])
 

@@ -13,7 +13,12 @@ from typing import Any, ClassVar
 from visuomotor_gym.body import names
 from visuomotor_gym.body import walker_names as wn
 from visuomotor_gym.body.walker import GaitParams
-from visuomotor_gym.body.walker_body import TURNING_WALKER_BLOCKS, WALKER_BLOCKS, TurningWalkerBody, WalkerBody
+from visuomotor_gym.body.walker_body import (
+    TURNING_WALKER_BLOCKS,
+    WALKER_BLOCKS,
+    TurningWalkerBody,
+    WalkerBody,
+)
 from visuomotor_gym.core import args
 from visuomotor_gym.core.env import MAX_VISION_NOISE_SCALE, MAX_VISUAL_DELAY_S, VisuomotorEnv  # noqa: F401 (re-exported)
 from visuomotor_gym.core.eye import EYE_BLOCKS

@@ -760,7 +760,22 @@ def top_points_of(obstacles: np.ndarray) -> np.ndarray:
 _UNSEEN_SLOT = [0.0] * (4 * N_POINTS)
 
 
-__all__ = ["COURSE_PRESETS", "DENSE_ROUGH_COURSE", "KINDS", "K_SLOTS", "LAYOUTS", "N_POINTS", "ROUGH_COURSE", "TOP_POINTS", "WINDING_COURSE", "Course",
-           "WindingPath", "sample_path",
-           "CourseDistribution", "ObstacleWalkTask",
-           "sample_course", "top_points", "top_points_of"]
+__all__ = [
+    "COURSE_PRESETS",
+    "DENSE_ROUGH_COURSE",
+    "KINDS",
+    "K_SLOTS",
+    "LAYOUTS",
+    "N_POINTS",
+    "ROUGH_COURSE",
+    "TOP_POINTS",
+    "WINDING_COURSE",
+    "Course",
+    "CourseDistribution",
+    "ObstacleWalkTask",
+    "WindingPath",
+    "sample_course",
+    "sample_path",
+    "top_points",
+    "top_points_of",
+]
