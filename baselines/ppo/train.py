@@ -340,6 +340,7 @@ def main(argv=None) -> Path:
     if config["algo"] == "RecurrentPPO":
         from sb3_contrib import RecurrentPPO
 
+        common["policy_kwargs"]["lstm_hidden_size"] = int(config.get("lstm_hidden_size", 256))
         model = RecurrentPPO("MlpLstmPolicy", train_env, **common)
     elif config["algo"] == "PPO":
         model = PPO("MlpPolicy", train_env, **common)
@@ -350,10 +351,26 @@ def main(argv=None) -> Path:
     # 3. Callbacks: evaluation on the registered env (with the training normalisation), checkpoints,
     #    and the wall-clock budget.
     class SyncNormalization(EvalCallback):
+        """EvalCallback with the training normalisation, and the wall time of each evaluation
+        (``eval/wall_time.json``, one row per evaluation: transitions, seconds since training started
+        before it ran, earlier evaluations included, and its own seconds; for learning curves against
+        wall time; ``eval/evaluations.npz`` holds the outcomes)."""
+
+        def _init_callback(self) -> None:
+            super()._init_callback()
+            self.wall = []
+
         def _on_step(self) -> bool:
-            if isinstance(train_env, VecNormalize) and self.eval_freq > 0 and self.n_calls % self.eval_freq == 0:
+            due = self.eval_freq > 0 and self.n_calls % self.eval_freq == 0
+            if isinstance(train_env, VecNormalize) and due:
                 eval_env.obs_rms = copy.deepcopy(train_env.obs_rms)
-            return super()._on_step()
+            elapsed = time.time() - start  # before the evaluation runs: training time to this point
+            keep_going = super()._on_step()
+            if due:
+                self.wall.append({"timesteps": int(self.num_timesteps), "wall_s": round(elapsed, 2),
+                                  "eval_wall_s": round(time.time() - start - elapsed, 2)})
+                (run_dir / "eval" / "wall_time.json").write_text(json.dumps(self.wall, indent=1))
+            return keep_going
 
     from stable_baselines3.common.callbacks import BaseCallback
 
