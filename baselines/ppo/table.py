@@ -143,7 +143,7 @@ def learning_curve(run_dir: Path) -> list[dict]:
     rows = []
     for i, steps in enumerate(z["timesteps"]):
         row = {"timesteps": int(steps), "wall_s": wall.get(int(steps)),
-               "mean_return": float(np.mean(z["results"][i]))}
+               "mean_return": float(np.mean(z["results"][i])), "mean_length": float(np.mean(z["ep_lengths"][i]))}
         if "successes" in z.files and len(z["successes"]) > i:
             row["success_rate"] = float(np.mean(z["successes"][i]))
         rows.append(row)
@@ -168,6 +168,7 @@ def parse_args(argv=None) -> argparse.Namespace:
     p.add_argument("--doc", default="docs/baselines/rl.md", help="--collect: the page whose table is replaced")
     p.add_argument("--images", default="docs/baselines/images", help="--collect: where the curves go")
     p.add_argument("--budget", type=int, default=100_000, help="--collect: the budget of the table's cells")
+    p.add_argument("--data", default="", help="--collect: also copy the table's cell JSONs into this folder")
     args = p.parse_args(argv)
     if args.collect is None:
         if not args.env:
@@ -272,6 +273,7 @@ def run_cell(args: argparse.Namespace, argv: list[str]) -> Path:
                    "format": "ppo-npz"},
         "under_current_definition": family in UNSETTLED,
         "command": command,
+        "run_dir": str(run_dir),
         "train_command": shlex.join(["python", *shlex.split((run_dir / "command.txt").read_text())[1:]]),
         "argv": argv,
         "versions": versions(),
@@ -314,10 +316,12 @@ def table_markdown(cells: list[dict], budget: int) -> str:
     for c in cells:
         if c["budget_transitions"] == budget and c["episodes"] == EPISODES:
             by_key.setdefault((c["env_id"], c["algo"]), []).append(c)
+    from visuomotor_gym.families import family_for
+
     lines = [
-        "| family | env id | algorithm | success [95 % Wilson] | gaze realism | foveation share | saccades / episode "
-        "| transitions | train wall | policy |",
-        "|---|---|---|---|---|---|---|---|---|---|",
+        "| family | env id | algorithm | success [95 % Wilson] | failed episodes (median) | gaze realism "
+        "| foveation share | saccades / episode | transitions | train wall | policy |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     not_run = []
     for family, foveated, oracle in FAMILY_ROWS:
@@ -326,15 +330,19 @@ def table_markdown(cells: list[dict], budget: int) -> str:
                 group = sorted(by_key.get((env_id, algo), []), key=lambda c: c["seed"])
                 label = f"{env_id}" + (" (under the current definition)" if family in UNSETTLED else "")
                 if not group:
-                    lines.append(f"| {family} | {label} | {algo} | not run | | | | | | |")
+                    lines.append(f"| {family} | {label} | {algo} | not run | | | | | | | |")
                     not_run.append(cell_command(env_id, algo_key, budget, 0))
                     continue
+                miss_label = family_for(env_id).outcome_labels[2].replace(", failed walks", "").replace(
+                    ", failed reaches", "").replace(", failed crossings", "")
                 for c in group:
                     lo, hi = c["success_rate_ci95"]
                     fov = c["foveation"]
+                    miss = (c.get("results") or {}).get("miss_distance_m", {}).get("median")
+                    miss_text = "–" if miss is None else f"{miss_label} {miss:.3g}"
                     lines.append(
                         f"| {family} | {label} | {algo} (seed {c['seed']}) | **{_pct(c['success_rate'])}** "
-                        f"[{100 * lo:.1f}, {100 * hi:.1f}] | {c['gaze_realism']:.3f} | "
+                        f"[{100 * lo:.1f}, {100 * hi:.1f}] | {miss_text} | {c['gaze_realism']:.3f} | "
                         f"{_pct(fov['value'])} ({fov['component']}) | {c['saccades_per_episode']:.1f} | "
                         f"{c['transitions']:,} | {c['train_wall_s'] / 60:.1f} min | "
                         f"`{Path(c['policy']['file']).name}` |")
@@ -345,8 +353,8 @@ def table_markdown(cells: list[dict], budget: int) -> str:
 
 
 def plot_curves(cells: list[dict], budget: int, out_dir: Path) -> list[Path]:
-    """Success of the EvalCallback's held-out episodes against transitions and against wall time, one
-    panel pair per family."""
+    """Success of the EvalCallback's held-out episodes against transitions and against wall time, and
+    their mean length (steps) against transitions, one row of panels per family."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -357,7 +365,7 @@ def plot_curves(cells: list[dict], budget: int, out_dir: Path) -> list[Path]:
     if not cells:
         return []
     families = [f for f, _, _ in FAMILY_ROWS if any(c["family"] == f for c in cells)]
-    fig, axes = plt.subplots(len(families), 2, figsize=(10, 2.6 * len(families)), squeeze=False)
+    fig, axes = plt.subplots(len(families), 3, figsize=(13, 2.6 * len(families)), squeeze=False)
     for row, family in enumerate(families):
         for c in cells:
             if c["family"] != family:
@@ -369,14 +377,18 @@ def plot_curves(cells: list[dict], budget: int, out_dir: Path) -> list[Path]:
             style = "-" if c["rung"] == "foveated" else "--"
             marker = "o" if c["algo"] == "PPO" else "s"
             label = f"{c['env_id']} {c['algo']} s{c['seed']}"
+            ls = [p.get("mean_length", float("nan")) for p in curve]
             axes[row, 0].plot(xs, ys, style, marker=marker, label=label)
             axes[row, 1].plot(ws, ys, style, marker=marker, label=label)
+            axes[row, 2].plot(xs, ls, style, marker=marker, label=label)
         axes[row, 0].set_ylabel(f"{family}: success %")
         axes[row, 0].set_ylim(-3, 103)
         axes[row, 1].set_ylim(-3, 103)
-        axes[row, 1].legend(fontsize=7, loc="best")
+        axes[row, 2].set_ylabel("episode steps")
+        axes[row, 2].legend(fontsize=7, loc="best")
     axes[-1, 0].set_xlabel("transitions")
     axes[-1, 1].set_xlabel("wall time (min, this machine, shared CPU)")
+    axes[-1, 2].set_xlabel("transitions")
     fig.suptitle(f"Free-gaze PPO / RecurrentPPO, EvalCallback held-out episodes (budget {budget_tag(budget)})",
                  fontsize=10)
     fig.tight_layout()
@@ -399,6 +411,13 @@ def collect(args: argparse.Namespace) -> str:
         _, tail = rest.split(MARK_END, 1)
         doc.write_text(f"{head}{MARK_BEGIN}\n{table}{MARK_END}{tail}")
     print(table)
+    if args.data:
+        data = Path(args.data)
+        data.mkdir(parents=True, exist_ok=True)
+        for c in cells:
+            if c["budget_transitions"] == args.budget and c["episodes"] == EPISODES:
+                body = {k: v for k, v in c.items() if not k.startswith("_")}
+                (data / f"{c['cell']}.json").write_text(json.dumps(body, indent=1) + "\n")
     for path in plot_curves(cells, args.budget, Path(args.images)):
         print(f"wrote {path}")
     return table

@@ -1,7 +1,13 @@
-"""Train PPO (or RecurrentPPO) on an EyeCatch env with stable-baselines3, top to bottom.
+"""Train PPO (or RecurrentPPO) on any registered env id with stable-baselines3, top to bottom.
 
     python -m visuomotor_gym.baselines.ppo.train --env EyeCatchOracle-v0 --timesteps 2000000
     vmgym train ppo --env EyeCatch-v0 --timesteps 3000000 --minutes 55
+    vmgym train ppo --env SteppingStones-v0 --recurrent --timesteps 100000
+
+Every registered id has hyperparameters in ``hyperparams.yml``: the catch ids default to the project's
+recipe (belief features, intercept hand action); every other family plays free gaze (the env's own
+actions) with its named training-only shaping term. ``--belief no --hand-action absolute`` gives the
+catch ids free gaze too (the RL baseline table, ``table.py``).
 
 Steps: read the hyperparameters for the env id (``hyperparams.yml``, a ``default`` plus per-id
 overrides, then command-line overrides), make the vectorised training env (shaped reward, optional
