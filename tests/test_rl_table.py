@@ -158,6 +158,12 @@ def test_table_cell_trains_evaluates_and_collects(tmp_path, capsys):
     assert cell["learning_curve"] and cell["learning_curve"][0]["wall_s"] is not None
     assert "--episodes 3" in cell["command"] and "--set n_envs=2" in cell["command"]
     assert (tmp_path / "pol" / "recurrentppo-free-256__SteppingStonesOracle-v0.npz").is_file()
+    cell_path = out / "cells" / "SteppingStonesOracle-v0__recurrentppo__s0__256.json"
+    assert table.main(["--twin", str(cell_path)]) == 0  # the held twin on the same (3) seeds
+    cell = json.loads(cell_path.read_text())
+    twin = cell["held_twin"]
+    assert twin["agent"].startswith("gaze_blind:ppo:") and twin["agent"].endswith(".npz")
+    assert twin["held_difference"] == pytest.approx(cell["success_rate"] - twin["success_rate"])
     assert table.main(argv) == 2  # never overwritten
     assert "never overwritten" in capsys.readouterr().err
     # Collect: a 3-episode cell is not a table cell; a 200-episode cell at the budget fills its row.

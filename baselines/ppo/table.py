@@ -165,11 +165,17 @@ def parse_args(argv=None) -> argparse.Namespace:
                         f"--collect leaves such cells out)")
     p.add_argument("--set", nargs="*", default=[], help="hyperparameter overrides (train.py --set), recorded in the cell")
     p.add_argument("--collect", nargs="*", metavar="DIR", help="collect the cells under these folders instead")
+    p.add_argument("--twin", nargs="*", metavar="CELL",
+                   help="add the held (gaze-blind) twin of these cell JSONs' policies, on the same seeds, to them")
     p.add_argument("--doc", default="docs/baselines/rl.md", help="--collect: the page whose table is replaced")
     p.add_argument("--images", default="docs/baselines/images", help="--collect: where the curves go")
     p.add_argument("--budget", type=int, default=100_000, help="--collect: the budget of the table's cells")
     p.add_argument("--data", default="", help="--collect: also copy the table's cell JSONs into this folder")
     args = p.parse_args(argv)
+    if args.twin is not None:
+        if not args.twin:
+            raise TableArgumentError("--twin needs at least one cell JSON")
+        return args
     if args.collect is None:
         if not args.env:
             raise TableArgumentError("--env is required (or --collect DIR ...)")
@@ -290,6 +296,27 @@ def run_cell(args: argparse.Namespace, argv: list[str]) -> Path:
     return cell_path
 
 
+def add_twin(path: Path, workers: int = 1) -> dict:
+    """The held twin of a cell's policy (``gaze_blind:ppo:<file>``: the same policy with its gaze and head
+    held where reset put them) on the cell's seeds, and the held-twin difference (success minus the twin's),
+    written into the cell as ``held_twin``. (The best static twin needs a posture searched for the policy,
+    ``static_gaze search``; none is searched for the table's policies.)"""
+    from visuomotor_gym.bench.evaluate import evaluate, twin_spec
+
+    cell = json.loads(path.read_text())
+    agent = twin_spec(f"ppo:{cell['policy']['file']}")
+    t0 = time.time()
+    twin = evaluate(agent, cell["env_id"], int(cell["episodes"]), 0, workers=workers)
+    s = twin.summary
+    cell["held_twin"] = {"agent": agent, "success_rate": float(s["success_rate"]),
+                         "success_rate_ci95": [float(x) for x in s["success_rate_ci95"]],
+                         "held_difference": cell["success_rate"] - float(s["success_rate"]),
+                         "eval_wall_s": round(time.time() - t0, 1)}
+    path.write_text(json.dumps(cell, indent=1) + "\n")
+    print(f"{cell['cell']}: held twin {s['success_rate']:.3f}, difference {cell['held_twin']['held_difference']:+.3f}")
+    return cell
+
+
 # ----------------------------------------------------------------------------------------- collect
 
 
@@ -310,6 +337,13 @@ def _pct(x) -> str:
     return "–" if x is None else f"{100 * x:.1f} %"
 
 
+def _twin_text(cell: dict) -> str:
+    twin = cell.get("held_twin")
+    if not twin:
+        return "–"
+    return f"{_pct(twin['success_rate'])} ({100 * twin['held_difference']:+.1f} pts)"
+
+
 def table_markdown(cells: list[dict], budget: int) -> str:
     """The table: one row per (family, rung, algorithm), the cells at ``budget`` (seeds pooled as rows)."""
     by_key: dict[tuple, list[dict]] = {}
@@ -320,8 +354,8 @@ def table_markdown(cells: list[dict], budget: int) -> str:
 
     lines = [
         "| family | env id | algorithm | success [95 % Wilson] | failed episodes (median) | gaze realism "
-        "| foveation share | saccades / episode | transitions | train wall | policy |",
-        "|---|---|---|---|---|---|---|---|---|---|---|",
+        "| foveation share | saccades / episode | held twin (difference) | transitions | train wall | policy |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     not_run = []
     for family, foveated, oracle in FAMILY_ROWS:
@@ -330,7 +364,7 @@ def table_markdown(cells: list[dict], budget: int) -> str:
                 group = sorted(by_key.get((env_id, algo), []), key=lambda c: c["seed"])
                 label = f"{env_id}" + (" (under the current definition)" if family in UNSETTLED else "")
                 if not group:
-                    lines.append(f"| {family} | {label} | {algo} | not run | | | | | | | |")
+                    lines.append(f"| {family} | {label} | {algo} | not run | | | | | | | | |")
                     not_run.append(cell_command(env_id, algo_key, budget, 0))
                     continue
                 miss_label = family_for(env_id).outcome_labels[2].replace(", failed walks", "").replace(
@@ -344,6 +378,7 @@ def table_markdown(cells: list[dict], budget: int) -> str:
                         f"| {family} | {label} | {algo} (seed {c['seed']}) | **{_pct(c['success_rate'])}** "
                         f"[{100 * lo:.1f}, {100 * hi:.1f}] | {miss_text} | {c['gaze_realism']:.3f} | "
                         f"{_pct(fov['value'])} ({fov['component']}) | {c['saccades_per_episode']:.1f} | "
+                        f"{_twin_text(c)} | "
                         f"{c['transitions']:,} | {c['train_wall_s'] / 60:.1f} min | "
                         f"`{Path(c['policy']['file']).name}` |")
     text = "\n".join(lines) + "\n"
@@ -427,7 +462,10 @@ def main(argv=None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     try:
         args = parse_args(argv)
-        if args.collect is not None:
+        if args.twin is not None:
+            for path in args.twin:
+                add_twin(Path(path), args.workers)
+        elif args.collect is not None:
             collect(args)
         else:
             run_cell(args, argv)
