@@ -28,6 +28,7 @@ say so, with their command) between the ``<!-- rl-table -->`` markers of the doc
 from __future__ import annotations
 
 import argparse
+import contextlib
 import hashlib
 import json
 import math
@@ -140,12 +141,24 @@ def learning_curve(run_dir: Path) -> list[dict]:
     z = np.load(path, allow_pickle=False)
     wall_path = run_dir / "eval" / "wall_time.json"
     wall = {w["timesteps"]: w["wall_s"] for w in json.loads(wall_path.read_text())} if wall_path.is_file() else {}
+    train_rows = []  # (transitions, shaped training return) from SB3's progress.csv (Monitor: raw rewards)
+    progress = run_dir / "progress.csv"
+    if progress.is_file():
+        import csv
+
+        with progress.open() as fh:
+            for rec in csv.DictReader(fh):
+                with contextlib.suppress(KeyError, ValueError, TypeError):
+                    train_rows.append((int(float(rec["time/total_timesteps"])), float(rec["rollout/ep_rew_mean"])))
     rows = []
     for i, steps in enumerate(z["timesteps"]):
         row = {"timesteps": int(steps), "wall_s": wall.get(int(steps)),
                "mean_return": float(np.mean(z["results"][i])), "mean_length": float(np.mean(z["ep_lengths"][i]))}
         if "successes" in z.files and len(z["successes"]) > i:
             row["success_rate"] = float(np.mean(z["successes"][i]))
+        before = [r for t, r in train_rows if t <= int(steps)]
+        if before:  # the training episodes' shaped return (stochastic policy), last logged at this point
+            row["train_shaped_return"] = before[-1]
         rows.append(row)
     return rows
 
@@ -388,8 +401,9 @@ def table_markdown(cells: list[dict], budget: int) -> str:
 
 
 def plot_curves(cells: list[dict], budget: int, out_dir: Path) -> list[Path]:
-    """Success of the EvalCallback's held-out episodes against transitions and against wall time, and
-    their mean length (steps) against transitions, one row of panels per family."""
+    """Success of the EvalCallback's held-out episodes against transitions and against wall time, their
+    mean length (steps) against transitions, and the training episodes' shaped return, one row of panels
+    per family."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -400,7 +414,7 @@ def plot_curves(cells: list[dict], budget: int, out_dir: Path) -> list[Path]:
     if not cells:
         return []
     families = [f for f, _, _ in FAMILY_ROWS if any(c["family"] == f for c in cells)]
-    fig, axes = plt.subplots(len(families), 3, figsize=(13, 2.6 * len(families)), squeeze=False)
+    fig, axes = plt.subplots(len(families), 4, figsize=(16, 2.6 * len(families)), squeeze=False)
     for row, family in enumerate(families):
         for c in cells:
             if c["family"] != family:
@@ -416,14 +430,18 @@ def plot_curves(cells: list[dict], budget: int, out_dir: Path) -> list[Path]:
             axes[row, 0].plot(xs, ys, style, marker=marker, label=label)
             axes[row, 1].plot(ws, ys, style, marker=marker, label=label)
             axes[row, 2].plot(xs, ls, style, marker=marker, label=label)
+            axes[row, 3].plot(xs, [p.get("train_shaped_return", float("nan")) for p in curve], style, marker=marker,
+                              label=label)
         axes[row, 0].set_ylabel(f"{family}: success %")
         axes[row, 0].set_ylim(-3, 103)
         axes[row, 1].set_ylim(-3, 103)
         axes[row, 2].set_ylabel("episode steps")
-        axes[row, 2].legend(fontsize=7, loc="best")
+        axes[row, 3].set_ylabel("training return (shaped)")
+        axes[row, 3].legend(fontsize=7, loc="best")
     axes[-1, 0].set_xlabel("transitions")
     axes[-1, 1].set_xlabel("wall time (min, this machine, shared CPU)")
     axes[-1, 2].set_xlabel("transitions")
+    axes[-1, 3].set_xlabel("transitions")
     fig.suptitle(f"Free-gaze PPO / RecurrentPPO, EvalCallback held-out episodes (budget {budget_tag(budget)})",
                  fontsize=10)
     fig.tight_layout()
