@@ -156,6 +156,7 @@ def test_table_cell_trains_evaluates_and_collects(tmp_path, capsys):
     assert cell["results"]["episodes"] == 3 and cell["success_rate"] == cell["results"]["success_rate"]
     assert cell["foveation"]["component"] == "stone_fixation_share" and cell["saccades_per_episode"] >= 0
     assert cell["learning_curve"] and cell["learning_curve"][0]["wall_s"] is not None
+    assert "train_shaped_return" in cell["learning_curve"][-1]  # from progress.csv
     assert "--episodes 3" in cell["command"] and "--set n_envs=2" in cell["command"]
     assert (tmp_path / "pol" / "recurrentppo-free-256__SteppingStonesOracle-v0.npz").is_file()
     cell_path = out / "cells" / "SteppingStonesOracle-v0__recurrentppo__s0__256.json"
