@@ -147,19 +147,19 @@ def test_every_registered_id_has_hyperparameters_and_the_non_catch_ones_play_fre
 
 def test_table_cell_trains_evaluates_and_collects(tmp_path, capsys):
     out = tmp_path / "t"
-    argv = ["--env", "SteppingStonesOracle-v0", "--algo", "recurrentppo", "--timesteps", "256", "--out", str(out),
+    argv = ["--env", "SteppingStonesOracle-v0", "--algo", "recurrentppo", "--timesteps", "512", "--out", str(out),
             "--episodes", "3", "--policy-dir", str(tmp_path / "pol"),
             "--set", "n_envs=2", "n_steps=128", "batch_size=128"]
     assert table.main(argv) == 0
-    cell = json.loads((out / "cells" / "SteppingStonesOracle-v0__recurrentppo__s0__256.json").read_text())
-    assert cell["algo"] == "RecurrentPPO" and cell["episodes"] == 3 and cell["transitions"] >= 256
+    cell = json.loads((out / "cells" / "SteppingStonesOracle-v0__recurrentppo__s0__512.json").read_text())
+    assert cell["algo"] == "RecurrentPPO" and cell["episodes"] == 3 and cell["transitions"] >= 512
     assert cell["results"]["episodes"] == 3 and cell["success_rate"] == cell["results"]["success_rate"]
     assert cell["foveation"]["component"] == "stone_fixation_share" and cell["saccades_per_episode"] >= 0
     assert cell["learning_curve"] and cell["learning_curve"][0]["wall_s"] is not None
     assert "train_shaped_return" in cell["learning_curve"][-1]  # from progress.csv
     assert "--episodes 3" in cell["command"] and "--set n_envs=2" in cell["command"]
-    assert (tmp_path / "pol" / "recurrentppo-free-256__SteppingStonesOracle-v0.npz").is_file()
-    cell_path = out / "cells" / "SteppingStonesOracle-v0__recurrentppo__s0__256.json"
+    assert (tmp_path / "pol" / "recurrentppo-free-512__SteppingStonesOracle-v0.npz").is_file()
+    cell_path = out / "cells" / "SteppingStonesOracle-v0__recurrentppo__s0__512.json"
     assert table.main(["--twin", str(cell_path)]) == 0  # the held twin on the same (3) seeds
     cell = json.loads(cell_path.read_text())
     twin = cell["held_twin"]
@@ -170,17 +170,17 @@ def test_table_cell_trains_evaluates_and_collects(tmp_path, capsys):
     # Collect: a 3-episode cell is not a table cell; a 200-episode cell at the budget fills its row.
     doc = tmp_path / "rl.md"
     doc.write_text(f"# x\n{table.MARK_BEGIN}\nold\n{table.MARK_END}\nafter\n")
-    full = dict(cell, episodes=200, budget_transitions=256, cell="x")
+    full = dict(cell, episodes=200, budget_transitions=512, cell="x")
     (out / "cells" / "full.json").write_text(json.dumps(full))
     assert table.main(["--collect", str(out), "--doc", str(doc), "--images", str(tmp_path / "img"),
-                       "--budget", "256"]) == 0
+                       "--budget", "512"]) == 0
     text = doc.read_text()
     assert "old" not in text and text.endswith("after\n")
     rows = [line for line in text.splitlines() if line.startswith("| stones | SteppingStonesOracle-v0")]
     assert len(rows) == 2 and "RecurrentPPO (seed 0)" in rows[1] and "not run" in rows[0]
     assert text.count("not run") == 19  # 5 families x 2 rungs x 2 algorithms, one filled
-    assert "--env SteppingStones-v0 --algo ppo --timesteps 256" in text
-    assert (tmp_path / "img" / "rl_curves_256.png").is_file()
+    assert "--env SteppingStones-v0 --algo ppo --timesteps 512" in text
+    assert (tmp_path / "img" / "rl_curves_512.png").is_file()
 
 
 def test_table_refuses_bad_arguments(capsys):
