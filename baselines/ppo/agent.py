@@ -63,10 +63,16 @@ NPZ_META_NUMBERS = {
 }
 NPZ_META_STRINGS = ("algo", "env_id", "hand_action", "gaze_action")
 NPZ_META_BOOLS = ("belief",)
+# RecurrentPPO (format "ppo-npz" with ``network.kind = "lstm_mlp"``): the actor's one-layer LSTM as four
+# arrays named in ``network.lstm`` (PyTorch's nn.LSTM layout: gates i, f, g, o stacked along rows).
+NPZ_LSTM_ARRAYS = ("weight_ih", "weight_hh", "bias_ih", "bias_hh")
 NPZ_ACTIVATIONS = ("tanh", "relu", "elu", "leaky_relu", "silu", "gelu", "sigmoid")
 # Observations on which pack_npz proves the rebuilt actor equal to the SB3 model (modelling choice:
 # 2000 single-observation calls take well under a second and cover the clipped normalised range).
 NPZ_PROOF_OBSERVATIONS = 2000
+# A recurrent actor is proven on one stream of observations with a new episode every 100 steps (modelling
+# choice: each state carried across ~100 steps and reset ~20 times in the default 2000).
+NPZ_PROOF_EPISODE = 100
 _ZIP_DATE = (1980, 1, 1, 0, 0, 0)  # fixed member dates: the same model packs to the same bytes
 
 
@@ -293,6 +299,22 @@ def network_budget(record: dict, shapes: dict[str, tuple[int, ...]]) -> dict[str
         raise PolicyFileError(f"$.network.layers has {len(layers)} layers, more than the {NPZ_MAX_LAYERS} allowed")
     refs: list[str] = []
     params = flops = 0
+    lstm = net.get("lstm")
+    if lstm is not None:  # RecurrentPPO's actor LSTM (one layer) before the layers
+        if not isinstance(lstm, dict):
+            raise PolicyFileError("$.network.lstm must be an object")
+        for key in NPZ_LSTM_ARRAYS:
+            ref = lstm.get(key)
+            if not isinstance(ref, str) or ref not in shapes:
+                raise PolicyFileError(f"$.network.lstm.{key}: array {ref!r} is missing")
+            refs.append(ref)
+        w_ih, w_hh = shapes[lstm["weight_ih"]], shapes[lstm["weight_hh"]]
+        if len(w_ih) != 2 or len(w_hh) != 2 or max(*w_ih, *w_hh) > 4 * NPZ_MAX_WIDTH:
+            raise PolicyFileError(f"$.network.lstm: weights {w_ih} / {w_hh} must be 2-D with at most "
+                                  f"{NPZ_MAX_WIDTH} hidden units")
+        for key in NPZ_LSTM_ARRAYS:
+            params += math.prod(shapes[lstm[key]])
+        flops += 2 * (math.prod(w_ih) + math.prod(w_hh)) + 10 * w_hh[0]  # gates: mat-vecs + elementwise
     for i, layer in enumerate(layers):
         if not isinstance(layer, dict):
             raise PolicyFileError(f"$.network.layers[{i}] must be an object")
@@ -354,8 +376,11 @@ def _check_record(record: dict, arrays: dict[str, np.ndarray]) -> None:
         raise PolicyFileError(f"unknown keys {extra} in {NPZ_RECORD} (allowed: {sorted(allowed)})")
     net = need(record, "network", dict, "$")
     meta = need(record, "meta", dict, "$")
-    if need(meta, "algo", str, "$.meta") != "PPO":
-        raise PolicyFileError(f"$.meta.algo must be 'PPO', got {meta['algo']!r}")
+    recurrent = net.get("lstm") is not None
+    algo = "RecurrentPPO" if recurrent else "PPO"
+    if need(meta, "algo", str, "$.meta") != algo:
+        raise PolicyFileError(f"$.meta.algo must be {algo!r} for a network "
+                              f"{'with' if recurrent else 'without'} $.network.lstm, got {meta['algo']!r}")
     network_budget(record, {k: v.shape for k, v in arrays.items()})
     obs_dim = need(net, "obs_dim", int, "$.network")
     action_dim = need(net, "action_dim", int, "$.network")
@@ -366,6 +391,19 @@ def _check_record(record: dict, arrays: dict[str, np.ndarray]) -> None:
     if not layers:
         raise PolicyFileError("$.network.layers is empty")
     width = obs_dim
+    if recurrent:
+        lstm = net["lstm"]
+        hidden = need(lstm, "hidden_size", int, "$.network.lstm")
+        if not 1 <= hidden <= NPZ_MAX_WIDTH:
+            raise PolicyFileError(f"$.network.lstm.hidden_size must be in [1, {NPZ_MAX_WIDTH}], got {hidden}")
+        want = {"weight_ih": (4 * hidden, obs_dim), "weight_hh": (4 * hidden, hidden), "bias_ih": (4 * hidden,),
+                "bias_hh": (4 * hidden,)}
+        for key, shape in want.items():
+            got = arrays[lstm[key]].shape
+            if got != shape:
+                raise PolicyFileError(f"$.network.lstm.{key}: array {lstm[key]!r} has shape {got}, an LSTM of "
+                                      f"{hidden} units on {obs_dim} inputs needs {shape}")
+        width = hidden
     for i, layer in enumerate(layers):
         where = f"$.network.layers[{i}]"
         w = arrays.get(need(layer, "weight", str, where))
@@ -400,7 +438,9 @@ def _check_record(record: dict, arrays: dict[str, np.ndarray]) -> None:
 class NpzActor:
     """The deterministic actor of a ``ppo-npz`` file: a ``torch.nn.Sequential`` built from the JSON
     record, with the arrays copied in; ``__call__(obs) -> action`` as SB3's ``predict(deterministic=True)``
-    computes it for a flat Box observation (batch of one, float32, action clipped to the action space)."""
+    computes it for a flat Box observation (batch of one, float32, action clipped to the action space).
+    With ``network.lstm`` (RecurrentPPO) an ``nn.LSTM`` comes first and its state is carried from call to
+    call (:meth:`reset` or ``episode_start=True`` starts it from zeros)."""
 
     def __init__(self, record: dict, arrays: dict[str, np.ndarray]):
         import torch
@@ -408,6 +448,18 @@ class NpzActor:
 
         _check_record(record, arrays)
         net = record["network"]
+        self.lstm = None
+        self.state = None  # (h, c) of the LSTM, carried across steps; None: zeros at the next step
+        if net.get("lstm") is not None:
+            spec = net["lstm"]
+            self.lstm = nn.LSTM(int(net["obs_dim"]), int(spec["hidden_size"]), num_layers=1)
+            with torch.no_grad():
+                for key in NPZ_LSTM_ARRAYS:
+                    getattr(self.lstm, f"{key}_l0").copy_(torch.from_numpy(np.array(arrays[spec[key]], dtype=np.float32)))
+            self.lstm.eval()
+            for param in self.lstm.parameters():
+                param.requires_grad_(False)
+            self.hidden_size = int(spec["hidden_size"])
         modules = []
         for layer in net["layers"]:
             w, b = arrays[layer["weight"]], arrays[layer["bias"]]
@@ -426,11 +478,28 @@ class NpzActor:
         self.high = np.asarray(net["action_high"], dtype=np.float32)
         self._torch = torch
 
-    def __call__(self, obs: np.ndarray) -> np.ndarray:
+    @property
+    def recurrent(self) -> bool:
+        return self.lstm is not None
+
+    def reset(self) -> None:
+        """Forget the LSTM state (a new episode); nothing to do for an MLP actor."""
+        self.state = None
+
+    def __call__(self, obs: np.ndarray, episode_start: bool = False) -> np.ndarray:
+        """The deterministic action; a recurrent actor carries its LSTM state to the next call and starts
+        from zeros at ``episode_start`` (as sb3-contrib's ``RecurrentPPO.predict``)."""
         torch = self._torch
         x = np.asarray(obs, dtype=np.float32).reshape(1, self.obs_dim)
         with torch.no_grad():
-            out = self.net(torch.as_tensor(x)).numpy()
+            h = torch.as_tensor(x)
+            if self.lstm is not None:
+                if episode_start or self.state is None:
+                    zeros = torch.zeros((1, 1, self.hidden_size), dtype=torch.float32)
+                    self.state = (zeros, zeros.clone())
+                out, self.state = self.lstm(h.reshape(1, 1, self.obs_dim), self.state)
+                h = out.reshape(1, self.hidden_size)
+            out = self.net(h).numpy()
         return np.clip(out.reshape(-1, self.low.shape[0]), self.low, self.high)[0]
 
 
@@ -441,9 +510,12 @@ def npz_from_model(model, meta: dict) -> bytes:
     from stable_baselines3.common.torch_layers import FlattenExtractor
 
     policy = model.policy
-    if meta.get("algo") != "PPO" or type(model).__name__ != "PPO":
-        raise ValueError(f"only PPO (MlpPolicy) policies have a pickle-free form; this is {meta.get('algo')!r} "
-                         f"(RecurrentPPO's LSTM is not supported yet)")
+    recurrent = type(model).__name__ == "RecurrentPPO"
+    if meta.get("algo") != type(model).__name__ or type(model).__name__ not in ("PPO", "RecurrentPPO"):
+        raise ValueError(f"only PPO (MlpPolicy) and RecurrentPPO (MlpLstmPolicy) policies have a pickle-free "
+                         f"form; this is a {type(model).__name__} whose meta says {meta.get('algo')!r}")
+    if recurrent and policy.lstm_actor.num_layers != 1:
+        raise ValueError(f"the pickle-free form holds a one-layer LSTM; this actor has {policy.lstm_actor.num_layers}")
     obs_space, act_space = model.observation_space, model.action_space
     if not isinstance(obs_space, spaces.Box) or len(obs_space.shape) != 1:
         raise ValueError(f"needs a flat Box observation space, got {obs_space}")
@@ -472,22 +544,39 @@ def npz_from_model(model, meta: dict) -> bytes:
     keep = {k: v for k, v in meta.items() if not str(k).startswith("_")}
     import stable_baselines3
 
+    network = {
+        "kind": "mlp",
+        "description": "deterministic SB3 PPO actor: x = clip((obs - obs_mean) / sqrt(obs_var + epsilon), "
+                       "+-clip_obs) as float32 (after the belief features when meta.belief), then "
+                       "Linear/activation layers in order, then the action clipped to [action_low, action_high]",
+        "obs_dim": int(obs_space.shape[0]),
+        "action_dim": int(act_space.shape[0]),
+        "layers": layers,
+        "action_low": [float(x) for x in act_space.low],
+        "action_high": [float(x) for x in act_space.high],
+    }
+    source = {"converted_from": "stable-baselines3 PPO", "stable_baselines3": stable_baselines3.__version__}
+    if recurrent:
+        import sb3_contrib
+
+        lstm = policy.lstm_actor
+        for key in NPZ_LSTM_ARRAYS:
+            arrays[f"lstm.{key}"] = getattr(lstm, f"{key}_l0").detach().cpu().numpy().astype(np.float32)
+        network["kind"] = "lstm_mlp"
+        network["lstm"] = {"hidden_size": int(lstm.hidden_size), **{key: f"lstm.{key}" for key in NPZ_LSTM_ARRAYS}}
+        network["description"] = (
+            "deterministic sb3-contrib RecurrentPPO actor: x normalised as for PPO, then a one-layer LSTM "
+            "(torch.nn.LSTM, gates i,f,g,o; state (h, c) zero at an episode's first step and carried across "
+            "its steps), then Linear/activation layers in order on h, then the action clipped to "
+            "[action_low, action_high]")
+        source = {"converted_from": "sb3-contrib RecurrentPPO", "stable_baselines3": stable_baselines3.__version__,
+                  "sb3_contrib": sb3_contrib.__version__}
     record = {
         "format": NPZ_FORMAT,
         "format_version": NPZ_FORMAT_VERSION,
-        "network": {
-            "kind": "mlp",
-            "description": "deterministic SB3 PPO actor: x = clip((obs - obs_mean) / sqrt(obs_var + epsilon), "
-                           "+-clip_obs) as float32 (after the belief features when meta.belief), then "
-                           "Linear/activation layers in order, then the action clipped to [action_low, action_high]",
-            "obs_dim": int(obs_space.shape[0]),
-            "action_dim": int(act_space.shape[0]),
-            "layers": layers,
-            "action_low": [float(x) for x in act_space.low],
-            "action_high": [float(x) for x in act_space.high],
-        },
+        "network": network,
         "meta": keep,
-        "source": {"converted_from": "stable-baselines3 PPO", "stable_baselines3": stable_baselines3.__version__},
+        "source": source,
     }
     return _write_npz(record, arrays)
 
@@ -495,16 +584,23 @@ def npz_from_model(model, meta: dict) -> bytes:
 def prove_npz_equals_model(data: bytes, model, n: int = NPZ_PROOF_OBSERVATIONS, seed: int = 0) -> int:
     """Raise ValueError unless the actor rebuilt from ``data`` gives ``model.predict(obs, deterministic=True)``
     bit for bit on ``n`` observations (normal draws scaled to cover the clipped normalised range, plus
-    the corners +-clip); returns ``n``."""
+    the corners +-clip); returns ``n``. A recurrent actor plays them as one stream, carrying its LSTM
+    state as ``RecurrentPPO.predict`` does, with a new episode every :data:`NPZ_PROOF_EPISODE` steps."""
     record, arrays = read_npz(data)
     actor = NpzActor(record, arrays)
     clip = float(record["meta"].get("clip_obs", 10.0))
     rng = np.random.default_rng(seed)
     obs = (rng.standard_normal((n, actor.obs_dim)) * (clip / 3.0)).astype(np.float32)
     obs[0], obs[1 % n] = clip, -clip
+    state = None
     for i in range(n):
-        expected, _ = model.predict(obs[i], deterministic=True)
-        got = actor(obs[i])
+        if actor.recurrent:  # one stream of observations, a new episode every NPZ_PROOF_EPISODE steps
+            start = i % NPZ_PROOF_EPISODE == 0
+            expected, state = model.predict(obs[i], state=state, episode_start=np.array([start]), deterministic=True)
+            got = actor(obs[i], episode_start=start)
+        else:
+            expected, _ = model.predict(obs[i], deterministic=True)
+            got = actor(obs[i])
         if not np.array_equal(np.asarray(expected, dtype=np.float32), got):
             raise ValueError(f"the pickle-free actor differs from the SB3 model on observation {i}: "
                              f"{got.tolist()} vs {np.asarray(expected).tolist()}")
@@ -597,6 +693,8 @@ class PPOAgent:
     def reset(self) -> None:
         self.lstm_state = None
         self.last_policy_action = None
+        if self.actor is not None:
+            self.actor.reset()
         if self.features is not None:
             self.features.reset()
 
@@ -610,7 +708,7 @@ class PPOAgent:
         if self.mean is not None:
             obs = np.clip((obs - self.mean) / self.std, -self.clip, self.clip).astype(np.float32)
         if self.actor is not None:
-            action = self.actor(obs)
+            action = self.actor(obs, episode_start=start)
         elif self.meta["algo"] == "RecurrentPPO":
             action, self.lstm_state = self.model.predict(
                 obs, state=self.lstm_state, episode_start=np.array([start]), deterministic=True

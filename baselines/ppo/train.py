@@ -1,7 +1,13 @@
-"""Train PPO (or RecurrentPPO) on an EyeCatch env with stable-baselines3, top to bottom.
+"""Train PPO (or RecurrentPPO) on any registered env id with stable-baselines3, top to bottom.
 
     python -m visuomotor_gym.baselines.ppo.train --env EyeCatchOracle-v0 --timesteps 2000000
     vmgym train ppo --env EyeCatch-v0 --timesteps 3000000 --minutes 55
+    vmgym train ppo --env SteppingStones-v0 --recurrent --timesteps 100000
+
+Every registered id has hyperparameters in ``hyperparams.yml``: the catch ids default to the project's
+recipe (belief features, intercept hand action); every other family plays free gaze (the env's own
+actions) with its named training-only shaping term. ``--belief no --hand-action absolute`` gives the
+catch ids free gaze too (the RL baseline table, ``table.py``).
 
 Steps: read the hyperparameters for the env id (``hyperparams.yml``, a ``default`` plus per-id
 overrides, then command-line overrides), make the vectorised training env (shaped reward, optional
@@ -340,6 +346,7 @@ def main(argv=None) -> Path:
     if config["algo"] == "RecurrentPPO":
         from sb3_contrib import RecurrentPPO
 
+        common["policy_kwargs"]["lstm_hidden_size"] = int(config.get("lstm_hidden_size", 256))
         model = RecurrentPPO("MlpLstmPolicy", train_env, **common)
     elif config["algo"] == "PPO":
         model = PPO("MlpPolicy", train_env, **common)
@@ -350,10 +357,26 @@ def main(argv=None) -> Path:
     # 3. Callbacks: evaluation on the registered env (with the training normalisation), checkpoints,
     #    and the wall-clock budget.
     class SyncNormalization(EvalCallback):
+        """EvalCallback with the training normalisation, and the wall time of each evaluation
+        (``eval/wall_time.json``, one row per evaluation: transitions, seconds since training started
+        before it ran, earlier evaluations included, and its own seconds; for learning curves against
+        wall time; ``eval/evaluations.npz`` holds the outcomes)."""
+
+        def _init_callback(self) -> None:
+            super()._init_callback()
+            self.wall = []
+
         def _on_step(self) -> bool:
-            if isinstance(train_env, VecNormalize) and self.eval_freq > 0 and self.n_calls % self.eval_freq == 0:
+            due = self.eval_freq > 0 and self.n_calls % self.eval_freq == 0
+            if isinstance(train_env, VecNormalize) and due:
                 eval_env.obs_rms = copy.deepcopy(train_env.obs_rms)
-            return super()._on_step()
+            elapsed = time.time() - start  # before the evaluation runs: training time to this point
+            keep_going = super()._on_step()
+            if due:
+                self.wall.append({"timesteps": int(self.num_timesteps), "wall_s": round(elapsed, 2),
+                                  "eval_wall_s": round(time.time() - start - elapsed, 2)})
+                (run_dir / "eval" / "wall_time.json").write_text(json.dumps(self.wall, indent=1))
+            return keep_going
 
     from stable_baselines3.common.callbacks import BaseCallback
 
