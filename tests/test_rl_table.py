@@ -1,4 +1,4 @@
-"""The RL baseline table (issue 27): free-gaze PPO / RecurrentPPO trains on every family, its pickle-free
+"""The RL baseline table: free-gaze PPO / RecurrentPPO trains on every family, its pickle-free
 policy file reloads with the trained model's actions (LSTM state carried), and the table runner writes
 a cell and collects cells into Markdown."""
 

@@ -39,7 +39,7 @@ import sys
 import time
 from pathlib import Path
 
-# The table's rows (issue 27): every family's foveated -v0 and its Oracle rung, in the order cells are
+# The table's rows: every family's foveated -v0 and its Oracle rung, in the order cells are
 # filled (families whose envs are settled first).
 FAMILY_ROWS = (
     ("stones", "SteppingStones-v0", "SteppingStonesOracle-v0"),
@@ -59,7 +59,7 @@ FOVEATION_COMPONENT = {
     "reach": "object_fixation_share",
     "walk": "obstacle_fixation_share",
 }
-# Families whose default eye may still change in this round (issue 23): their cells are marked "under the
+# Families whose default eye may still change in this round: their cells are marked "under the
 # current definition" of the env.
 UNSETTLED = ("catch", "walk")
 EPISODES = 200  # the pinned seeds 0-199 of the common evaluator
