@@ -368,5 +368,5 @@ def test_bearing_ratio_drops_a_poor_depth_reading_and_keeps_its_direction():
             sample()
             sample(scale)
             est[ratio, scale] = mem.corners[0][0].estimate()[0].copy()
-    assert np.abs(est[0.0, 2.0] - est[0.0, 1.0]).max() < 1e-3
-    assert np.abs(est[None, 2.0] - est[None, 1.0]).max() > 0.01
+    assert np.abs(est[0.0, 2.0] - est[0.0, 1.0]).max() < 5e-4
+    assert np.abs(est[None, 2.0] - est[None, 1.0]).max() > 3e-3
