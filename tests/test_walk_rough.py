@@ -316,3 +316,57 @@ def test_the_memory_weights_a_peripheral_sample_as_shared_under_disarray(ecc_deg
     f = 1.0 + math.degrees(t) / 0.7
     w = 0.8 * (1.0 - 1.0 / f**2)
     assert info[0.0] / info[0.8] == pytest.approx(1.0 + (DISARRAY_LOOKS - 1) * w, rel=1e-9)
+
+
+def _memory_and_samples(**kw):
+    """An ObstacleMemory (human periphery, no disarray) and a sampler of one point 25 deg below a level
+    line of sight, on the plane 0.15 m above the floor, its perceived distance ``scale`` x the true one."""
+    import math
+
+    from visuomotor_gym.baselines.iwao.perception import ObstacleMemory
+
+    from visuomotor_gym.vision.foveation import human_periphery
+
+    t = math.radians(25.0)
+    d = 1.45 / math.sin(t)
+    mem = ObstacleMemory(human_periphery(position_disarray=0.0), height_prior=(0.06, 0.1), **kw)
+
+    def sample(scale=1.0):
+        mem.add(0, 0, (scale * d * math.cos(t), 0.0, -scale * d * math.sin(t)), [0.0, 0.0, 0.6], np.eye(3).tolist(),
+                (0.0, 0.0, 0.0, 1.0), vergence=3.0)
+
+    return mem, sample
+
+
+def test_image_eccentricity_weighs_a_sample_read_behind_the_eye_by_its_image():
+    """A depth reading beyond minus the distance puts the perceived point behind the eye. iwao v0 judges
+    the sample's eccentricity from that point (~155 deg: all but no information); with
+    ``image_eccentricity`` from the estimate's line of sight (25 deg): the same information as a sample
+    read at the true distance."""
+    gains = {}
+    for flag in (False, True):
+        for scale in (1.0, -0.5):
+            mem, sample = _memory_and_samples(image_eccentricity=flag)
+            sample()
+            sample()
+            before = sum(mem.corners[0][0].info)
+            sample(scale)
+            gains[flag, scale] = sum(mem.corners[0][0].info) - before
+    assert gains[True, -0.5] == pytest.approx(gains[True, 1.0], rel=1e-2)
+    assert gains[False, -0.5] < 0.05 * gains[False, 1.0]
+
+
+def test_bearing_ratio_drops_a_poor_depth_reading_and_keeps_its_direction():
+    """With ``bearing_ratio`` a sample whose depth std exceeds that many times its distance is fused as a
+    bearing: one read at twice the true distance leaves the estimate where a sample at the true distance
+    does; without it (iwao v0) the depth error moves the estimate."""
+    est = {}
+    for ratio in (None, 0.0):
+        for scale in (1.0, 2.0):
+            mem, sample = _memory_and_samples(bearing_ratio=ratio)
+            sample()
+            sample()
+            sample(scale)
+            est[ratio, scale] = mem.corners[0][0].estimate()[0].copy()
+    assert np.abs(est[0.0, 2.0] - est[0.0, 1.0]).max() < 5e-4
+    assert np.abs(est[None, 2.0] - est[None, 1.0]).max() > 3e-3

@@ -134,6 +134,13 @@ class IwaoParams:
     # fixation work in path coordinates (along / across the centre line), the footstep turns each foothold
     # to the path's heading there.
     winding: bool = False
+    # With gaze_mode="footholds": judge each sample's eccentricity from its image's line of sight (the point's
+    # estimate once there is one), not from the perceived point, which a depth error beyond the distance
+    # puts behind the eye (ObstacleMemory.image_eccentricity). False: iwao v0 (the perceived point).
+    image_eccentricity: bool = False
+    # With gaze_mode="footholds": a sample whose depth std exceeds this many times its distance is fused as a
+    # bearing only (ObstacleMemory.bearing_ratio), or None (iwao v0). Modelling choice.
+    bearing_ratio: float | None = None
 
 
 class IwaoAgent:
@@ -151,7 +158,9 @@ class IwaoAgent:
         self.memory = ObstacleMemory(vision or VisionParams(noise_scale=p.vision_noise_scale, foveated=p.foveated,
                                                            position_slip_knee_deg_s=p.position_slip_knee_deg_s),
                                      self.planner.p.walkway_half_width_m,
-                                     *((p.height_prior_m, p.sample_gate) if p.gaze_mode == "footholds" else (None, None)))
+                                     *((p.height_prior_m, p.sample_gate) if p.gaze_mode == "footholds" else (None, None)),
+                                     image_eccentricity=p.image_eccentricity and p.gaze_mode == "footholds",
+                                     bearing_ratio=p.bearing_ratio if p.gaze_mode == "footholds" else None)
         self.delay_steps = round(p.visual_delay_s / p.control_dt)
         self.gaze_range = p.gaze_action_range_deg * DEG
         self.period_steps = round(self.gait.step_s / p.control_dt)

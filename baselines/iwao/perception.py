@@ -33,6 +33,7 @@ MIN_STD_M = 1e-4  # a floor for the noiseless oracle rung (its information would
 # foveation.believed_sigmas (k from the predicted slip, up to 1 s of looks) instead: 33/40 (seeds 40-79:
 # 32/40 against 36/40 with 15).
 DISARRAY_LOOKS = 15
+BEARING_DEPTH_STD_M = 1e3  # ObstacleMemory.bearing_ratio: no depth information (modelling choice)
 
 
 def eye_motion(prev, now, dt: float):
@@ -159,8 +160,22 @@ class ObstacleMemory:
 
     def __init__(self, vision: VisionParams,
                  walkway_half_width_m: float = 0.5 * CourseDistribution().walkway_width_m,
-                 height_prior: tuple[float, float] | None = None, gate: float | None = None) -> None:
+                 height_prior: tuple[float, float] | None = None, gate: float | None = None,
+                 image_eccentricity: bool = False, bearing_ratio: float | None = None) -> None:
         self.vision = vision
+        # How a sample's eccentricity (hence its acuity and both stds) is judged. False (iwao v0): from the
+        # perceived point, whose direction a depth error larger than the distance turns behind the eye (the
+        # std then judged ~180 deg off the fovea: the sample all but dropped), so the weight a sample gets
+        # depends on its own depth error and the fused estimate is pushed away from the eye. True: from the
+        # image's direction -- the line of sight of the point's estimate once there is one (as the distance
+        # is: an extended Kalman filter linearises at its prior), before it the perceived direction turned
+        # to the front of the eye (depth noise runs along the line of sight, which it cannot reverse).
+        self.image_eccentricity = image_eccentricity
+        # A sample whose depth std exceeds bearing_ratio x its distance is fused as a bearing only: its
+        # perceived point is put at the reference distance along its image's direction (its depth error,
+        # which the linearisation at the estimate's line of sight would leak across it, dropped) with no
+        # depth information. None: every sample as perceived (iwao v0). Modelling choice.
+        self.bearing_ratio = bearing_ratio
         self.walkway_half_width_m = walkway_half_width_m
         # (mean, std) in metres of a point's height above the floor before any sample, or None: no prior.
         # A top face on the floor is placed by the angle of its line of sight below the horizon, given
@@ -195,6 +210,10 @@ class ObstacleMemory:
         if d <= 0.0:
             return
         ecc = math.acos(max(-1.0, min(1.0, ex / d)))
+        flip = 1.0
+        if self.image_eccentricity and ex < 0.0:
+            # the depth reading put the point behind the eye; the image (its line of sight) lies in front
+            flip, ecc = -1.0, math.pi - ecc
         (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = rot_rows
         bx = eye_pos[0] + r00 * ex + r01 * ey + r02 * ez
         by = eye_pos[1] + r10 * ex + r11 * ey + r12 * ez
@@ -203,12 +222,12 @@ class ObstacleMemory:
         ox, oy, yaw, pz = odo
         c, s = math.cos(yaw), math.sin(yaw)
         z = (ox + c * bx - s * by, oy + s * bx + c * by, pz + bz)
-        u = ((c * lx - s * ly) / d, (s * lx + c * ly) / d, lz / d)
+        u = ((c * lx - s * ly) * flip / d, (s * lx + c * ly) * flip / d, lz * flip / d)
         points = self.corners.get(index)
         if points is None:
             points = self.corners[index] = tuple(Corner(self.height_prior) for _ in range(N_POINTS))
         corner = points[which]
-        eye_w = (z[0] - d * u[0], z[1] - d * u[1], z[2] - d * u[2])  # the eye, path frame
+        eye_w = (z[0] - flip * d * u[0], z[1] - flip * d * u[1], z[2] - flip * d * u[2])  # the eye, path frame
         # The noise is spread along and across the *true* line of sight at the *true* distance, which the
         # agent does not know. The perceived point is no guide when the depth noise is as large as the
         # distance (~40 deg off the fovea): it may come out next to the eye or behind it, its direction
@@ -223,6 +242,9 @@ class ObstacleMemory:
             lx, ly, lz = px - eye_w[0], py - eye_w[1], pz - eye_w[2]
             d_ref = math.sqrt(lx * lx + ly * ly + lz * lz)
             u = (lx / d_ref, ly / d_ref, lz / d_ref)
+            if self.image_eccentricity:  # the estimate's line of sight against the eye's axis (path frame)
+                ax, ay = c * r00 - s * r10, s * r00 + c * r10
+                ecc = math.acos(max(-1.0, min(1.0, u[0] * ax + u[1] * ay + u[2] * r20)))
         else:
             if u[2] >= -0.02 or u[0] <= 0.0:  # an obstacle's top lies ahead and below the eye
                 return
@@ -235,6 +257,11 @@ class ObstacleMemory:
         if self.vision.position_disarray > 0.0 and self.vision.foveated:
             # the fixed part w of the lateral variance counts DISARRAY_LOOKS times (see DISARRAY_LOOKS)
             s_lat *= math.sqrt(1.0 + (DISARRAY_LOOKS - 1) * periphery.disarray_weight(ecc, self.vision))
+        if self.bearing_ratio is not None and s_depth > self.bearing_ratio * d_ref:
+            dx, dy, dz = z[0] - eye_w[0], z[1] - eye_w[1], z[2] - eye_w[2]
+            k = flip * d_ref / d
+            z = (eye_w[0] + k * dx, eye_w[1] + k * dy, eye_w[2] + k * dz)
+            s_depth = BEARING_DEPTH_STD_M
         if crowded:
             s_depth, s_lat = max(s_depth, crowd_std(d_ref, ecc, self.vision)), max(s_lat, crowd_std(d_ref, ecc, self.vision))
         if self.gate is not None and prior is not None and corner.n >= 3:
