@@ -30,21 +30,21 @@ POSITION_E2 = {"position_e2_deg": 0.7}  # Levi, Klein & Aitsebaomo 1985, as quot
 CROWDING = {"crowding": True}  # Bouma 1970, b = 0.5; Parkes et al. 2001
 DEPTH = {"depth_pedestal_arcmin": 10.0}  # Blakemore 1970; the constant a modelling choice
 DISARRAY = {"position_disarray": 0.8}  # Hess & Field 1993; the share a modelling choice (the lead's 0.8)
+# human_periphery(position_disarray=0.8): the four mechanisms and the retinotopic disarray (the one eye)
+ONE_EYE = {**HUMAN_FIELD, **POSITION_E2, **CROWDING, **DEPTH, **DISARRAY}
 CONDITIONS = {
     "walkway, default vision": ({}, {}),
     "rough, default vision": ("rough", {}),
     "rough, human field": ("rough", dict(HUMAN_FIELD)),
     "rough, field + E2 + crowding": ("rough", {**HUMAN_FIELD, **POSITION_E2, **CROWDING}),
     "rough, all four": ("rough", {**HUMAN_FIELD, **POSITION_E2, **CROWDING, **DEPTH}),
-    # human_periphery(position_disarray=0.8): the four mechanisms and the retinotopic disarray
-    "rough, all four + disarray 0.8": ("rough", {**HUMAN_FIELD, **POSITION_E2, **CROWDING, **DEPTH, **DISARRAY}),
+    "rough, all four + disarray 0.8": ("rough", ONE_EYE),
     # the denser rough course (preset "rough_dense": hazards every 0.45-0.8 m) under the same eye
-    "rough dense, all four + disarray 0.8": ("rough_dense", {**HUMAN_FIELD, **POSITION_E2, **CROWDING, **DEPTH,
-                                                             **DISARRAY}),
+    "rough dense, all four + disarray 0.8": ("rough_dense", ONE_EYE),
     # the opt-in rows with gaps (preset "rows": tasks.obstacle_walk.ROWS_COURSE) under the same eye
-    "rows, all four + disarray 0.8": ("rows", {**HUMAN_FIELD, **POSITION_E2, **CROWDING, **DEPTH, **DISARRAY}),
+    "rows, all four + disarray 0.8": ("rows", ONE_EYE),
     # the opt-in winding walkway (preset "winding": tasks.obstacle_walk.WINDING_COURSE) under the same eye
-    "winding, all four + disarray 0.8": ("winding", {**HUMAN_FIELD, **POSITION_E2, **CROWDING, **DEPTH, **DISARRAY}),
+    "winding, all four + disarray 0.8": ("winding", ONE_EYE),
     # a variant: the rough course with flat patches only (no rocks), ROUGH_COURSE with kind_p = (0, 0, 1)
     "rough patches only, field + E2 + crowding": ("rough patches", {**HUMAN_FIELD, **POSITION_E2, **CROWDING}),
 }
@@ -56,6 +56,25 @@ def _setup() -> None:
 
     _use_checkout_baselines()
     import visuomotor_gym  # noqa: F401  (registers the ids)
+
+
+def patch_iwao_from_env() -> None:
+    """Lay the JSON object in the environment variable ``IWAO`` over every ``IwaoParams`` the process builds
+    (probes only: ``IWAO='{"winding": true}' python walk_probe.py ...``); nothing without it."""
+    import dataclasses
+    import importlib
+    import os
+
+    if not os.environ.get("IWAO"):
+        return
+    ag = importlib.import_module("visuomotor_gym.baselines.iwao.agent")
+    over = json.loads(os.environ["IWAO"])
+    init = ag.IwaoAgent.__init__
+
+    def patched(self, params=None, *a, **k):
+        init(self, dataclasses.replace(params or ag.IwaoParams(), **over), *a, **k)
+
+    ag.IwaoAgent.__init__ = patched
 
 
 def env_kwargs(course, vision: dict) -> dict:

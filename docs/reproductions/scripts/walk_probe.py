@@ -51,15 +51,7 @@ def main(argv=None) -> int:
             init(self, gait, params or pl.PlannerParams(**over))
 
         pl.FootstepPlanner.__init__ = patched
-    if os.environ.get("IWAO"):  # fields laid over IwaoParams (probes only)
-        ag = importlib.import_module("visuomotor_gym.baselines.iwao.agent")
-        over_i = json.loads(os.environ["IWAO"])
-        init_i = ag.IwaoAgent.__init__
-
-        def patched_i(self, params=None, *a, **k):
-            init_i(self, dataclasses.replace(params or ag.IwaoParams(), **over_i), *a, **k)
-
-        ag.IwaoAgent.__init__ = patched_i
+    rw.patch_iwao_from_env()  # fields laid over IwaoParams from $IWAO (probes only)
     course = dataclasses.asdict(dataclasses.replace(ROUGH_COURSE, **json.loads(a.course)))
     kwargs = {"course_distribution": course, "vision_params": json.loads(a.vision)}
     lo, hi = map(int, a.seeds.split(":"))

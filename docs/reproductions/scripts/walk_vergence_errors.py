@@ -15,7 +15,6 @@ from __future__ import annotations
 import dataclasses
 import importlib
 import json
-import os
 import sys
 import time
 from pathlib import Path
@@ -23,8 +22,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import rough_walk as rw
 
-VISION = {"field_shape": "human", "position_e2_deg": 0.7, "crowding": True, "depth_pedestal_arcmin": 10.0,
-          "position_disarray": 0.8}
+VISION = rw.ONE_EYE  # human_periphery(position_disarray=0.8)
 
 
 def main(argv=None) -> int:
@@ -38,15 +36,7 @@ def main(argv=None) -> int:
     from visuomotor_gym.static_gaze import registered_kwargs
     from visuomotor_gym.tasks.obstacle_walk import WINDING_COURSE
 
-    if os.environ.get("IWAO"):
-        ag = importlib.import_module("visuomotor_gym.baselines.iwao.agent")
-        over_i = json.loads(os.environ["IWAO"])
-        init_i = ag.IwaoAgent.__init__
-
-        def patched_i(self, params=None, *a, **k):
-            init_i(self, dataclasses.replace(params or ag.IwaoParams(), **over_i), *a, **k)
-
-        ag.IwaoAgent.__init__ = patched_i
+    rw.patch_iwao_from_env()  # fields laid over IwaoParams from $IWAO (probes only)
     ag = importlib.import_module("visuomotor_gym.baselines.iwao.agent")
     init_c = ag.IwaoAgent.__init__
 

@@ -21,8 +21,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import rough_walk as rw
 
-VISION = {"field_shape": "human", "position_e2_deg": 0.7, "crowding": True, "depth_pedestal_arcmin": 10.0,
-          "position_disarray": 0.8}
+VISION = rw.ONE_EYE  # human_periphery(position_disarray=0.8)
 
 
 def main(argv=None) -> int:
