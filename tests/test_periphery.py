@@ -205,7 +205,8 @@ def test_peripheral_fields_reject_bad_values_naming_the_field(kwargs):
 
 def test_defaults_are_off_and_periphery_on_needs_foveation():
     assert not VisionParams().periphery_on
-    for kw in ({"field_shape": "human"}, {"position_e2_deg": 0.7}, {"crowding": True}, {"depth_pedestal_arcmin": 10.0}):
+    for kw in ({"field_shape": "human"}, {"position_e2_deg": 0.7}, {"crowding": True}, {"depth_pedestal_arcmin": 10.0},
+               {"angular_lateral_noise": True}):
         assert VisionParams(**kw).periphery_on
         assert not VisionParams(**kw, foveated=False).periphery_on
 
@@ -289,6 +290,34 @@ def test_env_retina_position_and_depth_laws_match_the_closed_form():
     depth0 = np.array([np.array(u.retina._see_all(data, [t], eye, rng)[0][0]) - dist * los for _ in range(n)]) @ los
     assert np.std(depth0) == pytest.approx(0.05 * dist * k, rel=0.06)
     env.close()
+
+
+def test_angular_lateral_noise_keeps_the_direction_error_apart_from_the_depth_error():
+    """With ``angular_lateral_noise`` the six normals are the same, the depth offset too, and the lateral
+    offset is scaled by (d + n0) / d: the perceived point lies on the ray of the metric draw at the true
+    distance, so its direction error is the same whatever the depth error."""
+    vp_m = VisionParams(position_e2_deg=0.7, depth_pedestal_arcmin=10.0)
+    vp_a = VisionParams(position_e2_deg=0.7, depth_pedestal_arcmin=10.0, angular_lateral_noise=True)
+    assert vp_a.periphery_on and fov.human_periphery().angular_lateral_noise
+    x, y, z = 3.0 * np.array(unit(4.0, -9.0))
+    d = 3.0
+    ecc = math.acos(x / d)
+    for seed in range(30):
+        pm, vm = fov._draw_at(x, y, z, d, ecc, [0.1, 0.0, 0.0], 0.05, vp_m, np.random.default_rng(seed), 12.0)
+        pa, va = fov._draw_at(x, y, z, d, ecc, [0.1, 0.0, 0.0], 0.05, vp_a, np.random.default_rng(seed), 12.0)
+        e = np.random.default_rng(seed).standard_normal(6)
+        s = fov._sigmas(d, ecc, 0.05, vp_m, 12.0)
+        u = np.array([x, y, z]) / d
+        rot = fov.line_of_sight_rotation(u)
+        lateral = rot[:, 1] * s[1] * e[1] + rot[:, 2] * s[2] * e[2]
+        # by hand: the metric draw, and the angular one on its ray at distance d + n0
+        assert np.allclose(pm, d * u + rot[:, 0] * s[0] * e[0] + lateral, atol=1e-12)
+        assert np.allclose(pa, (d + s[0] * e[0]) * (u + lateral / d), atol=1e-12)
+        assert va == vm  # velocities untouched
+        # the direction error of the angular draw is the one the metric draw has at zero depth error
+        dir_a = np.array(pa) / np.linalg.norm(pa) * np.sign(d + s[0] * e[0])
+        ref = d * u + lateral
+        assert np.allclose(dir_a, ref / np.linalg.norm(ref), atol=1e-12)
 
 
 def test_walk_env_with_the_human_periphery_runs_and_groups_obstacle_points():

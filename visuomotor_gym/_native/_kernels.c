@@ -825,6 +825,8 @@ static void los_rows(double ux, double uy, double uz, double *r)
 /* One target's look, between foveation.perceive's checks and _draw_at's noise. */
 typedef struct {
     int kind; /* 0: not seen (nothing()), 1: at the eye's centre (the true state), 2: seen, noise to draw */
+    int angular; /* VisionParams.angular_lateral_noise: the lateral offset scaled by (d + n0) / d */
+    double d; /* the point's distance (used when angular) */
     double p[3], v[3], s[6], r[9];
 } Look;
 
@@ -834,6 +836,7 @@ static void perceive_prepare(const VisionConsts *c, const double *pe, const doub
     double x = pe[0], y = pe[1], z = pe[2];
     memcpy(lk->p, pe, sizeof(lk->p));
     memcpy(lk->v, ve, sizeof(lk->v));
+    lk->angular = 0;
     double d = sqrt(x * x + y * y + z * z);
     if (d <= 0.0) {
         lk->kind = 1;
@@ -904,6 +907,11 @@ static PyObject *look_sample(const Look *lk, const double *e)
         return sample_of(lk->p, lk->v, 1);
     const double *s = lk->s, *r = lk->r, *p = lk->p, *v = lk->v;
     double n0 = s[0] * e[0], n1 = s[1] * e[1], n2 = s[2] * e[2], n3 = s[3] * e[3], n4 = s[4] * e[4], n5 = s[5] * e[5];
+    if (lk->angular) { /* foveation._draw_at: the lateral offset as an angle */
+        double g = (lk->d + n0) / lk->d;
+        n1 = n1 * g;
+        n2 = n2 * g;
+    }
     double pos[3] = {p[0] + r[0] * n0 + r[1] * n1 + r[2] * n2, p[1] + r[3] * n0 + r[4] * n1 + r[5] * n2,
                      p[2] + r[6] * n0 + r[7] * n1 + r[8] * n2};
     double vel[3] = {v[0] + r[0] * n3 + r[1] * n4 + r[2] * n5, v[1] + r[3] * n3 + r[4] * n4 + r[5] * n5,
@@ -1009,7 +1017,7 @@ fail:
 typedef struct {
     double foveated, human, fov, side, up, down, crowding, crowd_fovea, bouma, pos_e2_on, pos_e2, e2,
         noise_scale, pos_std_arcmin, arcmin, knee, weber, floor, depth, depth_rate, pedestal_on, pedestal,
-        interocular, disarray;
+        interocular, disarray, angular;
 } PeripheryConsts;
 
 static int periphery_consts(PyObject *packed, PeripheryConsts *c)
@@ -1544,7 +1552,7 @@ static PyObject *retina_see_periphery(PyObject *self, PyObject *const *args, Py_
             if (s->d <= 0.0) { /* at the eye's centre: the (pooled) state itself */
                 sample = sample_of(s->p, s->v, 1);
             } else { /* foveation._draw_at */
-                Look lk = {.kind = 2};
+                Look lk = {.kind = 2, .angular = c.angular != 0.0, .d = s->d};
                 double eps[6];
                 memcpy(eps, e, sizeof(eps));
                 e += 6;

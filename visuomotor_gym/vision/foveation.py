@@ -129,6 +129,16 @@ class VisionParams:
     # correlation length in units of eccentricity, one crowding zone (Bouma 1970's 0.5; modelling choice).
     position_disarray: float = field(default=0.0, metadata={"bounds": (0.0, 1.0)})
     disarray_length: float = field(default=0.5, metadata={"bounds": (0.0, 4.0), "low_open": True})
+    # The lateral noise drawn as an angle about the eye instead of metres at the true distance: the
+    # perceived point lies on the ray its noisy visual direction gives, at its noisy distance, so a depth
+    # error no longer shrinks or grows the direction error. Visual direction comes from the retinal
+    # position and the eye's posture, distance from other cues (disparity, vergence): separate estimates
+    # (Hering's laws of visual direction; a point's retinal image does not vary with its distance,
+    # Berkeley 1709). Eyecatch's
+    # Eq. 1-3 draws both in metres at the true point (False, the paper's model). Modelling choice on,
+    # for the human periphery: it removes an artefact that let a far-verged still eye see ground
+    # directions better (docs/reproductions/obstacle_walk.md, "Why far vergence helps the still eye").
+    angular_lateral_noise: bool = False
     # Set by __post_init__: whether any of the mechanisms above acts (always False without foveation).
     periphery_on: ClassVar[bool] = False
 
@@ -139,7 +149,8 @@ class VisionParams:
         # Whether any peripheral mechanism acts (the retina then bypasses its compiled kernel).
         object.__setattr__(self, "periphery_on", self.foveated and (
             self.field_shape == "human" or self.position_e2_deg is not None or self.crowding
-            or self.depth_pedestal_arcmin is not None or self.position_disarray > 0.0))
+            or self.depth_pedestal_arcmin is not None or self.position_disarray > 0.0
+            or self.angular_lateral_noise))
 
     def scaled(self, factor: float) -> VisionParams:
         """A copy with ``noise_scale`` multiplied by ``factor``."""
@@ -151,9 +162,11 @@ class VisionParams:
 #: swept 0.35-1.4), crowding with Bouma's b = 0.5 (Bouma 1970; Parkes et al. 2001) and the depth pedestal of
 #: 10 arcmin (modelling choice, swept 10 / 60 / off) -- and the positional disarray (Hess & Field 1993) with
 #: the share 0.8 of the added lateral variance fixed in retinal coordinates (modelling choice, swept
-#: 0 / 0.5 / 0.8 / 1.0 in gaze_default.md (g)). The fields of :class:`VisionParams` they set.
+#: 0 / 0.5 / 0.8 / 1.0 in gaze_default.md (g)) -- and the lateral noise drawn as an angle about the eye
+#: (``angular_lateral_noise``; modelling choice, metric v. angular in gaze_default.md (h)). The fields of
+#: :class:`VisionParams` they set.
 HUMAN_PERIPHERY = {"field_shape": "human", "position_e2_deg": 0.7, "crowding": True, "depth_pedestal_arcmin": 10.0,
-                   "position_disarray": 0.8}
+                   "position_disarray": 0.8, "angular_lateral_noise": True}
 
 
 def human_periphery(base: VisionParams | None = None, **overrides) -> VisionParams:
@@ -328,7 +341,9 @@ def _draw_at(x, y, z, d, ecc, velocity_eye, retinal_speed, params, rng, fixation
     the lateral position components of eps are then ``sqrt(w) fixed + sqrt(1 - w) eps`` with ``w = s (1 -
     1 / f**2)``, ``s = params.position_disarray`` and ``f`` the position law's growth at ``ecc``
     (:func:`~visuomotor_gym.vision.periphery.position_factor`): a share ``s`` of the variance the periphery
-    adds to the fovea's is fixed in place (the same unit variance; the same six draws from ``rng``)."""
+    adds to the fovea's is fixed in place (the same unit variance; the same six draws from ``rng``). With
+    ``params.angular_lateral_noise`` the lateral offset is then scaled by ``(d + n_depth) / d``: the same
+    angle about the eye, at the perceived distance."""
     s0, s1, s2, s3, s4, s5 = _sigmas(d, ecc, retinal_speed, params, fixation)
     e0, e1, e2, e3, e4, e5 = rng.standard_normal(6).tolist()
     if fixed is not None:
@@ -336,6 +351,9 @@ def _draw_at(x, y, z, d, ecc, velocity_eye, retinal_speed, params, rng, fixation
         a, c = math.sqrt(w), math.sqrt(1.0 - w)
         e1, e2 = a * fixed[0] + c * e1, a * fixed[1] + c * e2
     n0, n1, n2, n3, n4, n5 = s0 * e0, s1 * e1, s2 * e2, s3 * e3, s4 * e4, s5 * e5
+    if params.angular_lateral_noise:  # the lateral offset scaled to the perceived distance: an angle
+        g = (d + n0) / d
+        n1, n2 = n1 * g, n2 * g
     (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = _los_rows(x / d, y / d, z / d)
     vx, vy, vz = velocity_eye
     return (
