@@ -298,7 +298,8 @@ def test_angular_lateral_noise_keeps_the_direction_error_apart_from_the_depth_er
     distance, so its direction error is the same whatever the depth error."""
     vp_m = VisionParams(position_e2_deg=0.7, depth_pedestal_arcmin=10.0)
     vp_a = VisionParams(position_e2_deg=0.7, depth_pedestal_arcmin=10.0, angular_lateral_noise=True)
-    assert vp_a.periphery_on and fov.human_periphery().angular_lateral_noise
+    assert vp_a.periphery_on and vp_a.angular_on and fov.human_periphery().angular_on
+    assert not VisionParams(angular_lateral_noise=True, foveated=False).angular_on  # FullView: no periphery
     x, y, z = 3.0 * np.array(unit(4.0, -9.0))
     d = 3.0
     ecc = math.acos(x / d)

@@ -253,7 +253,10 @@ class FarawayAgent:
         # distance: a sample that depth noise put near the eye (|s| << d) has no direction to speak of.
         # At the object's distance d <= FAR_SHELF_M the ray is off by d * (d k) / |s| <= lateral_std * FAR / |s|
         # (k: the angular lateral std), so the lateral std grows by FAR_SHELF_M / |s| below FAR_SHELF_M.
-        lateral_std *= max(1.0, FAR_SHELF_M / dist)
+        # An eye that draws the lateral noise as an angle (VisionParams.angular_lateral_noise) keeps the
+        # ray's angle whatever the depth error: no growth.
+        if not self.vision.angular_on:
+            lateral_std *= max(1.0, FAR_SHELF_M / dist)
         w = (np.eye(3) - np.outer(u, u)) / max(lateral_std, 1e-9) ** 2
         point = eye + rot @ pos_eye
         self.info += w

@@ -107,16 +107,19 @@ class StoneMemory:
         c, s = math.cos(yaw), math.sin(yaw)
         eye_h = pz + eye_pos[2] - STONE_PLANE_Z  # the eye's height over the plane
         t = eye_h / dep  # distance along the line of sight to the plane
-        if self.vision.depth_pedestal_arcmin is not None and d < NEAR_GATE * t:
+        angular = self.vision.angular_on
+        if self.vision.depth_pedestal_arcmin is not None and not angular and d < NEAR_GATE * t:
             # With the depth law the depth noise can bring a point far nearer the eye than the plane, and
-            # the lateral noise then bends its direction by degrees: its eccentricity, and the std the
-            # model gives it, are not to be trusted (modelling choice: such samples are dropped).
+            # the lateral noise (drawn in metres) then bends its direction by degrees: its eccentricity,
+            # and the std the model gives it, are not to be trusted (modelling choice: such samples are
+            # dropped). An eye that draws the lateral noise as an angle keeps the direction: kept.
             return
         hx, hy = (c * lx - s * ly) / d, (s * lx + c * ly) / d  # horizontal part of the unit line of sight
         exw, eyw = ox + c * eye_pos[0] - s * eye_pos[1], oy + s * eye_pos[0] + c * eye_pos[1]
         px, py = exw + t * hx, eyw + t * hy
         # The lateral noise is a distance at the true range (~t): seen from the eye at the perceived range
-        # d it is an angle s_lat / d, which is t s_lat / d across the line of sight on the plane.
+        # d it is an angle s_lat / d, which is t s_lat / d across the line of sight on the plane. Drawn as
+        # an angle (VisionParams.angular_lateral_noise) it is s_lat / t whatever d: s_lat on the plane.
         est = self.estimate(index)
         qx, qy = est[0] if est is not None else (px, py)
         pose = self.eye_pose(eye_pos, rot_rows, odo)
@@ -129,7 +132,8 @@ class StoneMemory:
             u = self._in_eye(pose, qx, qy, STONE_PLANE_Z)
             ecc = max(ecc, math.acos(max(-1.0, min(1.0, u[0]))))
         # dt: the positional disarray, if the eye has it, sized for a stream of looks (no effect without)
-        s_lat = max(believed_sigmas(t, ecc, slip, self.vision, None, dt)[1] * t / d, MIN_STD_M)
+        s_lat = believed_sigmas(t, ecc, slip, self.vision, None, dt)[1]
+        s_lat = max(s_lat if angular else s_lat * t / d, MIN_STD_M)
         if crowded:
             s_lat = max(s_lat, crowd_std(t, ecc, self.vision))
         h = math.hypot(hx, hy)

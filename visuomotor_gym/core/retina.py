@@ -43,7 +43,7 @@ def periphery_constants(params: VisionParams) -> bytes:
         p.retinal_velocity_floor_deg_s * foveation.DEG, p.depth_std_fraction, p.depth_rate_std_fraction,
         0.0 if p.depth_pedestal_arcmin is None else 1.0,
         0.0 if p.depth_pedestal_arcmin is None else p.depth_pedestal_arcmin * periphery.ARCMIN,
-        p.interocular_m, p.position_disarray, 1.0 if p.angular_lateral_noise else 0.0,
+        p.interocular_m, p.position_disarray, 1.0 if p.angular_on else 0.0,
     ], dtype=np.float64).tobytes()
 
 

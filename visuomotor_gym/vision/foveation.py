@@ -139,8 +139,10 @@ class VisionParams:
     # for the human periphery: it removes an artefact that let a far-verged still eye see ground
     # directions better (docs/reproductions/obstacle_walk.md, "Why far vergence helps the still eye").
     angular_lateral_noise: bool = False
-    # Set by __post_init__: whether any of the mechanisms above acts (always False without foveation).
+    # Set by __post_init__: whether any of the mechanisms above acts (always False without foveation), and
+    # whether the lateral noise is drawn as an angle (angular_lateral_noise with foveation).
     periphery_on: ClassVar[bool] = False
+    angular_on: ClassVar[bool] = False
 
     def __post_init__(self) -> None:
         # Every field, those added later included: VISION_RULES, else the field's metadata (bounds,
@@ -151,6 +153,7 @@ class VisionParams:
             self.field_shape == "human" or self.position_e2_deg is not None or self.crowding
             or self.depth_pedestal_arcmin is not None or self.position_disarray > 0.0
             or self.angular_lateral_noise))
+        object.__setattr__(self, "angular_on", self.foveated and self.angular_lateral_noise)
 
     def scaled(self, factor: float) -> VisionParams:
         """A copy with ``noise_scale`` multiplied by ``factor``."""
@@ -163,7 +166,7 @@ class VisionParams:
 #: 10 arcmin (modelling choice, swept 10 / 60 / off) -- and the positional disarray (Hess & Field 1993) with
 #: the share 0.8 of the added lateral variance fixed in retinal coordinates (modelling choice, swept
 #: 0 / 0.5 / 0.8 / 1.0 in gaze_default.md (g)) -- and the lateral noise drawn as an angle about the eye
-#: (``angular_lateral_noise``; modelling choice, metric v. angular in gaze_default.md (h)). The fields of
+#: (``angular_lateral_noise``; modelling choice, metric v. angular in gaze_default.md (i)). The fields of
 #: :class:`VisionParams` they set.
 HUMAN_PERIPHERY = {"field_shape": "human", "position_e2_deg": 0.7, "crowding": True, "depth_pedestal_arcmin": 10.0,
                    "position_disarray": 0.8, "angular_lateral_noise": True}
@@ -351,7 +354,7 @@ def _draw_at(x, y, z, d, ecc, velocity_eye, retinal_speed, params, rng, fixation
         a, c = math.sqrt(w), math.sqrt(1.0 - w)
         e1, e2 = a * fixed[0] + c * e1, a * fixed[1] + c * e2
     n0, n1, n2, n3, n4, n5 = s0 * e0, s1 * e1, s2 * e2, s3 * e3, s4 * e4, s5 * e5
-    if params.angular_lateral_noise:  # the lateral offset scaled to the perceived distance: an angle
+    if params.angular_on:  # the lateral offset scaled to the perceived distance: an angle
         g = (d + n0) / d
         n1, n2 = n1 * g, n2 * g
     (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = _los_rows(x / d, y / d, z / d)
