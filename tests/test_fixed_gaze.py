@@ -15,11 +15,15 @@ from visuomotor_gym.agents import GazeBlind, agent_names, is_deterministic, make
 
 
 def _blocks(env):
-    """Index masks of the gaze and head blocks, from the env's own action_structure."""
+    """Index masks of the gaze and head blocks (and the fixation block where the eye has the depth law:
+    EyeCatch-v0's human periphery), from the env's own action_structure."""
+    from visuomotor_gym.agents import has_depth_law
+
+    blocks = ("gaze", "head") + (("fixation",) if has_depth_law(env.unwrapped.vision_params) else ())
     held = np.zeros(env.action_space.shape[0], dtype=bool)
     start = 0
     for name, size in env.unwrapped.action_structure.items():
-        if name in ("gaze", "head"):
+        if name in blocks:
             held[start : start + size] = True
         start += size
     return held
@@ -45,7 +49,7 @@ def test_names_are_registered_and_parse():
 def test_only_gaze_and_head_differ_and_the_eye_never_saccades(spec, base_spec, seed):
     env = gym.make("EyeCatch-v0")
     held = _blocks(env)
-    assert held.tolist() == [False] * 4 + [True, True, False, True, True]  # gaze 4-5, head 7-8
+    assert held.tolist() == [False] * 4 + [True, True, True, True, True]  # gaze 4-5, fixation 6, head 7-8
     blind = make_agent(spec, "EyeCatch-v0", 9, seed=seed)
     base = make_agent(base_spec, "EyeCatch-v0", 9, seed=seed)  # the same agent, fed the same observations
     assert isinstance(blind, GazeBlind)
@@ -91,7 +95,7 @@ def test_gaze_stays_where_reset_put_it():
 
 
 def test_joint_control_layout_and_bad_layout():
-    env = gym.make("EyeCatch-v0", control="joint")
+    env = gym.make("EyeCatchPaper-v0", control="joint")  # no depth law: vergence not held
     held = _blocks(env)
     assert np.flatnonzero(held).tolist() == [11, 12, 14, 15]
     blind = GazeBlind(make_agent("random", "EyeCatch-v0", 16, seed=1), env.unwrapped.action_structure)
@@ -136,8 +140,8 @@ def test_bench_accepts_the_twin():
 
 def test_the_twin_holds_vergence_only_when_the_eye_has_the_depth_law():
     """SteppingStones-v0's eye has the depth law (vergence decides depth precision): the twin holds the
-    fixation block at 0 too; EyeCatch-v0's has not: the base agent's vergence passes. match_vision follows
-    the env's own vision (an override either way)."""
+    fixation block at 0 too; EyeCatchPaper-v0's has not: the base agent's vergence passes. match_vision
+    follows the env's own vision (an override either way)."""
     from visuomotor_gym.agents import match_vision
     from visuomotor_gym.vision.foveation import VisionParams, human_periphery
 
@@ -150,9 +154,9 @@ def test_the_twin_holds_vergence_only_when_the_eye_has_the_depth_law():
         raise AssertionError("no fixation block")
 
     stones = make_agent("gaze_blind:lookahead", "SteppingStones-v0", 9)
-    catch = make_agent("gaze_blind:eyecatch", "EyeCatch-v0", 7)
+    catch = make_agent("gaze_blind:eyecatch", "EyeCatchPaper-v0", 7)
     assert stones.hold_vergence and not catch.hold_vergence
-    assert stones.held[fixation_index("SteppingStones-v0")] and not catch.held[fixation_index("EyeCatch-v0")]
+    assert stones.held[fixation_index("SteppingStones-v0")] and not catch.held[fixation_index("EyeCatchPaper-v0")]
     env = gym.make("SteppingStones-v0")
     obs, _ = env.reset(seed=0)
     base = make_agent("lookahead", "SteppingStones-v0", 9)
@@ -168,6 +172,7 @@ def test_the_twin_holds_vergence_only_when_the_eye_has_the_depth_law():
         obs, *_ = env.step(a)
     assert moved
     match_vision(catch, human_periphery())
-    assert catch.hold_vergence and catch.held[fixation_index("EyeCatch-v0")]
+    assert catch.hold_vergence and catch.held[fixation_index("EyeCatchPaper-v0")]
+    assert make_agent("gaze_blind:eyecatch", "EyeCatch-v0", 7).hold_vergence  # EyeCatch-v0's own eye
     match_vision(stones, VisionParams())
     assert not stones.hold_vergence and not stones.held[fixation_index("SteppingStones-v0")]

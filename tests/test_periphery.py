@@ -215,8 +215,14 @@ def test_defaults_are_off_and_periphery_on_needs_foveation():
 ALL_ON = {"field_shape": "human", "position_e2_deg": 0.7, "crowding": True, "depth_pedestal_arcmin": 10.0}
 
 
+# EyeCatch-v0's eye with every periphery mechanism off (its default has them all): the base the tests below
+# switch single mechanisms on over.
+NO_PERIPHERY = {"field_shape": "cone", "position_e2_deg": None, "crowding": False, "depth_pedestal_arcmin": None,
+                "position_disarray": 0.0, "angular_lateral_noise": False}
+
+
 def _env_eye(vision_params=None, env_id="EyeCatch-v0"):
-    env = gym.make(env_id, vision_params=vision_params)
+    env = gym.make(env_id, vision_params={**NO_PERIPHERY, **(vision_params or {})})
     env.reset(seed=3)
     return env, env.unwrapped
 

@@ -250,11 +250,12 @@ def test_vergence_is_searched_only_under_the_depth_law():
     )
 
     depth = {"vision_params": {"depth_pedestal_arcmin": 10.0}}
-    assert not vision_has_depth_law("EyeCatch-v0")
-    with registered_kwargs("EyeCatch-v0", depth):
-        assert vision_has_depth_law("EyeCatch-v0")
-    with registered_kwargs("EyeCatch-v0", {**depth, "vision": "full_view"}):
-        assert not vision_has_depth_law("EyeCatch-v0")  # FullView: no periphery, no depth law
+    assert vision_has_depth_law("EyeCatch-v0")  # its human periphery; the paper's eye has none
+    assert not vision_has_depth_law("EyeCatchPaper-v0")
+    with registered_kwargs("EyeCatchPaper-v0", depth):
+        assert vision_has_depth_law("EyeCatchPaper-v0")
+    with registered_kwargs("EyeCatchPaper-v0", {**depth, "vision": "full_view"}):
+        assert not vision_has_depth_law("EyeCatchPaper-v0")  # FullView: no periphery, no depth law
     assert parse_fixations("auto") is None and parse_fixations("none") == ()
     assert parse_fixations("0.5,3") == (0.5, 3.0)
     for bad in ("", "x", "0,1", "-1", "nan"):
@@ -264,14 +265,14 @@ def test_vergence_is_searched_only_under_the_depth_law():
 
     tiny = {"coarse_step": 90.0, "coarse_episodes": 1, "final_episodes": 1, "refine_steps": (), "finalists": 1,
             "neck_step": 0.0}
-    record = search("EyeCatch-v0", "eyecatch", env_kwargs=depth, fixations=(1.0, 4.0), **tiny)
+    record = search("EyeCatchPaper-v0", "eyecatch", env_kwargs=depth, fixations=(1.0, 4.0), **tiny)
     stage = next(s for s in record["stages"] if s["name"] == "fixation")
     assert stage["postures"] == 2 and stage["fixations_m"] == [1.0, 4.0]
     played = {p["fix"] for p in record["postures"] if p["stage"] == "fixation"}
     assert played == {1.0, 4.0}
     assert record["rules"]["fixations_m"] == [1.0, 4.0]
     # auto and no depth law: no fixation stage, every posture at the default vergence
-    plain = search("EyeCatch-v0", "eyecatch", **tiny)
+    plain = search("EyeCatchPaper-v0", "eyecatch", **tiny)
     assert all(s["name"] != "fixation" for s in plain["stages"])
     assert {p["fix"] for p in plain["postures"]} == {2.0}
 

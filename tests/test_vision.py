@@ -18,6 +18,11 @@ import visuomotor_gym  # noqa: F401  (registers the environment ids)
 from visuomotor_gym.vision import foveation as fov
 from visuomotor_gym.vision.foveation import VisionParams
 
+# EyeCatch-v0's eye without the human periphery (the cone field, the acuity law, no crowding, depth law or
+# disarray): the closed forms below are those of that eye.
+PLAIN_EYE = {"field_shape": "cone", "position_e2_deg": None, "crowding": False, "depth_pedestal_arcmin": None,
+             "position_disarray": 0.0, "angular_lateral_noise": False}
+
 DEG = math.pi / 180.0
 ARCMIN_RAD = DEG / 60.0  # 2.909e-4 rad
 E2 = 2.0 * DEG
@@ -246,8 +251,12 @@ def test_paper_condition_ids_and_agents_use_the_paper_vision():
     for env_id in CATCH_ENV_IDS:  # the brain's model of its eye is the env's eye
         env = gym.make(env_id)
         want = env.unwrapped.vision_params
-        if env.unwrapped.vision == "oracle":
-            want = VisionParams(noise_scale=0.0, foveated=False)
+        if env.unwrapped.vision == "oracle":  # the family's eye (CATCH_VISION), noiseless and unfoveated
+            from dataclasses import replace
+
+            from visuomotor_gym.envs.catch import CATCH_VISION
+
+            want = replace(CATCH_VISION, noise_scale=0.0, foveated=False)
         assert env_vision_params(env_id) == want, env_id
         for spec in ("eyecatch", "belief_mpc", "fixed_gaze"):
             if env_id == "EyeCatchTwoBalls-v0":
@@ -518,7 +527,7 @@ def _action(gaze=(0.0, 0.0), head=(0.0, 0.0)):
 
 
 def test_ball_invisible_outside_field_of_view():
-    env = gym.make("EyeCatch-v0")
+    env = gym.make("EyeCatch-v0", vision_params=PLAIN_EYE)
     s = env.unwrapped.layout.slices
     obs, info = env.reset(seed=1)
     assert obs[s["ball_visible"]][0] == 1.0  # gaze starts on the ball
@@ -545,7 +554,7 @@ def test_ball_invisible_outside_field_of_view():
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_visibility_is_field_of_view_and_no_saccade(seed):
     """Random gaze and head actions: visible <=> (within 60 deg and not saccading this step)."""
-    env = gym.make("EyeCatch-v0")
+    env = gym.make("EyeCatch-v0", vision_params=PLAIN_EYE)
     s = env.unwrapped.layout.slices
     rng = np.random.default_rng(seed)
     obs, info = env.reset(seed=seed)
@@ -702,7 +711,7 @@ def test_env_position_noise_matches_model():
 def test_env_lateral_noise_grows_with_retinal_slip():
     """EyeCatch-v0 with the eye held: the lateral error, divided by the closed-form std at the true
     retinal slip (line-of-sight rotation minus the eye's, from ``info``), is a unit normal."""
-    env = gym.make("EyeCatch-v0")
+    env = gym.make("EyeCatch-v0", vision_params=PLAIN_EYE)
     s = env.unwrapped.layout.slices
     z, slips = [], []
     for seed in range(6):
