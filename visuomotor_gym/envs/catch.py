@@ -149,7 +149,7 @@ class EyeCatchEnv(VisuomotorEnv):
       gain 0.98 -> 0.75 with target speed, bounded acceleration; a refused saccade waits instead of
       being pursued), and the fixation observation no longer starts at the ball's true distance.
       The leaderboard entries made before are superseded.
-      Redefined in place for the moving eye (issue 23): the eye has the human periphery with the
+      Redefined in place for the moving eye (one eye for every family): the eye has the human periphery with the
       positional disarray (``CATCH_VISION``) instead of foveal acuity alone, on every rung of the ladder
       (``EyeCatchPaper-v0`` and ``EyeCatchPaperPoorVision-v0`` keep the Eyecatch paper's eye). On the pinned
       seeds 0-199 the Eyecatch agent catches 96.0 % of the throws, its held twin 9.5 %, its best static twin 25.0 %

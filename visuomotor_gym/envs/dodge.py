@@ -124,6 +124,9 @@ class ObstacleDodgeEnv(WalkerEnv):
       seeds 0-199 the best static posture of the eye reaches the goal in 48.5 % of the walks, fajen_warren
       in 91.0 % (docs/reproductions/data/terrain/dodge_groups.md); with the first definition's crowds and
       eye the best static posture reached 58 %. Former leaderboard entries are superseded.
+      Redefined in place again (one eye for every family): the one eye draws its lateral noise as an angle
+      about the eye (``angular_lateral_noise``; ``docs/reproductions/gaze_default.md`` (i)). Former entries
+      are superseded.
     """
 
     render_cameras: ClassVar[dict[str, tuple[str, ...]]] = {
