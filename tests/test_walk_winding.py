@@ -183,3 +183,32 @@ def test_walk_realism_reads_the_winding_walkway_in_path_coordinates():
     trace.task = {}  # the straight walkway's reading: the arc's point lies 1.5 m beside y = 0
     trace.gaze_dir = np.array([[*(ground - eye[0, :2]), -1.6]]) / np.linalg.norm([*(ground - eye[0, :2]), -1.6])
     assert on_walkway(trace).tolist() == [False]
+
+
+@pytest.mark.parametrize("steady", [True, False])
+def test_the_fixation_request_takes_the_eye_bob_out_of_the_eyes_height(steady):
+    """With ``fixation_steady_height`` the held fixation's direction is asked from the eye at its height averaged
+    over the last step (the head's bob out), else from its height now; by hand: a ground point 2 m ahead, the eye
+    bobbing 1.55 / 1.60 m, the eye frame level along x (its requested elevation is then the action's)."""
+    from visuomotor_gym.baselines.iwao.agent import IwaoParams
+
+    agent = IwaoAgent(IwaoParams(gaze_mode="footholds", fixation_steady_height=steady))
+    agent.target, agent.target_id, agent.fixation = (2.0, 0.0, 0.0), -1, (2.0, 0.0, 0.0)
+    rot = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+    heights = [1.55 if k % 2 else 1.60 for k in range(3 * agent.period_steps)]
+    obs = np.zeros(agent.layout.size)
+    for z in heights:
+        agent.fix_steps = 0  # hold the fixation: no new target is chosen
+        action = agent._look_footholds(obs, 0.0, ([0.0, 0.0, 0.0], rot, (0.0, 0.0, 0.0, z)))
+    window = heights[-agent.period_steps:]
+    z_seen = sum(window) / len(window) if steady else heights[-1]
+    assert action[1] * agent.gaze_range == pytest.approx(math.atan2(-z_seen, 2.0), abs=1e-9)
+    assert steady == (abs(z_seen - heights[-1]) > 0.02)  # the two differ by about half the bob
+
+
+def test_iwao_steadies_its_fixations_on_the_winding_walkway_only():
+    with registered_kwargs("ObstacleWalk-v0", {"course_distribution": "winding"}):
+        assert IwaoAgent.for_env("ObstacleWalk-v0").params.fixation_steady_height
+        assert not IwaoAgent.for_env("ObstacleWalk-v0", fixation_steady_height=False).params.fixation_steady_height
+    with registered_kwargs("ObstacleWalk-v0", {"course_distribution": "rough"}):
+        assert not IwaoAgent.for_env("ObstacleWalk-v0").params.fixation_steady_height
