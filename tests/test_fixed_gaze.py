@@ -171,3 +171,16 @@ def test_the_twin_holds_vergence_only_when_the_eye_has_the_depth_law():
     assert catch.hold_vergence and catch.held[fixation_index("EyeCatch-v0")]
     match_vision(stones, VisionParams())
     assert not stones.hold_vergence and not stones.held[fixation_index("SteppingStones-v0")]
+
+
+def test_the_twin_reads_the_action_blocks_of_the_kwargs_registered_now():
+    """``registered_kwargs`` can change an id's action blocks (ObstacleWalk's winding walkway: a fourth footstep
+    value); the twin made inside it holds the blocks the env has there, not those of an earlier read."""
+    from visuomotor_gym.agents import env_action_structure
+    from visuomotor_gym.static_gaze import registered_kwargs
+
+    for course, footstep in (("walkway", 3), ("winding", 4), ("walkway", 3)):
+        with registered_kwargs("ObstacleWalk-v0", {"course_distribution": course}):
+            assert env_action_structure("ObstacleWalk-v0")["footstep"] == footstep
+            blind = make_agent("gaze_blind:iwao", "ObstacleWalk-v0", footstep + 5)
+            assert np.flatnonzero(blind.held).tolist()[:2] == [footstep, footstep + 1]  # the gaze block
