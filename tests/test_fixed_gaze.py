@@ -184,3 +184,8 @@ def test_the_twin_reads_the_action_blocks_of_the_kwargs_registered_now():
             assert env_action_structure("ObstacleWalk-v0")["footstep"] == footstep
             blind = make_agent("gaze_blind:iwao", "ObstacleWalk-v0", footstep + 5)
             assert np.flatnonzero(blind.held).tolist()[:2] == [footstep, footstep + 1]  # the gaze block
+            env = gym.make("ObstacleWalk-v0")
+            still = make_agent("static_gaze:az=0,el=-30,neck_yaw=0,neck_pitch=-30,fix=3:iwao", "ObstacleWalk-v0",
+                               footstep + 5)
+            assert still.predict(env.reset(seed=0)[0])[0].shape == (footstep + 5,)  # the static twin too
+            env.close()
