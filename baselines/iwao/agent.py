@@ -657,8 +657,8 @@ class AgentPath:
 
 
 def _registered_course_is_rough(env_id: str) -> bool:
-    """Whether ``env_id`` is registered (in this process) with the rough course of ObstacleWalk or another
-    course with labelled slots (the rows with gaps)."""
+    """Whether ``env_id`` is registered (in this process) with a course of ObstacleWalk with labelled slots
+    (the winding walkway, its default; the rough course; the rows with gaps)."""
     from visuomotor_gym.tasks.obstacle_walk import ROUGH_LAYOUTS
 
     return _registered_layout(env_id) in ROUGH_LAYOUTS
@@ -676,8 +676,8 @@ def _registered_layout(env_id: str) -> str | None:
     except gym.error.Error:
         return None
     course = (spec.kwargs or {}).get("course_distribution")
-    if course is None:  # the env's default: the walkway course (ObstacleWalkEnv)
-        return "walkway" if str(spec.entry_point).endswith("envs.walk:ObstacleWalkEnv") else None
+    if course is None:  # the env's default: the winding walkway (ObstacleWalkEnv: WINDING_COURSE)
+        return "winding" if str(spec.entry_point).endswith("envs.walk:ObstacleWalkEnv") else None
     if isinstance(course, str):
         return COURSE_PRESETS[course].layout if course in COURSE_PRESETS else None
     if isinstance(course, dict):
