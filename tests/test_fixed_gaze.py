@@ -108,13 +108,13 @@ def test_joint_control_layout_and_bad_layout():
 @pytest.mark.parametrize("env_id, base", [("ObstacleWalk-v0", "iwao"), ("ShelfReach-v0", "faraway")])
 def test_the_twin_holds_gaze_and_head_in_every_family(env_id, base):
     """The twin reads the env's action_structure: the walk and reach layouts hold their own blocks (and the
-    fixation block where the eye has the depth law: ShelfReach-v0's human periphery)."""
+    fixation block where the eye has the depth law: both ids' human periphery)."""
     env = gym.make(env_id)
     structure = env.unwrapped.action_structure
     blind = make_agent(f"gaze_blind:{base}", env_id, env.action_space.shape[0])
     vp = env.unwrapped.vision_params
     blocks = ("gaze", "head") + (("fixation",) if vp.foveated and vp.depth_pedestal_arcmin is not None else ())
-    assert ("fixation" in blocks) == (env_id == "ShelfReach-v0")
+    assert "fixation" in blocks
     start, held = 0, []
     for name, size in structure.items():
         if name in blocks:
@@ -176,3 +176,21 @@ def test_the_twin_holds_vergence_only_when_the_eye_has_the_depth_law():
     assert make_agent("gaze_blind:eyecatch", "EyeCatch-v0", 7).hold_vergence  # EyeCatch-v0's own eye
     match_vision(stones, VisionParams())
     assert not stones.hold_vergence and not stones.held[fixation_index("SteppingStones-v0")]
+
+
+def test_the_twin_reads_the_action_blocks_of_the_kwargs_registered_now():
+    """``registered_kwargs`` can change an id's action blocks (ObstacleWalk's winding walkway: a fourth footstep
+    value); the twin made inside it holds the blocks the env has there, not those of an earlier read."""
+    from visuomotor_gym.agents import env_action_structure
+    from visuomotor_gym.static_gaze import registered_kwargs
+
+    for course, footstep in (("walkway", 3), ("winding", 4), ("walkway", 3)):
+        with registered_kwargs("ObstacleWalk-v0", {"course_distribution": course}):
+            assert env_action_structure("ObstacleWalk-v0")["footstep"] == footstep
+            blind = make_agent("gaze_blind:iwao", "ObstacleWalk-v0", footstep + 5)
+            assert np.flatnonzero(blind.held).tolist()[:2] == [footstep, footstep + 1]  # the gaze block
+            env = gym.make("ObstacleWalk-v0")
+            still = make_agent("static_gaze:az=0,el=-30,neck_yaw=0,neck_pitch=-30,fix=3:iwao", "ObstacleWalk-v0",
+                               footstep + 5)
+            assert still.predict(env.reset(seed=0)[0])[0].shape == (footstep + 5,)  # the static twin too
+            env.close()

@@ -56,6 +56,7 @@ CASES = [
     ("ShelfReach-v0", 0, "faraway", {}),
     ("ObstacleDodge-v0", 0, "fajen_warren", {}),
     ("SteppingStones-v0", 0, "lookahead", {}),
+    ("SteppingStonesFullView-v0", 0, None, {}),  # the one eye's angular lateral noise, without foveation
 ]
 
 

@@ -14,7 +14,7 @@ import pytest
 
 import visuomotor_gym  # noqa: F401  (registers the ids)
 from visuomotor_gym.agents import make_agent
-from visuomotor_gym.envs.walk import WALK_LAYOUT, ObstacleWalkEnv
+from visuomotor_gym.envs.walk import WALK_LAYOUT, WALKWAY_DEFINITION, WINDING_LAYOUT, ObstacleWalkEnv
 from visuomotor_gym.registration import ENV_SPECS, FAMILIES
 from visuomotor_gym.tasks.obstacle_walk import (
     BAR,
@@ -27,6 +27,10 @@ from visuomotor_gym.tasks.obstacle_walk import (
 )
 
 WALK_IDS = FAMILIES["walk"]
+# The first definition (the straight walkway's bars, boxes and mats, the 20 deg cone): what most tests here
+# check; the default (the winding walkway, the human periphery) is tested in tests/test_walk_winding.py.
+W = WALKWAY_DEFINITION
+W_VISION = WALKWAY_DEFINITION["vision_params"]
 
 
 def test_the_five_rungs_are_registered_in_the_walk_family():
@@ -39,8 +43,8 @@ def test_the_five_rungs_are_registered_in_the_walk_family():
 def test_every_rung_runs_from_the_registry_on_the_same_course(env_id):
     env = gym.make(env_id)
     obs, info = env.reset(seed=7)
-    assert obs.shape == (WALK_LAYOUT.size,) and env.observation_space.contains(obs)
-    ref = ObstacleWalkEnv()
+    assert obs.shape == (WINDING_LAYOUT.size,) and env.observation_space.contains(obs)
+    ref = ObstacleWalkEnv()  # the default: the winding walkway
     _, ref_info = ref.reset(seed=7)
     np.testing.assert_array_equal(info["obstacles"], ref_info["obstacles"])  # same course on every rung
     for _ in range(5):
@@ -49,9 +53,12 @@ def test_every_rung_runs_from_the_registry_on_the_same_course(env_id):
 
 
 def test_layout_and_action_blocks():
-    env = ObstacleWalkEnv()
+    env = ObstacleWalkEnv(**W)
     assert env.observation_structure == WALK_LAYOUT.structure
     assert env.action_structure == {"footstep": 3, "gaze": 2, "fixation": 1, "head": 2}
+    env = ObstacleWalkEnv()  # the default: the winding walkway's turning walker
+    assert env.observation_structure == WINDING_LAYOUT.structure
+    assert env.action_structure == {"footstep": 4, "gaze": 2, "fixation": 1, "head": 2}
 
 
 def _look_up(n):
@@ -78,7 +85,7 @@ def test_no_observation_leak_of_the_obstacles_true_state(vision):
     are or how high (the same episode with a moved course gives identical observations). The oracle rung
     (true corners) is the positive control: there the same change shows."""
     actions = _look_up(40)
-    a, b = ObstacleWalkEnv(vision=vision), ObstacleWalkEnv(vision=vision)
+    a, b = ObstacleWalkEnv(vision=vision, **W), ObstacleWalkEnv(vision=vision, **W)
     a.reset(seed=5)
     b.reset(seed=5)
     _move_obstacles(b)
@@ -121,12 +128,12 @@ def test_bars_span_the_walkway_and_everything_else_lies_inside_it():
         assert np.all(np.abs(ob[:, 1]) + 0.5 * ob[:, 3] <= half + 1e-12)
     assert n_bars > 20
     with pytest.raises(ValueError, match="walkway_width_m"):
-        ObstacleWalkEnv(course_distribution={"walkway_width_m": 0.0}).reset(seed=0)
+        ObstacleWalkEnv(vision_params=W_VISION, course_distribution={"walkway_width_m": 0.0}).reset(seed=0)
 
 
 def test_the_eye_sees_four_points_of_each_top_face():
     """On the oracle rung the slot's four points are the true corners and edge midpoints (eye frame)."""
-    env = ObstacleWalkEnv(vision="oracle")
+    env = ObstacleWalkEnv(vision="oracle", **W)
     obs, info = env.reset(seed=3)
     block = obs[WALK_LAYOUT.slices["obstacle_0"]]
     x, y, depth, width, height, _ = info["obstacles"][0]
@@ -150,7 +157,7 @@ def _walk_sideways(env, lateral):
 
 
 def test_leaving_the_walkway_ends_the_episode_as_a_failure():
-    env = ObstacleWalkEnv(course_distribution={"first_m": (8.0, 8.0)})  # nothing to trip on for 8 m
+    env = ObstacleWalkEnv(vision_params=W_VISION, course_distribution={"first_m": (8.0, 8.0)})  # nothing to trip on for 8 m
     env.reset(seed=0)
     _r, term, info = _walk_sideways(env, 1.0)
     assert term and info["off_path"] and not info["is_success"] and not info["tripped"]
@@ -158,7 +165,7 @@ def test_leaving_the_walkway_ends_the_episode_as_a_failure():
     feet_y = env.gait.feet_world(env.data)[:, 1]
     assert np.abs(feet_y).max() > 0.5 * env.course_distribution.walkway_width_m
     # Drifting sideways is fine inside a walkway wide enough for it.
-    wide = ObstacleWalkEnv(course_distribution={"first_m": (8.0, 8.0), "walkway_width_m": 40.0})
+    wide = ObstacleWalkEnv(vision_params=W_VISION, course_distribution={"first_m": (8.0, 8.0), "walkway_width_m": 40.0})
     wide.reset(seed=0)
     a = np.zeros(8, np.float32)
     a[1], a[2] = 1.0, 1.0
@@ -168,7 +175,7 @@ def test_leaving_the_walkway_ends_the_episode_as_a_failure():
 
 
 def test_the_task_checks_every_landed_foothold_once():
-    env = ObstacleWalkEnv()
+    env = ObstacleWalkEnv(**W)
     env.reset(seed=0)
     task: ObstacleWalkTask = env.task
     for _ in range(100):
@@ -178,7 +185,7 @@ def test_the_task_checks_every_landed_foothold_once():
 
 
 def test_a_trip_ends_the_episode_and_scores_nothing():
-    env = ObstacleWalkEnv()
+    env = ObstacleWalkEnv(**W)
     env.reset(seed=0)
     a = np.zeros(8, np.float32)
     a[0], a[2] = 0.1, -1.0  # 0.65 m steps, 2 cm clearance: walks into the first bar
@@ -191,8 +198,8 @@ def test_a_trip_ends_the_episode_and_scores_nothing():
 
 
 def _successes(agent, seeds):
-    env = gym.make("ObstacleWalk-v0")
-    policy = make_agent(agent, "ObstacleWalk-v0", 8)
+    env = gym.make("ObstacleWalk-v0")  # the default: the winding walkway, 9 actions
+    policy = make_agent(agent, "ObstacleWalk-v0", int(env.action_space.shape[0]))
     wins = 0
     for seed in seeds:
         obs, _ = env.reset(seed=seed)

@@ -18,6 +18,8 @@ from visuomotor_gym.baselines.belief_mpc.stone_belief import plane_variance
 
 import visuomotor_gym  # noqa: F401
 from visuomotor_gym.agents import make_agent, match_vision
+from visuomotor_gym.envs.walk import WALKWAY_DEFINITION
+from visuomotor_gym.static_gaze import registered_kwargs
 from visuomotor_gym.vision import periphery
 from visuomotor_gym.vision.foveation import ARCMIN, DEG, VisionParams
 
@@ -30,7 +32,7 @@ def _inner(policy):
     return policy
 
 
-# The walk family's 20 deg cone without the periphery (ObstacleWalk's default; SteppingStones' first definition).
+# The walk family's 20 deg cone without the periphery (ObstacleWalk's and SteppingStones' first definitions).
 CONE = {"field_shape": "cone", "field_of_view_deg": 20.0, "position_e2_deg": None, "crowding": False,
         "depth_pedestal_arcmin": None}
 
@@ -139,9 +141,12 @@ def test_iwao_verges_on_its_gaze_target_only_under_the_depth_law():
     for fields, check in (({}, lambda a: a == 0.0),
                           ({"depth_pedestal_arcmin": 10.0},
                            lambda a: 1.8 <= math.exp(lo + (a + 1.0) * 0.5 * (hi - lo)) <= 8.0)):
-        env = gym.make("ObstacleWalk-v0", vision_params=fields) if fields else gym.make("ObstacleWalk-v0")
-        try:
+        # on the first definition's walkway and eye (WALKWAY_DEFINITION), the depth law laid over it or not
+        first = {"course_distribution": "walkway", "vision_params": {**WALKWAY_DEFINITION["vision_params"], **fields}}
+        with registered_kwargs("ObstacleWalk-v0", first):
+            env = gym.make("ObstacleWalk-v0")
             policy = make_agent("iwao", "ObstacleWalk-v0", int(env.action_space.shape[0]))
+        try:
             match_vision(policy, env.unwrapped.vision_params)
             fix = env.unwrapped.action_structure  # the fixation action's index in the flat action
             index = sum(n for name, n in list(fix.items())[:list(fix).index("fixation")])

@@ -9,7 +9,7 @@ from visuomotor_gym.baselines.ppo import train
 
 from visuomotor_gym.agents import make_agent
 from visuomotor_gym.bench.evaluate import evaluate
-from visuomotor_gym.envs.walk import WALK_LAYOUT
+from visuomotor_gym.envs.walk import WINDING_LAYOUT
 
 
 @pytest.mark.parametrize(
@@ -120,13 +120,13 @@ def test_walk_id_trains_without_the_catch_features_and_its_npz_walks(tmp_path):
                       "--no-progress-bar", "--set", "n_envs=2", "n_steps=128", "batch_size=128", "eval_freq=100000",
                       "eval_episodes=1", "checkpoint_freq=100000"])
     meta = json.loads((run / "ppo_meta.json").read_text())
-    assert meta["env_id"] == "ObstacleWalk-v0" and not meta["belief"] and len(meta["obs_mean"]) == WALK_LAYOUT.size
+    assert meta["env_id"] == "ObstacleWalk-v0" and not meta["belief"] and len(meta["obs_mean"]) == WINDING_LAYOUT.size
     from visuomotor_gym.baselines.ppo.agent import pack_npz
 
     npz = tmp_path / "walk.npz"
     npz.write_bytes(pack_npz(run))
     result = evaluate(f"ppo:{npz}", "ObstacleWalk-v0", 1, 0, workers=1)
-    assert result.summary["episodes"] == 1 and result.traces[0].action.shape[1] == 8
+    assert result.summary["episodes"] == 1 and result.traces[0].action.shape[1] == 9  # the turning walker
 
 
 def test_ppo_agent_needs_a_policy_file():

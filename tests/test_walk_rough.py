@@ -174,8 +174,9 @@ def test_an_obstacle_passed_unseen_changes_no_slot_id():
 def test_iwao_looks_at_footholds_on_the_rough_course():
     from visuomotor_gym.agents import make_agent
 
-    agent = make_agent("iwao", "ObstacleWalk-v0", 8, seed=0)
-    assert agent.params.gaze_mode == "iwao"
+    with registered_kwargs("ObstacleWalk-v0", {"course_distribution": "walkway"}):
+        agent = make_agent("iwao", "ObstacleWalk-v0", 8, seed=0)
+        assert agent.params.gaze_mode == "iwao"
     with registered_kwargs("ObstacleWalk-v0", {"course_distribution": "rough"}):
         agent = make_agent("iwao", "ObstacleWalk-v0", 8, seed=0)
         env = gym.make("ObstacleWalk-v0")

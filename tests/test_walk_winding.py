@@ -13,9 +13,12 @@ import pytest
 from visuomotor_gym.baselines.iwao.agent import AgentPath, IwaoAgent
 
 from visuomotor_gym.agents import make_agent
+from visuomotor_gym.envs.walk import OBSTACLE_WALK_VISION, WALK_VISION, WALKWAY_DEFINITION, ObstacleWalkEnv
 from visuomotor_gym.static_gaze import registered_kwargs
 from visuomotor_gym.tasks.obstacle_walk import (
     COURSE_PRESETS,
+    K_SLOTS,
+    N_POINTS,
     PATH_DS_M,
     WINDING_COURSE,
     CourseDistribution,
@@ -24,6 +27,7 @@ from visuomotor_gym.tasks.obstacle_walk import (
     sample_path,
     top_points,
 )
+from visuomotor_gym.vision.foveation import human_periphery
 
 
 @pytest.mark.parametrize("seed", range(12))
@@ -82,8 +86,10 @@ def test_top_points_turned_by_hand():
     assert top_points(1.0, 2.0, 0.2, 0.4, 0.01) == top_points(1.0, 2.0, 0.2, 0.4, 0.01, 0.0)
 
 
-def test_the_winding_preset_is_opt_in_and_checks_its_fields():
+def test_the_winding_preset_is_the_default_and_checks_its_fields():
     assert COURSE_PRESETS["winding"] is WINDING_COURSE and WINDING_COURSE.rough
+    assert ObstacleWalkEnv().course_distribution == WINDING_COURSE  # the default (ObstacleWalk-v0 redefined)
+    assert ObstacleWalkEnv().vision_params == OBSTACLE_WALK_VISION == human_periphery(WALK_VISION)
     with pytest.raises(ValueError, match="winding_turn_deg"):
         CourseDistribution(layout="winding", winding_turn_deg=(10.0, 120.0))
     with pytest.raises(ValueError, match="winding_max_heading_deg"):
@@ -102,7 +108,7 @@ def test_the_env_turns_its_walker_and_shows_the_centre_line_ahead():
     for k, (x, y) in enumerate(ahead.tolist()):
         px, py = u.course.path.to_world(s0 + 0.5 * k, 0.0)
         assert (x, y) == pytest.approx((px - qx, py - qy), abs=2e-3)
-    straight = gym.make("ObstacleWalk-v0")
+    straight = gym.make("ObstacleWalk-v0", **WALKWAY_DEFINITION)
     assert straight.action_space.shape == (8,) and "path_ahead" not in straight.unwrapped.layout.structure
     env.close()
     straight.close()
@@ -129,9 +135,10 @@ def test_the_agent_path_follows_the_centre_line():
 
 
 def test_iwao_picks_the_winding_mode_from_the_registered_course():
-    with registered_kwargs("ObstacleWalk-v0", {"course_distribution": "winding"}):
-        assert IwaoAgent.for_env("ObstacleWalk-v0").params.winding
-    assert not IwaoAgent.for_env("ObstacleWalk-v0").params.winding
+    with registered_kwargs("ObstacleWalk-v0", {"course_distribution": "walkway"}):
+        assert not IwaoAgent.for_env("ObstacleWalk-v0").params.winding
+    assert IwaoAgent.for_env("ObstacleWalk-v0").params.winding  # the default
+    assert IwaoAgent.for_env("ObstacleWalk-v0").params.gaze_mode == "footholds"
 
 
 def test_the_planner_with_true_footprints_walks_a_winding_course():
@@ -183,3 +190,88 @@ def test_walk_realism_reads_the_winding_walkway_in_path_coordinates():
     trace.task = {}  # the straight walkway's reading: the arc's point lies 1.5 m beside y = 0
     trace.gaze_dir = np.array([[*(ground - eye[0, :2]), -1.6]]) / np.linalg.norm([*(ground - eye[0, :2]), -1.6])
     assert on_walkway(trace).tolist() == [False]
+
+
+@pytest.mark.parametrize("steady", [True, False])
+def test_the_fixation_request_takes_the_eye_bob_out_of_the_eyes_height(steady):
+    """With ``fixation_steady_height`` the held fixation's direction is asked from the eye at its height averaged
+    over the last step (the head's bob out), else from its height now; by hand: a ground point 2 m ahead, the eye
+    bobbing 1.55 / 1.60 m, the eye frame level along x (its requested elevation is then the action's)."""
+    from visuomotor_gym.baselines.iwao.agent import IwaoParams
+
+    agent = IwaoAgent(IwaoParams(gaze_mode="footholds", fixation_steady_height=steady))
+    agent.target, agent.target_id, agent.fixation = (2.0, 0.0, 0.0), -1, (2.0, 0.0, 0.0)
+    rot = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+    heights = [1.55 if k % 2 else 1.60 for k in range(3 * agent.period_steps)]
+    obs = np.zeros(agent.layout.size)
+    for z in heights:
+        agent.fix_steps = 0  # hold the fixation: no new target is chosen
+        action = agent._look_footholds(obs, 0.0, ([0.0, 0.0, 0.0], rot, (0.0, 0.0, 0.0, z)))
+    window = heights[-agent.period_steps:]
+    z_seen = sum(window) / len(window) if steady else heights[-1]
+    assert action[1] * agent.gaze_range == pytest.approx(math.atan2(-z_seen, 2.0), abs=1e-9)
+    assert steady == (abs(z_seen - heights[-1]) > 0.02)  # the two differ by about half the bob
+
+
+def test_iwao_steadies_its_fixations_on_the_winding_walkway_only():
+    with registered_kwargs("ObstacleWalk-v0", {"course_distribution": "winding"}):
+        assert IwaoAgent.for_env("ObstacleWalk-v0").params.fixation_steady_height
+        assert not IwaoAgent.for_env("ObstacleWalk-v0", fixation_steady_height=False).params.fixation_steady_height
+    with registered_kwargs("ObstacleWalk-v0", {"course_distribution": "rough"}):
+        assert not IwaoAgent.for_env("ObstacleWalk-v0").params.fixation_steady_height
+
+
+def test_an_obstacle_passed_unseen_changes_no_slot_id_on_the_winding_walkway():
+    """Counterfactual courses on the default (winding) walkway: in A a patch lies beside the straight start at
+    s = 1.2 m, which the walker passes while looking up; in B the same patch lies behind the start. Every other
+    obstacle is the same. The observations are identical all along (while looking up every slot is empty, id
+    -1; once the walker looks down the first obstacle it sees is labelled 0 in both, although A has passed one
+    obstacle more). The oracle rung (true points, course indices) is the positive control: there it shows."""
+    patches = {"kind_p": (0.0, 0.0, 1.0), "first_m": (5.5, 5.5)}  # flat patches, beyond the 5 m sight range
+    runs = {}
+    for vision in ("foveated", "oracle"):
+        for name, s_ in (("A", 1.2), ("B", -3.0)):
+            env = ObstacleWalkEnv(vision=vision, course_distribution={**WINDING_COURSE.__dict__, **patches})
+            env.reset(seed=3)
+            task = env.task
+            assert task.course.path.heading_at(0.0) == 0.0 and task.course.path.heading_at(1.2) == 0.0
+            row = task.course.local[0].copy()
+            row[0], row[1] = s_, 0.6  # on the straight start (path = world frame there), beside the feet
+            task.course.local[0] = row
+            task.course.obstacles[0] = row
+            task.course.yaw[0] = 0.0
+            x, y, depth, width, height, _ = row.tolist()
+            task.pool.place(env.model, env.data, 0, x, y, depth, width, height, yaw=0.0)
+            for t, point in zip(task.targets[:N_POINTS], top_points(x, y, depth, width, height)):
+                t.place(*point)
+            out = []
+            slots = [env.layout.slices[f"obstacle_{k}"] for k in range(K_SLOTS)]
+            for t in range(140):  # straight at the nominal step: gaze and head up, then 25 deg down
+                a = np.zeros(9, np.float32)
+                up = t < 100
+                elevation = np.degrees(np.arcsin(env.eye.rot[2, 0]))  # the line of sight's (test driver only)
+                a[5] = 0.5 if up else float(np.clip((-25.0 - elevation) / 60.0, -0.5, 0.0))
+                a[8] = 1.0 if up else 0.0
+                obs, _, term, trunc, info = env.step(a)
+                out.append(([obs[sl] for sl in slots], obs, info))
+                assert not term and not trunc
+            runs[vision, name] = out
+            env.close()
+    a, b = runs["foveated", "A"], runs["foveated", "B"]
+    assert a[99][2]["obstacles_passed"] == 1 and b[99][2]["obstacles_passed"] == 1  # A passed it walking
+    assert a[0][2]["obstacles_passed"] == 0
+    for (_, oa, _), (_, ob, _) in zip(a, b):
+        np.testing.assert_array_equal(oa, ob)
+    assert {float(sl[0]) for slots, _, _ in a[:100] for sl in slots} == {-1.0}
+    seen = [(float(sl[0]), sl[1 + 3 * N_POINTS:]) for slots, _, _ in a[100:] for sl in slots]
+    assert any(flags.any() for _, flags in seen)
+    assert min(i for i, flags in seen if flags.any()) == 0.0
+    assert any(not np.array_equal(oa, ob) for (_, oa, _), (_, ob, _) in zip(runs["oracle", "A"], runs["oracle", "B"]))
+
+
+def test_a_nan_arc_length_reads_nan_not_an_error():
+    """Diverged physics makes the pelvis NaN: the centre line then gives NaN points (the env flags the
+    divergence) instead of raising while it builds the observation."""
+    path = sample_path(np.random.default_rng(0), WINDING_COURSE, 16.0)
+    assert all(math.isnan(v) for v in path.to_world(float("nan"), 0.0))
+    assert path.to_world(1.0, 0.0) == pytest.approx((1.0, 0.0))  # finite arc lengths as before

@@ -362,15 +362,24 @@ def registered_kwargs(env_id: str, kwargs: dict | None):
         return
     if not isinstance(kwargs, dict):
         raise TypeError(f"env kwargs must be a dict of constructor arguments, got {type(kwargs).__name__}")
+    from visuomotor_gym.agents import _registered_action_structure
+
     spec = gym.registry[env_id.removeprefix("visuomotor_gym:")]
     saved = dict(spec.kwargs)
     spec.kwargs.update(kwargs)
+    # The action blocks read from the registered id (agents.env_action_structure and env_geometry, cached per
+    # process) may differ under these kwargs (ObstacleWalk's winding walkway has a fourth footstep value): read
+    # them again.
+    _registered_action_structure.cache_clear()
+    env_geometry.cache_clear()
     try:
         gym.make(spec.id).close()  # refuse a bad argument here, naming it, before any search
         yield
     finally:
         spec.kwargs.clear()
         spec.kwargs.update(saved)
+        _registered_action_structure.cache_clear()
+        env_geometry.cache_clear()
 
 
 def neck_along(az: float, el: float, geometry: EyeGeometry) -> tuple[float, float]:

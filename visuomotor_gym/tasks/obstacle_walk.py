@@ -54,8 +54,8 @@ must step through each gap. Sizes and spacings are modelling choices; labelled s
 as on the rough course. Measured: it does not need a moving eye (a fixed posture 30 deg down crosses as
 often as iwao; docs/reproductions/data/terrain/obstacle_walk.md, fifth session).
 
-**The winding walkway** (opt-in, ``course_distribution="winding"``: :data:`WINDING_COURSE`, a design probe for
-the moving-eye redefinition): the rough course's hazards laid in *path coordinates* (``s`` along the centre
+**The winding walkway** (``course_distribution="winding"``: :data:`WINDING_COURSE`, ObstacleWalk-v0's default
+since the moving-eye redefinition): the rough course's hazards laid in *path coordinates* (``s`` along the centre
 line, ``n`` across it, each obstacle turned to the path's heading at its centre) on a walkway whose centre
 line runs 2 m straight from the start, then alternates arcs (25-50 deg of heading over 2-3.5 m, to the left
 or right at random, the heading kept within +-60 deg of the start's) and straights of 0.5-1.5 m
@@ -226,7 +226,7 @@ ROUGH_COURSE = CourseDistribution(layout="rough", length_m=(12.0, 14.0), first_m
 DENSE_ROUGH_COURSE = replace(ROUGH_COURSE, rough_step_m=(0.45, 0.8))
 # Rows with gaps (opt-in, preset "rows"): ROUGH_COURSE's length and start with the rows of _sample_rows.
 ROWS_COURSE = replace(ROUGH_COURSE, layout="rows")
-# The winding walkway (opt-in, preset "winding"): ROUGH_COURSE's hazards in path coordinates on a centre line of
+# The winding walkway (preset "winding", ObstacleWalkEnv's default): ROUGH_COURSE's hazards in path coordinates on a centre line of
 # arcs and straights (sample_path).
 WINDING_COURSE = replace(ROUGH_COURSE, layout="winding")
 COURSE_PRESETS = {"walkway": CourseDistribution(), "rough": ROUGH_COURSE, "rough_dense": DENSE_ROUGH_COURSE,
@@ -246,7 +246,9 @@ class WindingPath:
         self.length = PATH_DS_M * (len(self.xy) - 1)
 
     def _index(self, s: float) -> tuple[int, float]:
-        f = min(max(s / PATH_DS_M, 0.0), len(self.xy) - 1.0)
+        f = s / PATH_DS_M
+        # a NaN arc length (diverged physics: the pelvis is NaN) reads the start; the caller's result stays NaN
+        f = min(max(f, 0.0), len(self.xy) - 1.0) if f == f else 0.0
         i = min(int(f), len(self.xy) - 2)
         return i, f - i
 

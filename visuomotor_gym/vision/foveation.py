@@ -345,8 +345,10 @@ def _draw_at(x, y, z, d, ecc, velocity_eye, retinal_speed, params, rng, fixation
     1 / f**2)``, ``s = params.position_disarray`` and ``f`` the position law's growth at ``ecc``
     (:func:`~visuomotor_gym.vision.periphery.position_factor`): a share ``s`` of the variance the periphery
     adds to the fovea's is fixed in place (the same unit variance; the same six draws from ``rng``). With
-    ``params.angular_lateral_noise`` the lateral offset is then scaled by ``(d + n_depth) / d``: the same
-    angle about the eye, at the perceived distance."""
+    ``params.angular_lateral_noise`` and ``params.foveated`` the lateral offset is then scaled by ``(d +
+    n_depth) / d``: the same angle about the eye, at the perceived distance. Without foveation (the full-view
+    rungs) the draw stays Eyecatch's in metres, as the compiled retina's foveal kernel draws it (a
+    peripheral mechanism, like the others of ``periphery_on``)."""
     s0, s1, s2, s3, s4, s5 = _sigmas(d, ecc, retinal_speed, params, fixation)
     e0, e1, e2, e3, e4, e5 = rng.standard_normal(6).tolist()
     if fixed is not None:

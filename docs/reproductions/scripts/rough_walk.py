@@ -30,23 +30,34 @@ POSITION_E2 = {"position_e2_deg": 0.7}  # Levi, Klein & Aitsebaomo 1985, as quot
 CROWDING = {"crowding": True}  # Bouma 1970, b = 0.5; Parkes et al. 2001
 DEPTH = {"depth_pedestal_arcmin": 10.0}  # Blakemore 1970; the constant a modelling choice
 DISARRAY = {"position_disarray": 0.8}  # Hess & Field 1993; the share a modelling choice (the lead's 0.8)
-# human_periphery(position_disarray=0.8): the four mechanisms and the retinotopic disarray (the one eye)
-ONE_EYE = {**HUMAN_FIELD, **POSITION_E2, **CROWDING, **DEPTH, **DISARRAY}
+# the four mechanisms and the retinotopic disarray, lateral noise in metres (the one eye before the angular draw;
+# the conditions and scripts whose numbers were recorded with it keep it)
+ONE_EYE_METRIC = {**HUMAN_FIELD, **POSITION_E2, **CROWDING, **DEPTH, **DISARRAY}
+ANGULAR = {"angular_lateral_noise": True}  # modelling choice (visuomotor_gym.vision.foveation.HUMAN_PERIPHERY)
+# human_periphery(): the one eye now, the lateral noise drawn as an angle about the eye
+ONE_EYE = {**ONE_EYE_METRIC, **ANGULAR}
+# The walk family's former eye, every field the conditions set spelled out (ObstacleWalk-v0's default is now the
+# one eye, so a condition lays its mechanisms over this, not over the default): the 20 deg cone
+# (envs.walk.WALK_VISION), no peripheral mechanism.
+CONE = {"field_shape": "cone", "field_of_view_deg": 20.0, "position_e2_deg": None, "crowding": False,
+        "depth_pedestal_arcmin": None, "position_disarray": 0.0, "angular_lateral_noise": False}
 CONDITIONS = {
-    "walkway, default vision": ({}, {}),
-    "rough, default vision": ("rough", {}),
-    "rough, human field": ("rough", dict(HUMAN_FIELD)),
-    "rough, field + E2 + crowding": ("rough", {**HUMAN_FIELD, **POSITION_E2, **CROWDING}),
-    "rough, all four": ("rough", {**HUMAN_FIELD, **POSITION_E2, **CROWDING, **DEPTH}),
-    "rough, all four + disarray 0.8": ("rough", ONE_EYE),
+    "walkway, default vision": ("walkway", dict(CONE)),
+    "rough, default vision": ("rough", dict(CONE)),
+    "rough, human field": ("rough", {**CONE, **HUMAN_FIELD}),
+    "rough, field + E2 + crowding": ("rough", {**CONE, **HUMAN_FIELD, **POSITION_E2, **CROWDING}),
+    "rough, all four": ("rough", {**CONE, **HUMAN_FIELD, **POSITION_E2, **CROWDING, **DEPTH}),
+    "rough, all four + disarray 0.8": ("rough", {**CONE, **ONE_EYE_METRIC}),
     # the denser rough course (preset "rough_dense": hazards every 0.45-0.8 m) under the same eye
-    "rough dense, all four + disarray 0.8": ("rough_dense", ONE_EYE),
+    "rough dense, all four + disarray 0.8": ("rough_dense", {**CONE, **ONE_EYE_METRIC}),
     # the opt-in rows with gaps (preset "rows": tasks.obstacle_walk.ROWS_COURSE) under the same eye
-    "rows, all four + disarray 0.8": ("rows", ONE_EYE),
-    # the opt-in winding walkway (preset "winding": tasks.obstacle_walk.WINDING_COURSE) under the same eye
-    "winding, all four + disarray 0.8": ("winding", ONE_EYE),
+    "rows, all four + disarray 0.8": ("rows", {**CONE, **ONE_EYE_METRIC}),
+    # the winding walkway (preset "winding": tasks.obstacle_walk.WINDING_COURSE) under the same eye
+    "winding, all four + disarray 0.8": ("winding", {**CONE, **ONE_EYE_METRIC}),
+    # the winding walkway under human_periphery() (the angular lateral noise on): ObstacleWalk-v0's default
+    "winding, one eye": ("winding", {**CONE, **ONE_EYE}),
     # a variant: the rough course with flat patches only (no rocks), ROUGH_COURSE with kind_p = (0, 0, 1)
-    "rough patches only, field + E2 + crowding": ("rough patches", {**HUMAN_FIELD, **POSITION_E2, **CROWDING}),
+    "rough patches only, field + E2 + crowding": ("rough patches", {**CONE, **HUMAN_FIELD, **POSITION_E2, **CROWDING}),
 }
 
 

@@ -26,7 +26,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import rough_walk as rw
 
-ALL_FOUR = {"field_shape": "human", "position_e2_deg": 0.7, "crowding": True, "depth_pedestal_arcmin": 10.0}
+ALL_FOUR = {**rw.CONE, "field_shape": "human", "position_e2_deg": 0.7, "crowding": True, "depth_pedestal_arcmin": 10.0}
 
 
 def main(argv=None) -> int:
@@ -53,7 +53,8 @@ def main(argv=None) -> int:
         pl.FootstepPlanner.__init__ = patched
     rw.patch_iwao_from_env()  # fields laid over IwaoParams from $IWAO (probes only)
     course = dataclasses.asdict(dataclasses.replace(ROUGH_COURSE, **json.loads(a.course)))
-    kwargs = {"course_distribution": course, "vision_params": json.loads(a.vision)}
+    # the vision laid over the walk family's former eye (rw.CONE), not over the default's one eye
+    kwargs = {"course_distribution": course, "vision_params": {**rw.CONE, **json.loads(a.vision)}}
     lo, hi = map(int, a.seeds.split(":"))
     for spec in a.agents.split(";"):
         t0 = time.time()

@@ -22,7 +22,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import rough_walk as rw
 
-VISION = rw.ONE_EYE  # human_periphery(position_disarray=0.8)
+VISION = {**rw.CONE, **rw.ONE_EYE_METRIC}  # the one eye before the angular draw (its numbers were recorded so)
 
 
 def main(argv=None) -> int:
