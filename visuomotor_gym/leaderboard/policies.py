@@ -283,7 +283,20 @@ def _belief_mpc_load(data: bytes, env_id: str) -> Policy:
     obj = _read_json_policy(data, BELIEF_MPC_FORMAT, env_id)
     agent_cls, params_cls, vision = _belief_mpc_classes(env_id)
     params = params_cls(**_typed_params(obj["params"], params_cls, params_cls.__name__, fill_defaults=True))
-    return agent_cls(params, vision=env_vision_params(env_id)) if vision else agent_cls(params)
+    if vision:
+        return agent_cls(params, vision=env_vision_params(env_id))
+    agent = agent_cls(params)
+    from visuomotor_gym.families import family_for
+
+    if family_for(env_id).belief_mpc.env_vision:
+        # every constant of the env's eye, as the spec path gives it (agents._with_env_vision): the human
+        # periphery of EyeCatch-v0 is more than the noise scale and foveation the params carry
+        from visuomotor_gym.agents import _with_env_vision, parse_agent_spec
+
+        if not isinstance(obj.get("agent"), str):
+            raise ValueError(f"agent must be an agent spec string, got {obj.get('agent')!r}")
+        _with_env_vision(agent, env_id, parse_agent_spec(obj["agent"])[1])
+    return agent
 
 
 def _belief_mpc_same(committed: bytes, fresh: bytes, env_id: str) -> bool:
