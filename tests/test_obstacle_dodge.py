@@ -393,7 +393,7 @@ def test_wide_preset_draws_its_angles_and_sides_and_one_seed_is_one_crowd_on_eve
     wide = CROWD_PRESETS["wide"]
     assert wide == CrowdDistribution(angle_deg=WIDE_ANGLE_DEG, side_m=WIDE_SIDE_M, group_size=(1, 2),
                                       onset_gap_s=(1.0, 2.0)) and wide.groups
-    assert WIDE_ANGLE_DEG > CrowdDistribution().angle_deg
+    assert CrowdDistribution().angle_deg < WIDE_ANGLE_DEG
     angles, sides, lateral, sizes, gaps = [], [], [], [], []
     for seed in range(300):
         p = sample_crowd(np.random.default_rng(seed), wide).pedestrians

@@ -50,8 +50,10 @@ def main() -> None:
     for name in sorted(CROWD_PRESETS):
         frac, b = threat_bearings(CROWD_PRESETS[name], args.seeds)
         p10, p50, p90 = np.percentile(b, [10, 50, 90])
-        print(f"{name:7s} threats {frac:.2f} of pedestrians; bearing 2 s before contact p10/p50/p90 "
-              f"{p10:.0f}/{p50:.0f}/{p90:.0f} deg, beyond 60 deg {np.mean(b > 60):.2f}")
+        print(
+            f"{name:7s} threats {frac:.2f} of pedestrians; bearing 2 s before contact p10/p50/p90 "
+            f"{p10:.0f}/{p50:.0f}/{p90:.0f} deg, beyond 60 deg {np.mean(b > 60):.2f}"
+        )
 
 
 if __name__ == "__main__":
