@@ -23,6 +23,8 @@ from visuomotor_gym.registration import ENV_SPECS, FAMILIES
 from visuomotor_gym.tasks.obstacle_dodge import (
     CROWD_PRESETS,
     N_PEDESTRIANS,
+    WIDE_ANGLE_DEG,
+    WIDE_SIDE_M,
     CrowdDistribution,
     intercept_velocity,
     sample_crowd,
@@ -382,6 +384,50 @@ def test_groups_are_reproducible_and_one_seed_is_one_crowd_on_every_rung():
         env.close()
     assert all(np.array_equal(c, crowds[0]) for c in crowds)
     assert len(np.unique(crowds[0][:, 0])) < N_PEDESTRIANS  # some walk together
+
+
+def test_wide_preset_draws_its_angles_and_sides_and_one_seed_is_one_crowd_on_every_rung():
+    """The opt-in "wide" preset (issue 23): singles and pairs, one party every 1-2 s, crossing up to
+    WIDE_ANGLE_DEG off the perpendicular (head-on and overtaking, both sides of the path) from WIDE_SIDE_M
+    to the side."""
+    wide = CROWD_PRESETS["wide"]
+    assert wide == CrowdDistribution(angle_deg=WIDE_ANGLE_DEG, side_m=WIDE_SIDE_M, group_size=(1, 2),
+                                      onset_gap_s=(1.0, 2.0)) and wide.groups
+    assert CrowdDistribution().angle_deg < WIDE_ANGLE_DEG
+    angles, sides, lateral, sizes, gaps = [], [], [], [], []
+    for seed in range(300):
+        p = sample_crowd(np.random.default_rng(seed), wide).pedestrians
+        onsets = np.unique(p[:, 0])
+        gaps += np.diff(onsets).tolist()
+        for onset in onsets:
+            g = p[p[:, 0] == onset]
+            sizes.append(len(g))
+            vx, vy = g[0, 3], g[0, 4]
+            angles.append(math.degrees(math.atan2(vx, abs(vy))))  # + walks the walker's way, - toward it
+            sides.append(np.sign(g[:, 2].mean()))
+            lateral.append(abs(g[:, 2].mean()))  # the group centre's start, off the path
+    angles, lateral = np.array(angles), np.array(lateral)
+    assert np.all(np.abs(angles) <= WIDE_ANGLE_DEG + 1e-9)
+    assert np.mean(angles > 45.0) > 0.15 and np.mean(angles < -45.0) > 0.15  # overtaking and head-on
+    assert 0.4 < np.mean(np.array(sides) > 0) < 0.6  # both sides of the path
+    assert lateral.min() >= WIDE_SIDE_M[0] - 1e-9 and lateral.max() <= WIDE_SIDE_M[1] + 1e-9
+    assert lateral.max() > CrowdDistribution().side_m[1] and lateral.min() < CrowdDistribution().side_m[0]
+    assert set(sizes) == {1, 2} and 0.5 < np.mean(np.array(sizes) == 1) < 0.7  # singles, pairs (the last cut)
+    assert min(gaps) >= 1.0 - 1e-9 and max(gaps) <= 2.0 + 1e-9
+    crowds = []
+    for env_id in DODGE_IDS:
+        env = gym.make(env_id, crowd_distribution="wide")
+        assert env.unwrapped.crowd_distribution == wide
+        env.reset(seed=11)
+        crowds.append(env.unwrapped.crowd.pedestrians.copy())
+        env.reset(seed=11)
+        assert np.array_equal(env.unwrapped.crowd.pedestrians, crowds[-1])
+        env.close()
+    assert all(np.array_equal(c, crowds[0]) for c in crowds)
+    default = gym.make(DODGE_IDS[0])
+    default.reset(seed=11)
+    assert not np.array_equal(default.unwrapped.crowd.pedestrians, crowds[0])  # opt-in: the default is unchanged
+    default.close()
 
 
 def _set_crowd(env, rows):

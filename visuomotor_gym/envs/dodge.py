@@ -144,8 +144,10 @@ class ObstacleDodgeEnv(WalkerEnv):
     vision_defaults = DODGE_VISION
     argument_meanings = {  # noqa: RUF012  (read only: the generated Arguments table)
         "crowd_distribution": ('``CrowdDistribution``, a dict of its fields, or a preset name: ``"groups"`` (the '
-                               'default: pairs and triads) or ``"single"`` (every pedestrian alone, the first '
-                               'definition); ``CROWD_PRESETS`` in ``visuomotor_gym.tasks.obstacle_dodge``'),
+                               'default: pairs and triads), ``"single"`` (every pedestrian alone, the first '
+                               'definition) or ``"wide"`` (opt-in prototype: singles and pairs from up to 70 deg '
+                               'off the perpendicular, one party every 1-2 s); ``CROWD_PRESETS`` in '
+                               '``visuomotor_gym.tasks.obstacle_dodge``'),
         "render_camera": '``"both"`` (top view beside the eye view), ``"side"``, ``"follow"``, ``"top"``, ``"eye"``',
     }
     scene = DODGE_SCENE
