@@ -387,7 +387,7 @@ def test_groups_are_reproducible_and_one_seed_is_one_crowd_on_every_rung():
 
 
 def test_wide_preset_draws_its_angles_and_sides_and_one_seed_is_one_crowd_on_every_rung():
-    """The opt-in "wide" preset (issue 23): singles and pairs, one party every 1-2 s, crossing up to
+    """The opt-in "wide" preset: singles and pairs, one party every 1-2 s, crossing up to
     WIDE_ANGLE_DEG off the perpendicular (head-on and overtaking, both sides of the path) from WIDE_SIDE_M
     to the side."""
     wide = CROWD_PRESETS["wide"]

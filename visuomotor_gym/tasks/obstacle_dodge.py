@@ -156,7 +156,7 @@ class CrowdDistribution:
 
 
 # "groups": the default, pairs and triads (Moussaid et al. 2010); "single": the first definition's crowds,
-# every pedestrian alone. "wide" (opt-in prototype, issue 23: a crowd no single eye posture covers): more,
+# every pedestrian alone. "wide" (opt-in prototype: a crowd no single eye posture covers): more,
 # smaller parties from more directions, overlapping in time. Singles and pairs (WIDE_GROUP_SIZE, uniform over
 # parties, the fourth pedestrian's cut to what is left: 43 % of the pedestrians alone, 57 % in pairs;
 # Moussaid et al. 2010: up to 70 % of pedestrians walk in groups, pairs the commonest), one party every
