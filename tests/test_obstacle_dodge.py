@@ -373,17 +373,24 @@ def test_groups_have_one_lone_veerer_and_keep_ten_percent_of_pedestrians_veering
     assert 0.07 < np.mean(veers) < 0.13  # veer_p of the pedestrians (Jovancevic et al.)
 
 
-def test_groups_are_reproducible_and_one_seed_is_one_crowd_on_every_rung():
+def _one_crowd_on_every_rung(crowd_distribution, seed=11):
+    """The crowd seed ``seed`` draws on every dodge rung under ``crowd_distribution``, checked to repeat on
+    a second reset and to be the same on every rung; returns it."""
     crowds = []
     for env_id in DODGE_IDS:
-        env = gym.make(env_id, crowd_distribution=GROUPS)
-        env.reset(seed=11)
+        env = gym.make(env_id, crowd_distribution=crowd_distribution)
+        env.reset(seed=seed)
         crowds.append(env.unwrapped.crowd.pedestrians.copy())
-        env.reset(seed=11)
+        env.reset(seed=seed)
         assert np.array_equal(env.unwrapped.crowd.pedestrians, crowds[-1])
         env.close()
     assert all(np.array_equal(c, crowds[0]) for c in crowds)
-    assert len(np.unique(crowds[0][:, 0])) < N_PEDESTRIANS  # some walk together
+    return crowds[0]
+
+
+def test_groups_are_reproducible_and_one_seed_is_one_crowd_on_every_rung():
+    crowd = _one_crowd_on_every_rung(GROUPS)
+    assert len(np.unique(crowd[:, 0])) < N_PEDESTRIANS  # some walk together
 
 
 def test_wide_preset_draws_its_angles_and_sides_and_one_seed_is_one_crowd_on_every_rung():
@@ -414,19 +421,13 @@ def test_wide_preset_draws_its_angles_and_sides_and_one_seed_is_one_crowd_on_eve
     assert lateral.max() > CrowdDistribution().side_m[1] and lateral.min() < CrowdDistribution().side_m[0]
     assert set(sizes) == {1, 2} and 0.5 < np.mean(np.array(sizes) == 1) < 0.7  # singles, pairs (the last cut)
     assert min(gaps) >= 1.0 - 1e-9 and max(gaps) <= 2.0 + 1e-9
-    crowds = []
     for env_id in DODGE_IDS:
-        env = gym.make(env_id, crowd_distribution="wide")
-        assert env.unwrapped.crowd_distribution == wide
-        env.reset(seed=11)
-        crowds.append(env.unwrapped.crowd.pedestrians.copy())
-        env.reset(seed=11)
-        assert np.array_equal(env.unwrapped.crowd.pedestrians, crowds[-1])
-        env.close()
-    assert all(np.array_equal(c, crowds[0]) for c in crowds)
+        with gym.make(env_id, crowd_distribution="wide") as env:
+            assert env.unwrapped.crowd_distribution == wide
+    crowd = _one_crowd_on_every_rung("wide")
     default = gym.make(DODGE_IDS[0])
     default.reset(seed=11)
-    assert not np.array_equal(default.unwrapped.crowd.pedestrians, crowds[0])  # opt-in: the default is unchanged
+    assert not np.array_equal(default.unwrapped.crowd.pedestrians, crowd)  # opt-in: the default is unchanged
     default.close()
 
 
