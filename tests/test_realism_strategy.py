@@ -24,12 +24,18 @@ from visuomotor_gym.metrics.reach_realism import REACH_REFERENCE, reach_measures
 from visuomotor_gym.metrics.realism import (
     GROUPS,
     gaze_realism,
+    group_scores,
     load_reference,
     score_component,
     score_components,
 )
 from visuomotor_gym.metrics.stones_realism import STONES_REFERENCE, stone_fixation_share, stones_gaze_realism
-from visuomotor_gym.metrics.walk_realism import WALK_REFERENCE, path_fixation_share, walk_gaze_realism
+from visuomotor_gym.metrics.walk_realism import (
+    WALK_REFERENCE,
+    episode_measures,
+    path_fixation_share,
+    walk_gaze_realism,
+)
 
 DT = 0.02
 FAMILIES = ("catch", "reach", "walk", "stones", "dodge")
@@ -169,7 +175,10 @@ def walk_trace(kind, seed=0):
     if kind == "human":  # a saccade every 0.3 s; every fifth fixation during an approach goes to the obstacle
         onsets = list(np.round(np.arange(0.3, t[-1], 0.3), 10))
         fix = piecewise(t, onsets)
-        gaze = travel.copy()
+        # between saccades gaze holds the floor point it landed on, 1.9 m ahead (Muller et al. 2023, Fig. 1)
+        start = np.searchsorted(fix, fix)  # the first row of each row's fixation
+        held = eye[start] * [1, 1, 0] + [1.9, 0.0, 0.0]
+        gaze = unit(held - eye)
         for ob in OBSTACLES:
             near = ob[0] - 0.5 * ob[2]
             approach = (pelvis[:, 0] >= near - 5.0) & (pelvis[:, 0] < near - 1.5)
@@ -177,6 +186,8 @@ def walk_trace(kind, seed=0):
             gaze[look] = unit(np.array([ob[0], ob[1], ob[4]]) - eye[look])
     elif kind == "still":  # body-locked 40 deg down (lands 1.9 m ahead: on the walkway), never a saccade
         onsets, gaze = [], np.tile(direction(0.0, -40.0), (len(t), 1))
+    elif kind == "body-locked saccades":  # the floor 1.5 m ahead carried with the body, re-centred every 0.3 s
+        onsets, gaze = list(np.round(np.arange(0.3, t[-1], 0.3), 10)), travel
     else:
         rng = np.random.default_rng(seed)
         onsets = random_onsets(rng, t[-1])
@@ -378,6 +389,28 @@ def test_path_fixation_share_on_the_walkway_ahead():
     aside = make("ObstacleWalk-v0", t, np.tile(direction(60.0, -40.0), (len(t), 1)), human.eye_pos, [],
                  **human.task)  # 1.9 m out at 60 deg: 1.65 m to the side, off the 1.5 m walkway
     assert path_fixation_share(aside) == 0.0
+
+
+def test_ground_fixation_share_counts_held_floor_points_only():
+    from visuomotor_gym.metrics.walk_realism import ground_fixation_share
+
+    human, carried = walk_trace("human"), walk_trace("body-locked saccades")
+    resting = ~(human.in_saccade | human.saccade_onset)
+    # the human eye's floor point jumps only while a saccade is in flight; a look at an obstacle's top (0.2 m
+    # high, eye at 1.6 m) moves its floor point at 1.3 * 0.2 / 1.4 = 0.19 m/s, under 0.5: every resting row
+    # holds but the first row of the trace (no speed yet)
+    assert ground_fixation_share(human) == pytest.approx(1 - 1 / resting.sum())
+    assert ground_fixation_share(carried) == 0.0  # the floor point moves at 1.3 m/s, past 0.5 m/s
+    assert ground_fixation_share(walk_trace("still")) == 0.0
+
+
+def test_a_body_locked_eye_that_saccades_fails_where_it_looks_on_the_walkway():
+    """A line of sight carried with the body and re-centred at a human rate (the winding walkway's best static
+    twin re-centres as the pelvis turns) passes ``moves`` and ``layout``; holding no point, it fails ``where``."""
+    r = score_components([episode_measures(walk_trace("body-locked saccades"))], WALK_REFERENCE)
+    groups = group_scores(r, WALK_REFERENCE)
+    assert groups["moves"] > 0.9 and groups["layout"] > 0.9 and groups["where"] <= 0.2, groups
+    assert r["score"] <= 0.5
 
 
 def test_stone_fixation_share_counts_upcoming_stones_only():

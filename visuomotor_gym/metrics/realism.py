@@ -24,8 +24,12 @@ How a set of episodes is scored (:func:`score_components`, used by every family)
   lands there);
 * components are grouped: ``"moves"`` (when the eye moves: saccade rate, fixation durations, saccade
   latencies and timing locked to the task), ``"where"`` (where it lands: share of fixation time on the task's
-  targets, look-ahead, foveation of the ball or the object) and, for the reach family, ``"hand"`` (the
-  hand path). A group's score is the mean of its components' scores;
+  targets, look-ahead, foveation of the ball or the object), for the reach family ``"hand"`` (the
+  hand path) and, for the walk family, ``"layout"`` (where the line of sight sits relative to the
+  walkway: on the travel path, how far ahead, how far below the horizon, which one posture of a still
+  eye satisfies as well as a moving one; kept as a group of its own so that it cannot bank points for
+  ``"where"``, which there counts only fixations that hold a target). A group's score is the mean of its
+  components' scores;
 * the realism **score is the smallest group score**. Each group is necessary: a human eye both moves like
   a human eye and looks where humans look. The two cheap ways to imitate one group fail the other: a
   still or body-locked eye (held twin, best static posture) can sit where humans look most of the time
@@ -62,7 +66,7 @@ REALISM_VERSION = 2
 REFERENCE_FILE = "human_reference.json"
 REQUIRED_FIELDS = ("value", "low", "high", "unit", "source", "notes", "group")
 #: The component groups (each reference entry names one); the score is the smallest group score.
-GROUPS = ("moves", "where", "hand")
+GROUPS = ("moves", "where", "hand", "layout")
 
 #: component name -> per-episode measure (trace -> float, NaN when undefined)
 COMPONENT_MEASURES: dict[str, Callable] = {

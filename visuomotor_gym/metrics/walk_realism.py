@@ -1,8 +1,8 @@
 """Walking gaze realism (ObstacleWalk family): per-episode measures of when the eye moved and where it
 looked, scored against human walking data with :func:`visuomotor_gym.metrics.realism.score_components`
 (each component 1 inside the human range with a Gaussian fall-off outside, times the share of episodes
-that define it, 0 when none does; the score is the smaller of the ``moves`` and ``where`` group means, so
-a still eye and a random eye both fail: see :mod:`visuomotor_gym.metrics.realism`).
+that define it, 0 when none does; the score is the smallest of the ``moves``, ``where`` and ``layout``
+group means, so a still eye and a random eye both fail: see :mod:`visuomotor_gym.metrics.realism`).
 
 Measures (from an :class:`~visuomotor_gym.bench.trace.EpisodeTrace` of an ObstacleWalk env: ``eye_pos``,
 ``gaze_dir``, ``pelvis_pos``, ``in_saccade``, ``saccade_onset`` per step; the course ``obstacles`` per
@@ -28,6 +28,16 @@ episode):
   ``CROSSING_M`` before its near edge to ``CROSSING_M`` past its far edge), over the obstacles that were
   fixated during their approach: "planning in the steps before" means looking at it and then away.
   (Counted over every obstacle, an eye that never looked at one scored 1 here for free);
+* ``ground_fixation_share``: of the resting rows whose gaze lands on the walkway ahead (below), the share
+  in which the point where the line of sight meets the floor *holds* (moves slower than
+  ``STABLE_GAZE_M_S``): walkers looking at the nearby ground saccade to a location and hold gaze on it
+  while the body moves on (Muller et al. 2023, Fig. 1; Matthis, Yates & Hayhoe 2018). A line of sight
+  kept at one posture in the body frame, or held in direction by the vestibulo-ocular reflex, sweeps
+  the floor at walking speed and holds nothing.
+
+``layout`` (where the line of sight sits; one posture of a still eye can satisfy all three, so they form
+a group of their own and cannot bank points for ``where``):
+
 * ``path_fixation_share``: the share of the resting rows (no saccade in flight) whose gaze lands on the
   walkway ahead: on an obstacle, or on the floor between ``PATH_NEAR_M`` and ``PATH_FAR_M`` ahead of the
   eye and within ``PATH_HALF_WIDTH_M`` of the walkway's centre line;
@@ -85,9 +95,22 @@ WALK_REFERENCE: dict[str, dict] = {
         "notes": "Pelvis within one step of the obstacle; over the obstacles fixated during their approach "
                  "(undefined, scoring 0, when the eye never looked at one).",
     },
+    "ground_fixation_share": {
+        "value": 0.6, "low": 0.3, "high": 1.0, "tolerance": 0.1, "unit": "fraction of the time on the walkway",
+        "group": "where",
+        "source": "Muller et al. 2023, eLife 12:e82410, Fig. 1: walkers looking at the nearby ground make saccades "
+                  "to new locations followed by fixations in which gaze is held stable at a location in the "
+                  "world while the body moves forward (REFERENCES.md [V]); Matthis, Yates & Hayhoe 2018 on rough "
+                  "terrain. Patla & Vickers 2003 report travel fixations (gaze carried with the body) > 50 % of "
+                  "the time on a flat laboratory walkway, so the lower bound 0.3 admits them; the range and the "
+                  "tolerance (a line of sight that holds no ground point scores exp(-4.5) = 0.01) are our "
+                  "modelling choice",
+        "notes": "Resting rows with gaze on the walkway ahead (as path_fixation_share); a row holds when the "
+                 "point where the line of sight meets the floor moves slower than 0.5 m/s.",
+    },
     "path_fixation_share": {
         "value": 0.9, "low": 0.8, "high": 1.0, "tolerance": 0.2, "unit": "fraction of the fixation time",
-        "group": "where",
+        "group": "layout",
         "source": "Patla & Vickers 1997: the fixations of walkers approaching an obstacle are obstacle "
                   "fixations, travel fixations 1-2 m ahead and fixations 4-6 m ahead, all on the travel path; "
                   "Patla & Vickers 2003, Exp Brain Res 148:133: travel fixations alone take > 50 % of the time "
@@ -97,13 +120,13 @@ WALK_REFERENCE: dict[str, dict] = {
                  "ahead of the eye.",
     },
     "travel_fixation_distance_m": {
-        "value": 1.5, "low": 1.0, "high": 2.0, "tolerance": 0.5, "unit": "m", "group": "where", "given": "path_fixation_share",
+        "value": 1.5, "low": 1.0, "high": 2.0, "tolerance": 0.5, "unit": "m", "group": "layout", "given": "path_fixation_share",
         "source": "Patla & Vickers 1997: travel fixations 1-2 m ahead of the feet (REFERENCES.md [V])",
         "notes": "The look-ahead: median horizontal eye-to-gaze-point distance while gaze is on the floor and "
                  "on no obstacle.",
     },
     "gaze_below_horizon_deg": {
-        "value": 45.0, "low": 30.0, "high": 60.0, "tolerance": 10.0, "unit": "deg", "group": "where",
+        "value": 45.0, "low": 30.0, "high": 60.0, "tolerance": 10.0, "unit": "deg", "group": "layout",
         "source": "Muller et al. 2023, eLife 12:e82410: gaze 30-60 deg from the vertical on rocky ground "
                   "(REFERENCES.md [V]); consistent with Iwao et al.'s arctan(h/l) (Sec. 4.2.1), 47 deg for "
                   "h = 1.6, l = 1.5 m",
@@ -203,6 +226,16 @@ def path_fixation_share(trace) -> float:
     return strategy.fixation_share(trace, on_walkway(trace))
 
 
+def ground_fixation_share(trace) -> float:
+    """Share of the resting rows with gaze on the walkway ahead (:func:`on_walkway`) whose floor point holds
+    (moves slower than ``STABLE_GAZE_M_S`` since the previous row)."""
+    eye, gaze = np.asarray(trace.eye_pos, dtype=float), np.asarray(trace.gaze_dir, dtype=float)
+    ground = _gaze_hits(eye, gaze, 0.0)
+    speed = np.r_[np.inf, np.linalg.norm(np.diff(ground, axis=0), axis=1) / float(trace.dt)]
+    holds = np.nan_to_num(speed, nan=np.inf) <= STABLE_GAZE_M_S
+    return strategy.fixation_share(trace, holds, rows=on_walkway(trace))
+
+
 def travel_fixation_distance(trace) -> float:
     obstacles, to_path = _frame(trace)
     eye, gaze = np.asarray(trace.eye_pos), np.asarray(trace.gaze_dir)
@@ -232,6 +265,7 @@ def episode_measures(trace) -> dict[str, float]:
         "fixation_duration_s": strategy.fixation_duration(trace),
         "obstacle_fixation_share": share,
         "fixation_while_crossing": crossing,
+        "ground_fixation_share": ground_fixation_share(trace),
         "path_fixation_share": path_fixation_share(trace),
         "travel_fixation_distance_m": travel_fixation_distance(trace),
         "gaze_below_horizon_deg": gaze_below_horizon(trace),
