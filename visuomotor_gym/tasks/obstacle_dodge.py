@@ -18,8 +18,13 @@ the walker if both kept their velocities) for ``veer_s`` = 1.0 s (the veer in Jo
 ~1 s; REFERENCES.md "(10 %, ~1 s)"), then resumes its course. (In the first definition of v0 ``veer_s`` was
 1.5 s, a modelling choice; docs/reproductions/dodge.md has both.)
 
-**Groups** (the default: ``CrowdDistribution.group_size`` = (2, 3), the preset ``"groups"``; ``"single"``,
-``group_size=(1, 1)``, gives the first definition's crowds;
+The ranges above are ``CrowdDistribution``'s own defaults, the preset ``"groups"`` (ObstacleDodge-v0's second
+definition). **The env's default crowd is the preset ``"wide"``** (``DEFAULT_CROWD``; its ranges and sources at
+``CROWD_PRESETS``): singles and pairs, a new party every 1-2 s, crossing up to 70 deg off the perpendicular
+from 3-8 m to the side, so that the threats come from bearings no single posture of the eye covers.
+
+**Groups** (``CrowdDistribution.group_size`` = (2, 3) in the preset ``"groups"``, (1, 2) in ``"wide"``;
+``"single"``, ``group_size=(1, 1)``, gives the first definition's crowds;
 :func:`sample_groups`): the same
 4 pedestrians come as groups (e.g. ``group_size=(2, 3)``: pairs and triads, the commonest groups of
 Moussaid, Perozo, Garnier, Helbing & Theraulaz 2010, PLoS ONE 5:e10047, Fig. 1), one group per onset,
@@ -136,7 +141,7 @@ class CrowdDistribution:
     veer_s: float = 1.0  # Jovancevic, Sullivan & Hayhoe: the veer lasted ~1 s
     min_crossing_m: float = 3.0  # crossing points between this far from the start ...
     goal_clear_m: float = 1.0  # ... and this far before the goal
-    # Groups (the default since ObstacleDodge-v0's redefinition; preset "single", (1, 1): every pedestrian alone,
+    # Groups (since ObstacleDodge-v0's second definition; preset "single", (1, 1): every pedestrian alone,
     # the first definition's draws). Members per group, uniform over
     # the whole numbers of the range (pairs the commonest group, then triads: Moussaid et al. 2010, Fig. 1),
     # walking abreast (Moussaid et al. 2010: at low density "group members tend to walk side by side,
@@ -155,8 +160,9 @@ class CrowdDistribution:
         return self.group_size != (1.0, 1.0)
 
 
-# "groups": the default, pairs and triads (Moussaid et al. 2010); "single": the first definition's crowds,
-# every pedestrian alone. "wide" (opt-in prototype: a crowd no single eye posture covers): more,
+# "wide" (the default of ObstacleDodge-v0 since its third definition, DEFAULT_CROWD: a crowd no single eye
+# posture covers); "groups": the second definition, pairs and triads (Moussaid et al. 2010), and the
+# dataclass's own defaults; "single": the first definition's crowds, every pedestrian alone. "wide": more,
 # smaller parties from more directions, overlapping in time. Singles and pairs (WIDE_GROUP_SIZE, uniform over
 # parties, the fourth pedestrian's cut to what is left: 43 % of the pedestrians alone, 57 % in pairs;
 # Moussaid et al. 2010: up to 70 % of pedestrians walk in groups, pairs the commonest), one party every
@@ -171,6 +177,7 @@ class CrowdDistribution:
 # streets at all angles, not only at right angles; the 70 deg and 3-8 m are modelling choices, short of the
 # rules' 80 deg (walkers parallel to the path, who never cross it). Veers as "groups" (Jovancevic,
 # Sullivan & Hayhoe: 10 %, ~1 s).
+DEFAULT_CROWD = "wide"  # the env's crowd when none is given (see CROWD_PRESETS)
 CROWD_PRESETS = {"groups": CrowdDistribution(), "single": CrowdDistribution(group_size=(1.0, 1.0)),
                  "wide": CrowdDistribution(angle_deg=WIDE_ANGLE_DEG, side_m=WIDE_SIDE_M,
                                            group_size=WIDE_GROUP_SIZE, onset_gap_s=WIDE_ONSET_GAP_S)}
@@ -507,5 +514,5 @@ def intercept_velocity(px: float, py: float, speed: float, wx: float, wy: float,
     return np.array([speed * dx / n, speed * dy / n])
 
 
-__all__ = ["CROWD_PRESETS", "K_SLOTS", "N_PEDESTRIANS", "Crowd", "CrowdDistribution", "ObstacleDodgeTask",
+__all__ = ["CROWD_PRESETS", "DEFAULT_CROWD", "K_SLOTS", "N_PEDESTRIANS", "Crowd", "CrowdDistribution", "ObstacleDodgeTask",
            "PedestrianTarget", "crowd_preset", "intercept_velocity", "sample_crowd", "sample_groups"]
