@@ -1,0 +1,242 @@
+"""The ``eom_brace`` baseline for PushRecovery: Eom et al.'s (2019, section 7) behaviour after a push.
+
+The agent sees observations only (the cubes only as the eye's samples of their faces). Each 20 ms step:
+
+1. **Perception**: every visual sample of a cube's face (eye frame at sampling time; the eye pose of that
+   time is kept for the visual delay) is turned into the stance frame and fused per cube as a
+   precision-weighted mean, weighted by the depth precision of the vision model at the sample's
+   eccentricity (Eyecatch Eq. 2, as the ``faraway`` baseline): a peripheral sample knows the direction
+   well and the depth badly, a fixated one both.
+2. **Before the push**: ``look_latency_s`` after the start the eye and head turn to the wall's expected
+   middle (modelling choice: Eom's character stands near the wall; the wall is on the right), so that the
+   cubes are seen, peripherally, before anything happens; the hand waits at the body's right side.
+3. **Detection**: the push is detected when the centre of pressure (the ``foot_pressure`` block) comes
+   within ``cop_margin_m`` of the right foot's outer edge, i.e. leaves the support polygon's interior
+   (Eom et al.: "the trajectory of the center of pressure crosses over the boundary of the supporting
+   polygon"), or the left foot unloads.
+4. **Brace**: the agent chooses the **nearest believed cube** to the right shoulder, saccades to the
+   centre of its face and keeps gaze there (Eom: "keeping the visual attention at the center of the
+   block on which it places the hand") while the hand moves to ``reach_depth_m`` beyond the believed face.
+   The choice and the target follow the belief as it sharpens under the fovea. When the hand stops (speed
+   below ``contact_speed_m_s`` after ``min_reach_s``), it holds where it is: the arm, braced, is a strut.
+5. **Look away**: once the trunk is still (vestibular rates below ``still_rad_s`` for ``still_s``), gaze and
+   head return straight ahead (Eom: "it turns the head away from the wall"). The hand stays on the cube
+   (not released: releasing tips the leaning body back over; see the reproduction page).
+
+``gaze_blind`` is the twin with gaze, vergence and head held (zero actions); the registered
+``gaze_blind:eom_brace`` wrapper gives the same.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from dataclasses import dataclass, fields, replace
+
+import numpy as np
+
+from visuomotor_gym.body import standing as sn
+from visuomotor_gym.core.head import neck_range_deg
+from visuomotor_gym.core.observation import ObservationLayout
+from visuomotor_gym.envs.push import push_observation
+from visuomotor_gym.oculomotor.plant import OculomotorParams
+from visuomotor_gym.registration import env_vision
+from visuomotor_gym.vision import foveation
+from visuomotor_gym.vision.foveation import VisionParams
+
+DEG = math.pi / 180.0
+_LAYOUT = ObservationLayout(push_observation())
+_S = _LAYOUT.slices
+_NECK = neck_range_deg()
+_FIX = OculomotorParams().fixation_range_m
+_LOG_FIX = (math.log(_FIX[0]), math.log(_FIX[1]))
+N = sn.N_BLOCKS
+SHOULDER = np.array([0.0, -0.2, 0.4])  # right shoulder, stance frame (envs_assets/push.xml: upper_arm)
+FOOT_HALF_WIDTH_M = 0.045  # envs_assets/push.xml: the foot box's half width
+PRIOR_DISTANCE_M = 0.8  # distance assumed for a first sample's noise: the wall is 0.6-0.8 m away (modelling choice)
+
+
+@dataclass(frozen=True)
+class EomBraceParams:
+    """Every constant of the baseline, with its source; override by name (``eom_brace:name=value``)."""
+
+    vision_noise_scale: float = 1.0
+    foveated: bool = True
+    visual_delay_s: float = 0.0
+    gaze_action_range_deg: float = 60.0
+    look_latency_s: float = 0.2  # first saccade 180-200 ms after the start (REFERENCES.md, saccade latency)
+    wall_look_point: tuple = (0.05, -0.75, 0.35)  # stance frame: the wall's expected middle (modelling choice)
+    hand_ready_offset: tuple = (0.0, -0.1, 0.05)  # hand waits this far right/up of its start (modelling choice)
+    cop_margin_m: float = 0.01  # CoP within 1 cm of the foot's outer edge: leaving the polygon (modelling choice)
+    unload_fraction: float = 0.05  # or the left foot carrying < 5 % of body weight (modelling choice)
+    reach_depth_m: float = 0.05  # aim 5 cm beyond the believed face, so the hand arrives pushing (modelling choice)
+    contact_speed_m_s: float = 0.3  # the hand has stopped on the cube (modelling choice)
+    min_reach_s: float = 0.1  # ... no sooner than this after the reach began (modelling choice)
+    still_rad_s: float = 0.15  # trunk still: every vestibular rate below this (modelling choice)
+    still_s: float = 0.5  # ... for this long before looking away (modelling choice)
+    head_dead_zone_deg: float = 20.0  # Eyecatch Sec. 4.2 Eq. 17
+    gaze_blind: bool = False
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            v = getattr(self, f.name)
+            if f.name in ("foveated", "gaze_blind"):
+                if not isinstance(v, bool):
+                    raise ValueError(f"EomBraceParams.{f.name} must be true or false, got {v!r}")
+            elif isinstance(v, tuple):
+                if len(v) != 3 or not all(isinstance(x, (int, float)) and math.isfinite(x) for x in v):
+                    raise ValueError(f"EomBraceParams.{f.name} must be three finite numbers, got {v!r}")
+            elif isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v < 0:
+                raise ValueError(f"EomBraceParams.{f.name} must be a finite number >= 0, got {v!r}")
+
+
+def encode(hand_target, brace: float, gaze, fixation_m, head, gaze_range: float) -> np.ndarray:
+    """The 9-dim PushRecovery action: hand target (stance frame), brace (-1..1), gaze change (rad), fixation
+    distance (m; None keeps the neutral value), neck (yaw, pitch; rad)."""
+    a = np.zeros(9, dtype=np.float32)
+    a[:3] = sn.hand_target_action(np.asarray(hand_target) + sn.STANCE_ORIGIN)
+    a[3] = brace
+    a[4] = np.clip(gaze[0] / gaze_range, -1.0, 1.0)
+    a[5] = np.clip(gaze[1] / gaze_range, -1.0, 1.0)
+    if fixation_m is not None:
+        lo, hi = _LOG_FIX
+        a[6] = np.clip(2.0 * (math.log(max(fixation_m, 1e-3)) - lo) / (hi - lo) - 1.0, -1.0, 1.0)
+    for k in range(2):
+        lo_h, hi_h = _NECK[k]
+        h = math.degrees(float(head[k]))
+        a[7 + k] = np.clip(h / hi_h if h >= 0 else -h / lo_h, -1.0, 1.0)
+    return a
+
+
+class EomBraceAgent:
+    """Detect the push, look at the nearest believed cube, put the hand on it (SB3 ``predict`` interface)."""
+
+    def __init__(self, params: EomBraceParams | None = None, dt: float = 0.02):
+        self.params = params or EomBraceParams()
+        p = self.params
+        self.dt = float(dt)
+        self.vision = VisionParams(noise_scale=max(p.vision_noise_scale, 1e-6), foveated=p.foveated)
+        self.delay_steps = round(p.visual_delay_s / self.dt)
+        self.gaze_range = p.gaze_action_range_deg * DEG
+        self.reset()
+
+    @classmethod
+    def for_env(cls, env_id: str, **overrides) -> EomBraceAgent:
+        """An agent whose assumed vision matches the registered env (noise, foveation, latency)."""
+        base = EomBraceParams(**env_vision(env_id))
+        known = {f.name for f in fields(EomBraceParams)}
+        unknown = sorted(set(overrides) - known)
+        if unknown:
+            raise TypeError(f"unknown eom_brace parameter(s) {unknown}; known: {sorted(known)}")
+        return cls(replace(base, **overrides))
+
+    def reset(self) -> None:
+        self.started = False
+        self.w = np.zeros(N)
+        self.sum = np.zeros((N, 3))
+        self.poses: deque = deque(maxlen=self.delay_steps + 1)
+        self.home: np.ndarray | None = None
+        self.detected_at: float | None = None
+        self.chosen: int | None = None
+        self.hold: np.ndarray | None = None
+        self.still_since: float | None = None
+        self.looked_away = False
+        self.events: list[tuple[float, str]] = []
+
+    # --- belief -----------------------------------------------------------------------------------
+    def estimate(self, i: int) -> np.ndarray:
+        return self.sum[i] / self.w[i]
+
+    def _fuse(self, i: int, pos_eye: np.ndarray, rot: np.ndarray, eye: np.ndarray) -> None:
+        if pos_eye[0] <= 0.0:
+            return
+        ref = float(np.linalg.norm(self.estimate(i) - eye)) if self.w[i] > 0 else PRIOR_DISTANCE_M
+        v = self.vision
+        ecc = foveation.eccentricity(pos_eye)
+        depth_std = max(ref, 0.1) * v.depth_std_fraction * v.noise_scale / foveation.acuity(ecc, v)
+        w = 1.0 / max(depth_std, 1e-6) ** 2
+        self.w[i] += w
+        self.sum[i] += w * (eye + rot @ pos_eye)
+
+    # --- policy -----------------------------------------------------------------------------------
+    def predict(self, observation, state=None, episode_start=None, deterministic=True):
+        obs = np.asarray(observation, dtype=float)
+        if episode_start is not None and bool(np.asarray(episode_start).reshape(-1)[0]) and self.started:
+            self.reset()
+        if obs.shape != (_LAYOUT.size,):
+            raise ValueError(f"EomBraceAgent expects the flat PushRecovery observation of size {_LAYOUT.size}, "
+                             f"got shape {obs.shape}")
+        return self._act(obs), state
+
+    def _act(self, obs: np.ndarray) -> np.ndarray:
+        p = self.params
+        t = float(obs[_S["time"]][0])
+        rot = obs[_S["eye_rot"]].reshape(3, 3)
+        eye = obs[_S["eye_pos"]].copy()
+        hand = obs[_S["hand_pos"]].copy()
+        if not self.started:
+            self.started = True
+            self.home = hand + np.array(p.hand_ready_offset)
+        self.poses.append((rot.copy(), eye.copy()))
+        if len(self.poses) == self.delay_steps + 1:
+            r0, e0 = self.poses[0]
+            pos = obs[_S["block_pos"]].reshape(N, 3)
+            vis = obs[_S["block_visible"]]
+            for i in range(N):
+                if vis[i] > 0.5:
+                    self._fuse(i, pos[i].copy(), r0, e0)
+
+        # --- detection: the CoP at the support polygon's edge (or the left foot unloaded) ----------------
+        cop = obs[_S["foot_pressure"]]
+        feet = obs[_S["feet"]].reshape(2, 3)
+        if self.detected_at is None and (cop[2] + cop[3]) > 0:
+            edge = feet[1, 1] - FOOT_HALF_WIDTH_M
+            if cop[1] < edge + p.cop_margin_m or cop[2] < p.unload_fraction:
+                self.detected_at = t
+                self.events.append((t, "detect"))
+
+        # --- which cube, and the hand ------------------------------------------------------------------
+        target = self.home
+        look_at = np.array(p.wall_look_point) if t >= p.look_latency_s - 1e-9 else None
+        known = [i for i in range(N) if self.w[i] > 0]
+        if self.detected_at is not None and known:
+            if self.hold is None:
+                ves = obs[_S["vestibular"]]
+                lean = SHOULDER + 0.15 * np.array([ves[5], ves[6], 0.0])  # where the shoulder is heading
+                faces = np.array([self.estimate(i) for i in known])
+                self.chosen = known[int(np.argmin(np.linalg.norm((faces - lean)[:, [0, 2]], axis=1)))]
+                face = self.estimate(self.chosen)
+                target = face + np.array([0.0, -p.reach_depth_m, 0.0])
+                speed = float(np.linalg.norm(obs[_S["hand_vel"]]))
+                if t - self.detected_at >= p.min_reach_s and speed < p.contact_speed_m_s:
+                    self.hold = hand.copy()
+                    self.events.append((t, "hold"))
+            if self.hold is not None:
+                target = self.hold
+            look_at = self.estimate(self.chosen)
+            rates = obs[_S["vestibular"]][2:5]
+            if self.hold is not None and float(np.max(np.abs(rates))) < p.still_rad_s:
+                self.still_since = t if self.still_since is None else self.still_since
+                if t - self.still_since >= p.still_s and not self.looked_away:
+                    self.looked_away = True
+                    self.events.append((t, "look_away"))
+            else:
+                self.still_since = None
+            if self.looked_away:
+                look_at = eye + np.array([3.0, 0.0, 0.0])
+
+        gaze, head, fixation = (0.0, 0.0), (0.0, 0.0), None
+        if look_at is not None and not p.gaze_blind:
+            d_eye = rot.T @ (look_at - eye)
+            gaze = (math.atan2(d_eye[1], d_eye[0]), math.atan2(d_eye[2], math.hypot(d_eye[0], d_eye[1])))
+            d = look_at - eye
+            az, el = math.atan2(d[1], d[0]), math.atan2(d[2], math.hypot(d[0], d[1]))
+            head = (self._beyond_dead_zone(az, 0), self._beyond_dead_zone(el, 1))
+            fixation = float(np.linalg.norm(d))
+        return encode(target, 1.0, gaze, fixation, head, self.gaze_range)
+
+    def _beyond_dead_zone(self, angle: float, k: int) -> float:
+        dz = self.params.head_dead_zone_deg * DEG
+        h = 0.0 if abs(angle) <= dz else angle - math.copysign(dz, angle)
+        lo, hi = _NECK[k]
+        return min(max(h, lo * DEG), hi * DEG)

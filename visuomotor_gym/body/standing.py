@@ -1,0 +1,289 @@
+"""The standing body of PushRecovery (Eom et al. 2019, section 7): a body that can fall.
+
+The walker's legs and pelvis on a **free joint** (``envs_assets/push.xml``), the seated body's waist
+(3-DOF torso joints) and 7-DOF right arm with its palm, and the shared head and eye. It stands on the
+floor through real foot-floor contact; the legs hold a fixed stance through position servos (their
+gains: ``envs_assets/README.md``, PushRecovery), so a push that carries the centre of mass past the
+feet's edge tips it over: nothing keeps it upright but its feet and, if it puts it there, its hand.
+
+Gravity compensation is switched off on every body of the model (the shared head fragment asks for it,
+as the seated and walking bodies are kinematically held): a compensated head would be an external force
+holding the body up.
+
+Actions: ``hand_target`` (3 values in [-1, 1] onto :data:`HAND_WORKSPACE`, stance frame) that the seated
+body's damped-least-squares controller (:mod:`visuomotor_gym.control.hand`) turns into waist and arm
+setpoints on the floating base, then ``brace`` (1 value): the arm's stiffness, from relaxed (-1:
+:data:`RELAXED_STIFFNESS` of the servos' gain) to braced (+1: the full gain of the seated arm's servos).
+
+Observations are in the **stance frame** (:data:`STANCE_FRAME`): origin at the pelvis's start (0, 0,
+0.93 m), axes of the world (x forward, y left, z up); the body does not walk, so the frame stays put
+while it sways or falls.
+"""
+
+from __future__ import annotations
+
+import math
+
+import mujoco
+import numpy as np
+
+from visuomotor_gym.body import names
+from visuomotor_gym.control.hand import HandController, HandControlParams
+from visuomotor_gym.core.frames import FixedFrame
+from visuomotor_gym.core.observation import Block
+from visuomotor_gym.core.parts import Body
+from visuomotor_gym.oculomotor.plant import DEG
+
+# --- names of envs_assets/push.xml beyond those of body/names.py (the arm, head and eye keep theirs) ----
+SCENE = "push.xml"
+PELVIS = "pelvis"
+ROOT_JOINT = "root"
+FLOOR_GEOM = "floor"
+FEET_GEOMS = ("left_foot", "right_foot")
+SOLE_SITES = ("left_sole", "right_sole")
+HAND_GEOMS = ("palm", "forearm")  # the hand and the forearm that carries it (see the task: a brace)
+LEG_JOINTS = ("left_hip_roll", "left_hip_pitch", "left_knee", "left_ankle_pitch", "left_ankle_roll",
+              "right_hip_roll", "right_hip_pitch", "right_knee", "right_ankle_pitch", "right_ankle_roll")
+LEG_ACTUATORS = LEG_JOINTS
+# The stance the leg servos hold (rad, LEG_JOINTS order): straight legs, ankles dorsiflexed 0.03 rad so
+# that the centre of mass stands ~5 cm ahead of the ankles, as in human quiet standing (Winter 1995,
+# "Human balance and posture control during standing and walking", Gait & Posture 3: the CoM a few cm
+# anterior to the ankle joint; recalled, modelling choice). At 0 the CoM sits over the heels' edge and
+# any backward arm movement tips the body over.
+STANCE_RAD = (0.0, 0.0, 0.0, 0.03, 0.0, 0.0, 0.0, 0.0, 0.03, 0.0)
+N_BLOCKS = 6  # the pool of cube blocks in push.xml (block_0 ... block_5)
+BLOCKS = tuple(f"block_{i}" for i in range(N_BLOCKS))
+SCENE_CAMERA = "scene_camera"
+FRONT_CAMERA = "front_camera"
+ALL_NAMES = {
+    "body": (PELVIS, names.TORSO, names.HEAD, names.HAND, *BLOCKS),
+    "joint": (ROOT_JOINT, *LEG_JOINTS, *names.BODY_JOINTS, *names.NECK_JOINTS, names.GRASP),
+    "actuator": (*LEG_ACTUATORS, *names.BODY_ACTUATORS, *names.NECK_ACTUATORS, names.GRASP_ACTUATOR),
+    "geom": (FLOOR_GEOM, *FEET_GEOMS, *HAND_GEOMS, *BLOCKS),
+    "site": (*SOLE_SITES, names.CATCH_SITE),
+    "camera": (SCENE_CAMERA, FRONT_CAMERA, names.EYE_CAMERA),
+}
+
+# The stance: the pelvis's start position (straight legs: hip joints 0.93 m above the soles, the walker's
+# proportions), axes of the world. A test checks it against the compiled model.
+STANCE_ORIGIN = np.array([0.0, 0.0, 0.93])
+STANCE_FRAME = FixedFrame(STANCE_ORIGIN)
+# Hand workspace of the hand_target action (stance frame, min/max, metres). Modelling choice: the right
+# arm's reach (upper arm 0.29 m + forearm 0.265 m + hand) from the right shoulder (0, -0.2, 0.4) with the
+# waist's help, and a body that leans up to ~30 deg toward a wall on its right.
+HAND_WORKSPACE = np.array([[-0.5, 0.7], [-1.1, 0.3], [-0.5, 0.9]])
+# Ready posture at reset (degrees): the seated body's (hand in front of the belly), modelling choice.
+READY_POSTURE_DEG = {"shoulder_flex": 30.0, "shoulder_abd": 10.0, "shoulder_rot": 0.0, "elbow": 80.0,
+                     "forearm_rot": 0.0, "wrist_flex": 0.0, "wrist_dev": 0.0}
+# The hand controller of the standing body: the seated one's, with the waist weighted 0.05 instead of 0.35
+# (modelling choice: a standing person reaches with the arm; a waist that swings the trunk to move the
+# hand shifts the centre of mass over the heels' edge and tips the stance backward, as measured while
+# building this body).
+STANDING_HAND_PARAMS = HandControlParams(torso_weight=0.05)
+# brace = -1 leaves the shoulder and elbow servos this fraction of their gain (a relaxed arm that cannot
+# carry the body's weight; modelling choice: a co-contraction command, stiffness rising with it).
+RELAXED_STIFFNESS = 0.15
+BRACED_JOINTS = ("shoulder_flex", "shoulder_abd", "shoulder_rot", "elbow")
+
+STANDING_BLOCKS = (
+    Block("body_qpos", 10, "rad", "waist (yaw, pitch, roll) and arm (7) joint angles"),
+    Block("body_qvel", 10, "rad/s", "waist and arm joint velocities"),
+    Block("hand_pos", 3, "m", "catch-site (palm) position, stance frame"),
+    Block("hand_vel", 3, "m/s", "catch-site velocity, stance frame"),
+    Block("brace", 1, "0..1", "arm stiffness: 0 relaxed, 1 braced"),
+    Block("vestibular", 8, "rad, rad/s, m/s",
+          "trunk (pelvis) tilt: roll and pitch; its angular velocity (roll, pitch, yaw rates); pelvis linear "
+          "velocity (x, y, z): the semicircular canals' and otoliths' signal of a push"),
+    Block("feet", 6, "m", "left and right sole centres, stance frame"),
+    Block("foot_pressure", 4, "m, 0..", "centre of pressure (x, y, stance frame; 0 without foot contact) and the "
+          "left and right feet's normal forces over body weight"),
+)
+
+
+class StandingBody(Body):
+    """Hand and brace actions, proprioception and contacts of the standing body (``push.xml``)."""
+
+    frame = STANCE_FRAME
+    observation_blocks = STANDING_BLOCKS
+    trace_step_fields = ("hand_pos", "pelvis_pos", "cop")
+    action_structure = {"hand_target": 3, "brace": 1}  # noqa: RUF012  (read only)
+    n_action = 4
+
+    def __init__(self, model: mujoco.MjModel, hand_params: HandControlParams, dt: float) -> None:
+        m = model
+        self.model = m
+        self.dt = float(dt)
+        m.body_gravcomp[:] = 0.0  # a body that can fall (see the module docstring)
+
+        def jid(name):
+            return mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, name)
+
+        def aid(name):
+            return mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, name)
+
+        def gid(name):
+            return mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, name)
+
+        body_j = [jid(n) for n in names.BODY_JOINTS]
+        self._qpos = np.array([m.jnt_qposadr[j] for j in body_j])
+        self._dof = np.array([m.jnt_dofadr[j] for j in body_j])
+        self.joint_range = m.jnt_range[body_j].copy()
+        body_act = [aid(n) for n in names.BODY_ACTUATORS]
+        self._act = np.array(body_act)
+        self._actadr = np.array([m.actuator_actadr[a] for a in body_act])
+        self._leg_act = np.array([aid(n) for n in LEG_ACTUATORS])
+        self._leg_q = np.array([m.jnt_qposadr[jid(n)] for n in LEG_JOINTS])
+        self._braced = np.array([aid(n) for n in BRACED_JOINTS])
+        self._gain = m.actuator_gainprm[self._braced, 0].copy()
+        self._grasp_act = aid(names.GRASP_ACTUATOR)
+        root = jid(ROOT_JOINT)
+        self._root_q = int(m.jnt_qposadr[root])
+        self._root_v = int(m.jnt_dofadr[root])
+        self.pelvis = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, PELVIS)
+        self.head_body = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, names.HEAD)
+        self.catch_site = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, names.CATCH_SITE)
+        self.soles = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, n) for n in SOLE_SITES]
+        self.feet_geoms = tuple(gid(n) for n in FEET_GEOMS)
+        self.hand_geoms = tuple(gid(n) for n in HAND_GEOMS)
+        self.floor_geom = gid(FLOOR_GEOM)
+        self.weight = float(m.body_subtreemass[self.pelvis]) * 9.81
+        self.ready = np.array([0.0, 0.0, 0.0] + [READY_POSTURE_DEG[n] * DEG for n in names.ARM_JOINTS])
+        self.hand_params = hand_params
+        self.hand = HandController(m, self.catch_site, self._dof, self._qpos, self.joint_range, self.ready,
+                                   n_torso=len(names.TORSO_JOINTS), params=hand_params)
+        ws_lo = HAND_WORKSPACE[:, 0] + STANCE_ORIGIN
+        ws_half = 0.5 * (HAND_WORKSPACE[:, 1] - HAND_WORKSPACE[:, 0])
+        self._ws = (ws_lo, ws_half)
+        self._force = np.zeros(6)
+        self.brace_level = 1.0
+        self._hand_prev = (0.0, 0.0, 0.0)
+        self._cop = (0.0, 0.0, 0.0, 0.0)
+
+    # --- episode ------------------------------------------------------------------------------
+    def reset_pose(self, data: mujoco.MjData) -> None:
+        """Standing still at the stance origin, legs straight (their servos' setpoints 0), the arm in the
+        ready posture."""
+        q = self._root_q
+        data.qpos[q:q + 3] = STANCE_ORIGIN
+        data.qpos[q + 3:q + 7] = (1.0, 0.0, 0.0, 0.0)
+        data.qpos[self._qpos] = self.ready
+        data.act[self._actadr] = self.ready
+        data.ctrl[self._leg_act] = STANCE_RAD
+        data.qpos[self._leg_q] = STANCE_RAD
+        self._set_brace(1.0)
+
+    def start(self, data: mujoco.MjData) -> None:
+        site = data.site_xpos[self.catch_site]
+        self.hand.reset(site)
+        self._hand_prev = tuple(site.tolist())
+        self._cop = self.centre_of_pressure(data)
+
+    # --- control ------------------------------------------------------------------------------
+    def _set_brace(self, level: float) -> None:
+        self.brace_level = level
+        kp = self._gain * (RELAXED_STIFFNESS + (1.0 - RELAXED_STIFFNESS) * level)
+        self.model.actuator_gainprm[self._braced, 0] = kp
+        self.model.actuator_biasprm[self._braced, 1] = -kp
+
+    def command(self, data: mujoco.MjData, a: np.ndarray, al: list, dt: float) -> None:
+        d = data
+        lo, half = self._ws
+        target = lo + (a[:3] + 1.0) * half
+        self.hand.advance_reference(target, dt)
+        setpoint = d.act[self._actadr]
+        new_setpoint = self.hand.setpoints(d, setpoint)
+        d.ctrl[self._act] = (new_setpoint - setpoint) / dt  # MuJoCo clamps to ctrlrange: a rate limit
+        self._set_brace(0.5 * (al[3] + 1.0))
+        d.ctrl[self._grasp_act] = 0.0
+        d.ctrl[self._leg_act] = STANCE_RAD  # the stance
+
+    # --- state --------------------------------------------------------------------------------
+    def hand_pos(self, data: mujoco.MjData) -> np.ndarray:
+        return data.site_xpos[self.catch_site]
+
+    def head_height(self, data: mujoco.MjData) -> float:
+        return float(data.xpos[self.head_body][2])
+
+    def pelvis_pos(self, data: mujoco.MjData) -> np.ndarray:
+        return data.xpos[self.pelvis]
+
+    def centre_of_pressure(self, data: mujoco.MjData) -> tuple[float, float, float, float]:
+        """(x, y) of the centre of pressure of the foot-floor contacts (world; 0, 0 without contact) and
+        the left and right feet's normal forces over body weight."""
+        d = data
+        fl = fr = sx = sy = 0.0
+        left, right = self.feet_geoms
+        floor = self.floor_geom
+        for i in range(d.ncon):
+            c = d.contact[i]
+            g1, g2 = c.geom1, c.geom2
+            if g1 == floor:
+                g1, g2 = g2, g1
+            elif g2 != floor:
+                continue
+            if g1 != left and g1 != right:
+                continue
+            mujoco.mj_contactForce(self.model, d, i, self._force)
+            fn = float(self._force[0])
+            if fn <= 0.0:
+                continue
+            if g1 == left:
+                fl += fn
+            else:
+                fr += fn
+            px, py, _pz = c.pos.tolist()
+            sx += fn * px
+            sy += fn * py
+        total = fl + fr
+        if total <= 0.0:
+            return 0.0, 0.0, 0.0, 0.0
+        return sx / total, sy / total, fl / self.weight, fr / self.weight
+
+    def support_polygon(self, data: mujoco.MjData) -> np.ndarray:
+        """(8, 2) corners of the two feet's soles (world x, y): their convex hull is the support polygon."""
+        out = []
+        for g in self.feet_geoms:
+            r = data.geom_xmat[g].reshape(3, 3)
+            c = data.geom_xpos[g]
+            hx, hy = self.model.geom_size[g, 0], self.model.geom_size[g, 1]
+            for sx, sy in ((1, 1), (1, -1), (-1, -1), (-1, 1)):
+                out.append((c + r @ np.array([sx * hx, sy * hy, 0.0]))[:2])
+        return np.array(out)
+
+    def observe(self, values: list, data: mujoco.MjData) -> None:
+        """Append the :data:`STANDING_BLOCKS`."""
+        d = data
+        ox, oy, oz = self.frame.origin_list
+        hx, hy, hz = d.site_xpos[self.catch_site].tolist()
+        px, py, pz = self._hand_prev
+        dt = self.dt
+        values += d.qpos[self._qpos].tolist()
+        values += d.qvel[self._dof].tolist()
+        values += (hx - ox, hy - oy, hz - oz, (hx - px) / dt, (hy - py) / dt, (hz - pz) / dt, self.brace_level)
+        self._hand_prev = (hx, hy, hz)
+        r = d.xmat[self.pelvis]  # row-major world rotation of the pelvis
+        roll = math.atan2(float(r[7]), float(r[8]))
+        pitch = -math.asin(max(-1.0, min(1.0, float(r[6]))))
+        v = self._root_v
+        values += (roll, pitch)
+        values += d.qvel[v + 3:v + 6].tolist()  # angular velocity (free joint: local frame)
+        values += d.qvel[v:v + 3].tolist()  # linear velocity (world)
+        for s in self.soles:
+            x, y, z = d.site_xpos[s].tolist()
+            values += (x - ox, y - oy, z - oz)
+        cx, cy, fl, fr = self.centre_of_pressure(d)
+        self._cop = (cx, cy, fl, fr)
+        values += ((cx - ox) if (fl + fr) > 0 else 0.0, (cy - oy) if (fl + fr) > 0 else 0.0, fl, fr)
+
+    def info(self, data: mujoco.MjData) -> dict:
+        cx, cy, fl, fr = self._cop
+        return {"hand_pos": data.site_xpos[self.catch_site].copy(),
+                "pelvis_pos": data.xpos[self.pelvis].copy(),
+                "cop": np.array([cx, cy, fl + fr]),
+                "head_height": self.head_height(data)}
+
+
+def hand_target_action(target_world) -> np.ndarray:
+    """The hand_target block (3 values in [-1, 1]) for a world point (clipped to the workspace)."""
+    lo, hi = HAND_WORKSPACE[:, 0] + STANCE_ORIGIN, HAND_WORKSPACE[:, 1] + STANCE_ORIGIN
+    return np.clip(2.0 * (np.asarray(target_world, dtype=float) - lo) / (hi - lo) - 1.0, -1.0, 1.0)

@@ -1,0 +1,283 @@
+"""Balancing after a push (Eom et al. 2019, section 7): a standing body near a wall of cube blocks is
+pushed toward it; it stays upright only if it puts its hand on a block.
+
+The scene (``envs_assets/push.xml``): a pool of :data:`~visuomotor_gym.body.standing.N_BLOCKS` cube
+blocks on mocap bodies, placed and resized per episode in a row beside the body's right side (the
+"wall of multiple cube blocks"): the wall's distance, each cube's size, the gaps between them, each
+cube's height and how far it stands out of the wall plane are drawn from the episode's generator.
+There is nothing behind or between the cubes: a hand that lands in a gap or misses an edge goes
+through, and one that stops short touches nothing. Each cube is a
+:class:`~visuomotor_gym.core.retina.PointTarget` at the **centre of its face toward the body** (where a
+hand can push): the agent knows the blocks only through the eye's samples of these points.
+
+The push: a horizontal force on the torso (``xfrc_applied``) at a random time, for
+:data:`PUSH_DURATION_S`, toward the wall within :data:`PUSH_AZIMUTH_DEG` of its normal, of a magnitude
+the legs alone cannot absorb (tested: ``tests/test_push_recovery.py``).
+
+Outcome: a **fall** is any contact between the floor or a block and a body geom other than the feet and
+the palm, or the head below :data:`FALL_HEAD_HEIGHT_M` (checked after every physics substep); success
+(**upright**) is no fall :data:`HOLD_S` after the push began. Either ends the episode.
+"""
+
+from __future__ import annotations
+
+import math
+
+import mujoco
+import numpy as np
+
+from visuomotor_gym.body import names
+from visuomotor_gym.body import standing as sn
+from visuomotor_gym.core.observation import Block
+from visuomotor_gym.core.parts import Task
+from visuomotor_gym.core.retina import PointTarget
+
+DEG = math.pi / 180.0
+
+# --- the wall of blocks (world frame: x forward, y left; the wall is on the body's right, y < 0) -------
+# Modelling choices (Eom et al. give no dimensions): the wall's face plane 0.60-0.80 m from the body's
+# midline (the right hand reaches it only once the body leans toward it: the shoulder is 0.2 m right of
+# the midline and the arm ~0.62 m long); cubes of 12-20 cm ("cube blocks"); gaps of 12-30 cm (wider than
+# the 9 cm palm, so a hand can pass between two cubes); centres 1.05-1.50 m above the floor (around the
+# shoulder's 1.33 m); each cube standing out of the face plane by 0-15 cm.
+WALL_DISTANCE_M = (0.60, 0.80)
+BLOCK_HALF_SIZE_M = (0.06, 0.10)
+GAP_M = (0.12, 0.30)
+BLOCK_HEIGHT_M = (1.05, 1.50)
+BLOCK_OFFSET_M = (0.0, 0.15)
+FIRST_BLOCK_X_M = (-0.75, -0.35)  # the row starts behind the body and runs forward (modelling choice)
+PARKED = (-20.0, -20.0, -5.0)  # a parked block: 5 m under the floor, out of sight
+
+# --- the push --------------------------------------------------------------------------------------
+# Onset 0.6-1.4 s after the start (modelling choice: time to look around first, and unpredictable).
+PUSH_TIME_S = (0.6, 1.4)
+# A 150 ms shove: the duration of the waist-pull and shoulder-push perturbations of compensatory-reaction
+# studies is 100-300 ms (Maki & McIlroy 1997's reviews; REFERENCES.md marks their numbers unconfirmed):
+# modelling choice within that range.
+PUSH_DURATION_S = 0.15
+# 200-300 N for 0.15 s (30-45 N s). Modelling choice: the stance on its own survives a 150 N push and
+# tips over at 200 N (0.15 s; tests/test_push_recovery.py), so every push here needs the hand.
+PUSH_FORCE_N = (200.0, 300.0)
+# Direction: toward the wall (-y) within +-20 deg (modelling choice: "toward the wall", and still a push
+# that a hand on the right-hand wall can stop).
+PUSH_AZIMUTH_DEG = 20.0
+
+# --- the outcome -----------------------------------------------------------------------------------
+HOLD_S = 2.5  # upright this long after the push's onset: success (modelling choice; Eom's clip ~2-3 s)
+FALL_HEAD_HEIGHT_M = 1.0  # the head body's origin (1.43 m standing) below this: fallen (modelling choice)
+GAZE_JITTER_DEG = 2.0  # Gaussian jitter of the initial gaze (as the other families' starts, modelling choice)
+INITIAL_GAZE_POINT = (3.0, 0.0, 1.3)  # straight ahead, 3 m away (modelling choice: looking ahead, not at the wall)
+
+BLOCK_PERCEPT_BLOCKS = (
+    Block("block_pos", 3 * sn.N_BLOCKS, "m",
+          "perceived centre of each cube's face toward the body, eye frame at the sample (zeros when not seen)"),
+    Block("block_visible", sn.N_BLOCKS, "0/1", "1 if this step produced a visual sample of the cube"),
+    Block("block_age", 1, "s", "age of the visual samples (the visual latency; 0 without delay)"),
+)
+TIME_BLOCK = Block("time", 1, "s", "time since the episode started")
+REWARD_TERMS = ("upright", "fall", "effort")
+SPARSE_WEIGHTS = {"upright": 1.0}
+SHAPED_WEIGHTS = {"upright": 1.0, "fall": -1.0, "effort": -0.001}
+
+
+class PushRecoveryTask(Task):
+    """Blocks, the push, falls and success of PushRecovery (``body``: a :class:`StandingBody`)."""
+
+    trace_step_fields = ()
+    trace_flag_fields = ("hand_on_block",)
+
+    def __init__(self, model: mujoco.MjModel, body: sn.StandingBody, *, reward_weights: dict, dt: float,
+                 visual_delay_s: float, push_force_n: tuple[float, float] = PUSH_FORCE_N,
+                 n_blocks: int = 5) -> None:
+        self.model = model
+        self.body = body
+        self.reward_weights = reward_weights
+        self.dt = dt
+        self.visual_delay_s = visual_delay_s
+        self.push_force_n = push_force_n
+        self.n_blocks = int(n_blocks)
+        ids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, n) for n in sn.BLOCKS]
+        self._mocap = [int(model.body_mocapid[b]) for b in ids]
+        self._bvh = [int(model.body_bvhadr[b]) for b in ids]
+        posts = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, f"block_post_{i}") for i in range(sn.N_BLOCKS)]
+        self._post_mocap = [int(model.body_mocapid[b]) for b in posts]
+        self._block_geom = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, n) for n in sn.BLOCKS]
+        self._block_geoms = set(self._block_geom)
+        self._torso = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, names.TORSO)
+        self._allowed = set(body.feet_geoms) | set(body.hand_geoms)
+        self._hand = set(body.hand_geoms)
+        self._scene = {body.floor_geom} | self._block_geoms
+        self.targets = [PointTarget(f"block_{i}") for i in range(sn.N_BLOCKS)]
+        for t in self.targets:
+            t.kind = "block"
+        self.leading_blocks = BLOCK_PERCEPT_BLOCKS
+        self.trailing_blocks = (TIME_BLOCK,)
+        self.reset_state()
+
+    # --- episode ------------------------------------------------------------------------------
+    def reset_state(self) -> None:
+        self.success = False
+        self.fallen = False
+        self.fall_geoms: tuple[str, str] | None = None
+        self.hand_block = -1
+        self.first_contact_time: float | None = None
+        self.visible = [False] * sn.N_BLOCKS
+
+    def reset_episode(self, data: mujoco.MjData, rng: np.random.Generator) -> None:
+        """Draw the wall (distance, then per cube: size, gap, height, offset), the push (time, force,
+        direction) and the initial gaze jitter, in that order, from ``rng``."""
+        m = self.model
+        wall = float(rng.uniform(*WALL_DISTANCE_M))
+        x = float(rng.uniform(*FIRST_BLOCK_X_M))
+        centres, faces, sizes = [], [], []
+        for i in range(sn.N_BLOCKS):
+            if i >= self.n_blocks:
+                data.mocap_pos[self._mocap[i]] = PARKED
+                data.mocap_pos[self._post_mocap[i]] = PARKED
+                self.targets[i].hidden = True
+                continue
+            h = float(rng.uniform(*BLOCK_HALF_SIZE_M))
+            gap = float(rng.uniform(*GAP_M))
+            z = float(rng.uniform(*BLOCK_HEIGHT_M))
+            off = float(rng.uniform(*BLOCK_OFFSET_M))
+            if i > 0:
+                x += gap
+            x += h
+            y_face = -(wall - off)
+            centre = (x, y_face - h, z)
+            x += h
+            self._resize(i, h)
+            data.mocap_pos[self._mocap[i]] = centre
+            data.mocap_pos[self._post_mocap[i]] = (centre[0], centre[1], centre[2] - h)
+            self.targets[i].place(centre[0], y_face, z)
+            centres.append(centre)
+            faces.append((centre[0], y_face, z))
+            sizes.append(h)
+        self.wall_distance = wall
+        self.block_centres = np.array(centres)
+        self.block_faces = np.array(faces)
+        self.block_half_sizes = np.array(sizes)
+        self.push_time = float(rng.uniform(*PUSH_TIME_S))
+        self.push_force = float(rng.uniform(*self.push_force_n))
+        az = float(rng.uniform(-PUSH_AZIMUTH_DEG, PUSH_AZIMUTH_DEG)) * DEG
+        self.push_dir = np.array([math.sin(az), -math.cos(az), 0.0])
+        self.gaze_offset = rng.normal(0.0, GAZE_JITTER_DEG * DEG, 2)
+        data.xfrc_applied[:] = 0.0
+
+    def _resize(self, i: int, h: float) -> None:
+        """Cube ``i`` of half-size ``h``, with the bounding volumes MuJoCo's collision broad- and mid-phase
+        read (as :class:`visuomotor_gym.tasks.walk_scene.ObstaclePool` does)."""
+        m, g = self.model, self._block_geom[i]
+        m.geom_size[g] = (h, h, h)
+        m.geom_rbound[g] = math.sqrt(3.0) * h
+        m.geom_aabb[g] = (0.0, 0.0, 0.0, h, h, h)
+        if self._bvh[i] >= 0:
+            m.bvh_aabb[self._bvh[i]] = (0.0, 0.0, 0.0, h, h, h)
+
+    def initial_gaze(self) -> tuple[np.ndarray, tuple[float, float]]:
+        return np.array(INITIAL_GAZE_POINT), (float(self.gaze_offset[0]), float(self.gaze_offset[1]))
+
+    def trace_episode_fields(self) -> dict:
+        return {"block_faces": self.block_faces.copy(), "block_half_sizes": self.block_half_sizes.copy(),
+                "push_time": self.push_time, "push_force": self.push_force, "push_dir": self.push_dir.copy(),
+                "wall_distance": self.wall_distance}
+
+    @staticmethod
+    def trace_final_fields(info: dict) -> dict:
+        return {"fallen": bool(info["fallen"]), "hand_block": int(info["hand_block"])}
+
+    # --- physics ------------------------------------------------------------------------------
+    def before_physics(self, data: mujoco.MjData) -> None:
+        t0 = data.time
+        # The push acts over [push_time, push_time + duration): the fraction of this step it covers, as
+        # a constant force over the step (exact impulse whatever the control period).
+        lo = max(t0, self.push_time)
+        hi = min(t0 + self.dt, self.push_time + PUSH_DURATION_S)
+        frac = max(0.0, hi - lo) / self.dt
+        data.xfrc_applied[self._torso, :3] = (self.push_force * frac) * self.push_dir
+
+    def needs_substep_checks(self, data: mujoco.MjData) -> bool:
+        return not self.fallen
+
+    def check_substep(self, data: mujoco.MjData) -> bool:
+        """True once the body has fallen (a forbidden contact, or the head too low)."""
+        if self.fallen:
+            return True
+        d = data
+        allowed, scene, hand = self._allowed, self._scene, self._hand
+        for i in range(d.ncon):
+            c = d.contact[i]
+            g1, g2 = c.geom1, c.geom2
+            if g1 in scene:
+                g1, g2 = g2, g1
+            elif g2 not in scene:
+                continue
+            if g1 in scene:
+                continue
+            if g1 in hand and g2 in self._block_geoms:
+                continue
+            if g1 not in allowed or (g1 in hand and g2 not in self._block_geoms):
+                self.fallen = True
+                m = self.model
+                self.fall_geoms = (mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_GEOM, g1),
+                                   mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_GEOM, g2))
+                return True
+        if self.body.head_height(d) < FALL_HEAD_HEIGHT_M:
+            self.fallen = True
+            self.fall_geoms = ("head", "height")
+            return True
+        return False
+
+    def _hand_contact(self, data: mujoco.MjData) -> int:
+        """The block the palm touches now (its index), or -1."""
+        for i in range(data.ncon):
+            c = data.contact[i]
+            for g, o in ((c.geom1, c.geom2), (c.geom2, c.geom1)):
+                if g in self._hand and o in self._block_geoms:
+                    return self._block_geom.index(o)
+        return -1
+
+    # --- observation --------------------------------------------------------------------------
+    def observe_leading(self, values: list, samples: list) -> None:
+        vis = []
+        for pos, _vel, visible in samples:
+            values += pos
+            vis.append(1.0 if visible else 0.0)
+        self.visible = [v > 0.5 for v in vis]
+        values += vis
+        values.append(self.visual_delay_s)
+
+    def observe_trailing(self, values: list, samples: list, data: mujoco.MjData) -> None:
+        values.append(data.time)
+
+    # --- outcome ------------------------------------------------------------------------------
+    def evaluate(self, data: mujoco.MjData, fired: bool, a: np.ndarray, eye) -> tuple[float, dict, bool, dict]:
+        d = data
+        fallen = bool(fired or self.fallen)
+        self.hand_block = self._hand_contact(d)
+        if self.hand_block >= 0 and self.first_contact_time is None:
+            self.first_contact_time = float(d.time)
+        upright = (not fallen) and d.time >= self.push_time + HOLD_S - 1e-9
+        self.success = upright
+        w = self.reward_weights
+        terms = {}
+        if w.get("upright"):
+            terms["upright"] = w["upright"] * float(upright)
+        if w.get("fall"):
+            terms["fall"] = w["fall"] * float(fallen)
+        if w.get("effort"):
+            terms["effort"] = w["effort"] * float(a @ a) / a.size
+        reward = float(sum(terms.values()))
+        return reward, terms, upright or fallen, self.info(d, fallen=fallen)
+
+    def info(self, data: mujoco.MjData, *, fallen: bool = False, diverged: bool = False) -> dict:
+        """Task information: the true scene, for scoring only, never for a policy."""
+        t = float(data.time)
+        return {
+            "fallen": bool(fallen),
+            "pushed": t >= self.push_time,
+            "hand_on_block": self.hand_block >= 0,
+            "hand_block": int(self.hand_block),
+            "first_contact_time": -1.0 if self.first_contact_time is None else self.first_contact_time,
+            "blocks_visible": np.array(self.visible, dtype=bool) if not diverged else np.zeros(sn.N_BLOCKS, bool),
+        }
