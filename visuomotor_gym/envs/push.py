@@ -133,7 +133,7 @@ class PushRecoveryEnv(VisuomotorEnv):
         reward: str = "sparse",
         hand_params: HandControlParams | dict | None = None,
         push_force_n: tuple[float, float] = pr.PUSH_FORCE_N,
-        n_blocks: int = 5,
+        n_blocks: int = sn.N_BLOCKS,
         **shared: Any,
     ):
         self.reward_mode = args.choice(reward, REWARD_MODES, "reward")

@@ -45,7 +45,7 @@ BLOCK_HALF_SIZE_M = (0.06, 0.10)
 GAP_M = (0.12, 0.30)
 BLOCK_HEIGHT_M = (1.05, 1.50)
 BLOCK_OFFSET_M = (0.0, 0.15)
-FIRST_BLOCK_X_M = (-0.75, -0.35)  # the row starts behind the body and runs forward (modelling choice)
+FIRST_BLOCK_X_M = (-0.35, -0.05)  # the row starts beside the body and runs forward (modelling choice)
 PARKED = (-20.0, -20.0, -5.0)  # a parked block: 5 m under the floor, out of sight
 
 # --- the push --------------------------------------------------------------------------------------
@@ -88,7 +88,7 @@ class PushRecoveryTask(Task):
 
     def __init__(self, model: mujoco.MjModel, body: sn.StandingBody, *, reward_weights: dict, dt: float,
                  visual_delay_s: float, push_force_n: tuple[float, float] = PUSH_FORCE_N,
-                 n_blocks: int = 5) -> None:
+                 n_blocks: int = sn.N_BLOCKS) -> None:
         self.model = model
         self.body = body
         self.reward_weights = reward_weights
