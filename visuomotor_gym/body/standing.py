@@ -45,12 +45,17 @@ HAND_GEOMS = ("palm", "forearm")  # the hand and the forearm that carries it (se
 LEG_JOINTS = ("left_hip_roll", "left_hip_pitch", "left_knee", "left_ankle_pitch", "left_ankle_roll",
               "right_hip_roll", "right_hip_pitch", "right_knee", "right_ankle_pitch", "right_ankle_roll")
 LEG_ACTUATORS = LEG_JOINTS
-# The stance the leg servos hold (rad, LEG_JOINTS order): straight legs, ankles dorsiflexed 0.03 rad so
-# that the centre of mass stands ~5 cm ahead of the ankles, as in human quiet standing (Winter 1995,
+# The stance the leg servos hold (rad, LEG_JOINTS order). Hips abducted 0.08 rad (4.6 deg) with the ankles
+# rolled back so the soles stay flat: sole centres 32 cm apart, about shoulder width (modelling choice: a
+# braced, shoulder-width stance; the walker's hips alone put them 18 cm apart). Ankles dorsiflexed 0.03 rad
+# so that the centre of mass stands ~4 cm ahead of the ankles, as in human quiet standing (Winter 1995,
 # "Human balance and posture control during standing and walking", Gait & Posture 3: the CoM a few cm
-# anterior to the ankle joint; recalled, modelling choice). At 0 the CoM sits over the heels' edge and
-# any backward arm movement tips the body over.
-STANCE_RAD = (0.0, 0.0, 0.0, 0.03, 0.0, 0.0, 0.0, 0.0, 0.03, 0.0)
+# anterior to the ankle joint; recalled, modelling choice); at 0 the CoM sits over the heels' edge and any
+# backward arm movement tips the body over.
+STANCE_HIP_ROLL_RAD = 0.08
+STANCE_ANKLE_PITCH_RAD = 0.03
+STANCE_RAD = (STANCE_HIP_ROLL_RAD, 0.0, 0.0, STANCE_ANKLE_PITCH_RAD, -STANCE_HIP_ROLL_RAD,
+              -STANCE_HIP_ROLL_RAD, 0.0, 0.0, STANCE_ANKLE_PITCH_RAD, STANCE_HIP_ROLL_RAD)
 N_BLOCKS = 6  # the pool of cube blocks in push.xml (block_0 ... block_5)
 BLOCKS = tuple(f"block_{i}" for i in range(N_BLOCKS))
 SCENE_CAMERA = "scene_camera"
@@ -60,7 +65,7 @@ ALL_NAMES = {
     "joint": (ROOT_JOINT, *LEG_JOINTS, *names.BODY_JOINTS, *names.NECK_JOINTS, names.GRASP),
     "actuator": (*LEG_ACTUATORS, *names.BODY_ACTUATORS, *names.NECK_ACTUATORS, names.GRASP_ACTUATOR),
     "geom": (FLOOR_GEOM, *FEET_GEOMS, *HAND_GEOMS, *BLOCKS),
-    "site": (*SOLE_SITES, names.CATCH_SITE),
+    "site": (*SOLE_SITES, names.PALM_CENTER),
     "camera": (SCENE_CAMERA, FRONT_CAMERA, names.EYE_CAMERA),
 }
 
@@ -88,8 +93,8 @@ BRACED_JOINTS = ("shoulder_flex", "shoulder_abd", "shoulder_rot", "elbow")
 STANDING_BLOCKS = (
     Block("body_qpos", 10, "rad", "waist (yaw, pitch, roll) and arm (7) joint angles"),
     Block("body_qvel", 10, "rad/s", "waist and arm joint velocities"),
-    Block("hand_pos", 3, "m", "catch-site (palm) position, stance frame"),
-    Block("hand_vel", 3, "m/s", "catch-site velocity, stance frame"),
+    Block("hand_pos", 3, "m", "palm-centre position, stance frame"),
+    Block("hand_vel", 3, "m/s", "palm-centre velocity, stance frame"),
     Block("brace", 1, "0..1", "arm stiffness: 0 relaxed, 1 braced"),
     Block("vestibular", 8, "rad, rad/s, m/s",
           "trunk (pelvis) tilt: roll and pitch; its angular velocity (roll, pitch, yaw rates); pelvis linear "
@@ -141,7 +146,9 @@ class StandingBody(Body):
         self._root_v = int(m.jnt_dofadr[root])
         self.pelvis = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, PELVIS)
         self.head_body = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, names.HEAD)
-        self.catch_site = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, names.CATCH_SITE)
+        # The hand point the controller moves and the observation reports: the palm's centre (its face), the
+        # point that touches a cube (the catch site of the seated body floats 3 cm in front of the palm).
+        self.catch_site = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, names.PALM_CENTER)
         self.soles = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, n) for n in SOLE_SITES]
         self.feet_geoms = tuple(gid(n) for n in FEET_GEOMS)
         self.hand_geoms = tuple(gid(n) for n in HAND_GEOMS)
