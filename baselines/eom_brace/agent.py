@@ -16,9 +16,11 @@ The agent sees observations only (the cubes only as the eye's samples of their f
    polygon"), or the left foot unloads.
 4. **Brace**: the agent chooses the **nearest believed cube** to the right shoulder, saccades to the
    centre of its face and keeps gaze there (Eom: "keeping the visual attention at the center of the
-   block on which it places the hand") while the hand moves to ``reach_depth_m`` beyond the believed face.
-   The choice and the target follow the belief as it sharpens under the fovea. When the hand stops (speed
-   below ``contact_speed_m_s`` after ``min_reach_s``), it holds where it is: the arm, braced, is a strut.
+   block on which it places the hand") while the hand aligns in front of the believed face
+   (``approach_offset_m``, to within ``align_m``) and then moves in, at most ``approach_speed_m_s``, to
+   ``reach_depth_m`` beyond it. The choice and the target follow the belief as it sharpens under the
+   fovea. When the hand stops (speed below ``contact_speed_m_s``), it holds there, and the braced arm
+   acts as a strut along the wall's normal (the hand keeps its distance from the head as the body leans).
 5. **Look away**: once the trunk is still (vestibular rates below ``still_rad_s`` for ``still_s``), gaze and
    head return straight ahead (Eom: "it turns the head away from the wall"). The hand stays on the cube
    (not released: releasing tips the leaning body back over; see the reproduction page).
@@ -66,12 +68,15 @@ class EomBraceParams:
     gaze_action_range_deg: float = 60.0
     look_latency_s: float = 0.2  # first saccade 180-200 ms after the start (REFERENCES.md, saccade latency)
     wall_look_point: tuple = (0.05, -0.75, 0.35)  # stance frame: the wall's expected middle (modelling choice)
-    hand_ready_offset: tuple = (0.0, -0.1, 0.05)  # hand waits this far right/up of its start (modelling choice)
+    hand_ready: tuple = (0.1, -0.4, 0.27)  # stance frame: the hand waits beside the hip, toward the wall (modelling choice)
     cop_margin_m: float = 0.01  # CoP within 1 cm of the foot's outer edge: leaving the polygon (modelling choice)
     unload_fraction: float = 0.05  # or the left foot carrying < 5 % of body weight (modelling choice)
-    reach_depth_m: float = 0.05  # aim 5 cm beyond the believed face, so the hand arrives pushing (modelling choice)
-    contact_speed_m_s: float = 0.3  # the hand has stopped on the cube (modelling choice)
-    min_reach_s: float = 0.1  # ... no sooner than this after the reach began (modelling choice)
+    approach_offset_m: float = 0.10  # align the palm 10 cm in front of the believed face first (modelling choice)
+    align_m: float = 0.04  # ... to within 4 cm along the wall, then move in (modelling choice)
+    approach_speed_m_s: float = 1.0  # the last approach at <= 1 m/s: a hand that slams in bounces the body off
+    reach_depth_m: float = 0.02  # aim 2 cm beyond the believed face, so the hand arrives pushing (modelling choice)
+    contact_speed_m_s: float = 0.2  # the hand has stopped (on the cube, or short of it) (modelling choice)
+    min_reach_s: float = 0.04  # ... no sooner than two steps after the approach began (modelling choice)
     still_rad_s: float = 0.15  # trunk still: every vestibular rate below this (modelling choice)
     still_s: float = 0.5  # ... for this long before looking away (modelling choice)
     head_dead_zone_deg: float = 20.0  # Eyecatch Sec. 4.2 Eq. 17
@@ -139,6 +144,8 @@ class EomBraceAgent:
         self.detected_at: float | None = None
         self.chosen: int | None = None
         self.hold: np.ndarray | None = None
+        self.hold_eye: np.ndarray | None = None
+        self.approach_since: float | None = None
         self.still_since: float | None = None
         self.looked_away = False
         self.events: list[tuple[float, str]] = []
@@ -176,7 +183,7 @@ class EomBraceAgent:
         hand = obs[_S["hand_pos"]].copy()
         if not self.started:
             self.started = True
-            self.home = hand + np.array(p.hand_ready_offset)
+            self.home = np.array(p.hand_ready)
         self.poses.append((rot.copy(), eye.copy()))
         if len(self.poses) == self.delay_steps + 1:
             r0, e0 = self.poses[0]
@@ -200,19 +207,32 @@ class EomBraceAgent:
         look_at = np.array(p.wall_look_point) if t >= p.look_latency_s - 1e-9 else None
         known = [i for i in range(N) if self.w[i] > 0]
         if self.detected_at is not None and known:
+            hand_speed = float(np.linalg.norm(obs[_S["hand_vel"]]))
             if self.hold is None:
-                ves = obs[_S["vestibular"]]
-                lean = SHOULDER + 0.15 * np.array([ves[5], ves[6], 0.0])  # where the shoulder is heading
+                # The nearest believed face to the right shoulder, along the wall (x, z).
                 faces = np.array([self.estimate(i) for i in known])
-                self.chosen = known[int(np.argmin(np.linalg.norm((faces - lean)[:, [0, 2]], axis=1)))]
+                self.chosen = known[int(np.argmin(np.linalg.norm((faces - SHOULDER)[:, [0, 2]], axis=1)))]
                 face = self.estimate(self.chosen)
-                target = face + np.array([0.0, -p.reach_depth_m, 0.0])
-                speed = float(np.linalg.norm(obs[_S["hand_vel"]]))
-                if t - self.detected_at >= p.min_reach_s and speed < p.contact_speed_m_s:
-                    self.hold = hand.copy()
-                    self.events.append((t, "hold"))
+                if self.approach_since is None:
+                    # Align first: in front of the face, then toward it (a hand that sweeps along the wall
+                    # catches an edge).
+                    target = face + np.array([0.0, p.approach_offset_m, 0.0])
+                    if float(np.linalg.norm((hand - face)[[0, 2]])) < p.align_m:
+                        self.approach_since = t
+                        self.events.append((t, "approach"))
+                if self.approach_since is not None:
+                    goal = face + np.array([0.0, -p.reach_depth_m, 0.0])
+                    step = goal - hand
+                    n = float(np.linalg.norm(step))
+                    target = hand + step * min(1.0, 2.0 * p.approach_speed_m_s * self.dt / max(n, 1e-9))
+                    if t - self.approach_since >= p.min_reach_s and hand_speed < p.contact_speed_m_s:
+                        self.hold = hand.copy()
+                        self.hold_eye = eye.copy()
+                        self.events.append((t, "hold"))
             if self.hold is not None:
-                target = self.hold
+                # The braced arm as a strut along the wall's normal: the hand keeps its distance from the
+                # head as the body leans (a hand held fixed in the room would let the arm fold).
+                target = self.hold + np.array([0.0, eye[1] - self.hold_eye[1], 0.0])
             look_at = self.estimate(self.chosen)
             rates = obs[_S["vestibular"]][2:5]
             if self.hold is not None and float(np.max(np.abs(rates))) < p.still_rad_s:

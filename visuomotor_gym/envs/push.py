@@ -48,12 +48,13 @@ class PushRecoveryEnv(VisuomotorEnv):
     floor through real foot contact, the seated body's waist and 7-DOF right arm, the shared head and
     cyclopean eye; ``envs_assets/push.xml``) stands beside a **wall of cube blocks** on its right (Eom et
     al. 2019, section 7). Between 0.6 and 1.4 s after the start a **push** (a 150 ms horizontal force of
-    200-300 N on the torso, toward the wall within +-20 deg) tips it toward the wall: the legs hold their
+    300-400 N on the torso, toward the wall within +-10 deg) tips it toward the wall: the legs hold their
     stance through position servos but cannot stop the fall (a centre of mass carried past the feet's
     edge falls). It stays upright only if its right hand lands on a cube and holds: **there is nothing
     behind or between the cubes**, so a hand that lands in a gap, slides off an edge or stops short of
     the wall does not hold. The wall's distance (0.60-0.80 m from the body's midline), each cube's size
-    (12-20 cm), the gaps (12-30 cm), the cubes' heights and how far each stands out of the wall (0-15 cm)
+    (14-22 cm), the gaps (12-30 cm), the cubes' heights (1.00-1.35 m) and how far each stands out of the
+    wall (0-10 cm)
     are drawn per episode and reach the agent only as the eye's samples of the cubes' faces (foveated
     noise, field of view, saccadic suppression, delay): where the eye looks decides where the hand can go.
 
@@ -84,7 +85,7 @@ class PushRecoveryEnv(VisuomotorEnv):
 
     ## Starting State
 
-    Standing still, legs straight, feet 18 cm apart, the hand in front of the belly, looking straight
+    Standing still, legs straight, feet at shoulder width (sole centres 32 cm apart), the hand in front of the belly, looking straight
     ahead (3 m away at 1.3 m height, with a 2 deg Gaussian jitter). ``info`` at reset: ``block_faces``
     ((n, 3) true face centres), ``block_half_sizes``, ``push_time``, ``push_force``, ``push_dir``,
     ``wall_distance`` (scoring only). The same seed gives the same wall and push on every rung.

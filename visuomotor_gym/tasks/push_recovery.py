@@ -36,15 +36,16 @@ DEG = math.pi / 180.0
 
 # --- the wall of blocks (world frame: x forward, y left; the wall is on the body's right, y < 0) -------
 # Modelling choices (Eom et al. give no dimensions): the wall's face plane 0.60-0.80 m from the body's
-# midline (the right hand reaches it only once the body leans toward it: the shoulder is 0.2 m right of
-# the midline and the arm ~0.62 m long); cubes of 12-20 cm ("cube blocks"); gaps of 12-30 cm (wider than
-# the 9 cm palm, so a hand can pass between two cubes); centres 1.05-1.50 m above the floor (around the
-# shoulder's 1.33 m); each cube standing out of the face plane by 0-15 cm.
+# midline (the right hand reaches it at full stretch or once the body leans toward it: the shoulder is
+# 0.2 m right of the midline and the arm ~0.6 m long to the palm); cubes of 14-22 cm ("cube blocks");
+# gaps of 12-30 cm (wider than the 9 cm palm, so a hand can pass between two cubes); centres 1.00-1.35 m
+# above the floor (at and below the shoulder's 1.33 m, where a hand braces a sideways fall); each cube
+# standing out of the face plane by 0-10 cm.
 WALL_DISTANCE_M = (0.60, 0.80)
-BLOCK_HALF_SIZE_M = (0.06, 0.10)
+BLOCK_HALF_SIZE_M = (0.07, 0.11)
 GAP_M = (0.12, 0.30)
-BLOCK_HEIGHT_M = (1.05, 1.50)
-BLOCK_OFFSET_M = (0.0, 0.15)
+BLOCK_HEIGHT_M = (1.00, 1.35)
+BLOCK_OFFSET_M = (0.0, 0.10)
 FIRST_BLOCK_X_M = (-0.35, -0.05)  # the row starts beside the body and runs forward (modelling choice)
 PARKED = (-20.0, -20.0, -5.0)  # a parked block: 5 m under the floor, out of sight
 
@@ -55,12 +56,13 @@ PUSH_TIME_S = (0.6, 1.4)
 # studies is 100-300 ms (Maki & McIlroy 1997's reviews; REFERENCES.md marks their numbers unconfirmed):
 # modelling choice within that range.
 PUSH_DURATION_S = 0.15
-# 200-300 N for 0.15 s (30-45 N s). Modelling choice: the stance on its own survives a 150 N push and
-# tips over at 200 N (0.15 s; tests/test_push_recovery.py), so every push here needs the hand.
-PUSH_FORCE_N = (200.0, 300.0)
-# Direction: toward the wall (-y) within +-20 deg (modelling choice: "toward the wall", and still a push
-# that a hand on the right-hand wall can stop).
-PUSH_AZIMUTH_DEG = 20.0
+# 300-400 N for 0.15 s (45-60 N s). Modelling choice: the shoulder-width stance on its own survives a
+# 250 N push and tips over at 300 N (0.15 s, toward the wall; tests/test_push_recovery.py), so every push
+# here needs the hand.
+PUSH_FORCE_N = (300.0, 400.0)
+# Direction: toward the wall (-y) within +-10 deg (modelling choice: "toward the wall"; the stance's
+# sagittal margin, 10 cm behind the centre of mass to the heels, is the body's weak direction once braced).
+PUSH_AZIMUTH_DEG = 10.0
 
 # --- the outcome -----------------------------------------------------------------------------------
 HOLD_S = 2.5  # upright this long after the push's onset: success (modelling choice; Eom's clip ~2-3 s)
