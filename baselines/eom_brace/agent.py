@@ -26,7 +26,8 @@ The agent sees observations only (the cubes only as the eye's samples of their f
    (not released: releasing tips the leaning body back over; see the reproduction page).
 
 ``gaze_blind`` is the twin with gaze, vergence and head held (zero actions); the registered
-``gaze_blind:eom_brace`` wrapper gives the same.
+``gaze_blind:eom_brace`` wrapper gives the same. ``use_hand=false`` is the legs-only reference: the same
+agent whose hand stays at its ready point.
 """
 
 from __future__ import annotations
@@ -81,11 +82,13 @@ class EomBraceParams:
     still_s: float = 0.5  # ... for this long before looking away (modelling choice)
     head_dead_zone_deg: float = 20.0  # Eyecatch Sec. 4.2 Eq. 17
     gaze_blind: bool = False
+    # The legs-only reference: the same agent with its hand kept at the ready point (no brace).
+    use_hand: bool = True
 
     def __post_init__(self) -> None:
         for f in fields(self):
             v = getattr(self, f.name)
-            if f.name in ("foveated", "gaze_blind"):
+            if f.name in ("foveated", "gaze_blind", "use_hand"):
                 if not isinstance(v, bool):
                     raise ValueError(f"EomBraceParams.{f.name} must be true or false, got {v!r}")
             elif isinstance(v, tuple):
@@ -245,6 +248,8 @@ class EomBraceAgent:
             if self.looked_away:
                 look_at = eye + np.array([3.0, 0.0, 0.0])
 
+        if not p.use_hand:
+            target = self.home
         gaze, head, fixation = (0.0, 0.0), (0.0, 0.0), None
         if look_at is not None and not p.gaze_blind:
             d_eye = rot.T @ (look_at - eye)
