@@ -14,7 +14,7 @@ The agent sees observations only (the cubes only as the eye's samples of their f
    within ``cop_margin_m`` of the right foot's outer edge, i.e. leaves the support polygon's interior
    (Eom et al.: "the trajectory of the center of pressure crosses over the boundary of the supporting
    polygon"), or the left foot unloads.
-4. **Brace**: the agent chooses the **nearest believed cube** to the right shoulder, saccades to the
+4. **Brace**: ``reaction_latency_s`` after the detection, the agent chooses the **nearest believed cube** to the right shoulder, saccades to the
    centre of its face and keeps gaze there (Eom: "keeping the visual attention at the center of the
    block on which it places the hand") while the hand aligns in front of the believed face
    (``approach_offset_m``, to within ``align_m``) and then moves in, at most ``approach_speed_m_s``, to
@@ -70,6 +70,9 @@ class EomBraceParams:
     look_latency_s: float = 0.2  # first saccade 180-200 ms after the start (REFERENCES.md, saccade latency)
     wall_look_point: tuple = (0.05, -0.75, 0.35)  # stance frame: the wall's expected middle (modelling choice)
     hand_ready: tuple = (0.1, -0.4, 0.27)  # stance frame: the hand waits beside the hip, toward the wall (modelling choice)
+    # The reaction: saccade and hand start this long after the detection. Arm reactions to a perturbation
+    # start ~100-150 ms after it (Maki & McIlroy's reviews, REFERENCES.md, unconfirmed): modelling choice.
+    reaction_latency_s: float = 0.1
     cop_margin_m: float = 0.01  # CoP within 1 cm of the foot's outer edge: leaving the polygon (modelling choice)
     unload_fraction: float = 0.05  # or the left foot carrying < 5 % of body weight (modelling choice)
     approach_offset_m: float = 0.10  # align the palm 10 cm in front of the believed face first (modelling choice)
@@ -209,7 +212,7 @@ class EomBraceAgent:
         target = self.home
         look_at = np.array(p.wall_look_point) if t >= p.look_latency_s - 1e-9 else None
         known = [i for i in range(N) if self.w[i] > 0]
-        if self.detected_at is not None and known:
+        if self.detected_at is not None and known and t >= self.detected_at + p.reaction_latency_s - 1e-9:
             hand_speed = float(np.linalg.norm(obs[_S["hand_vel"]]))
             if self.hold is None:
                 # The nearest believed face to the right shoulder, along the wall (x, z).

@@ -48,7 +48,7 @@ class PushRecoveryEnv(VisuomotorEnv):
     floor through real foot contact, the seated body's waist and 7-DOF right arm, the shared head and
     cyclopean eye; ``envs_assets/push.xml``) stands beside a **wall of cube blocks** on its right (Eom et
     al. 2019, section 7). Between 0.6 and 1.4 s after the start a **push** (a 150 ms horizontal force of
-    300-400 N on the torso, toward the wall within +-10 deg) tips it toward the wall: the legs hold their
+    300-350 N on the torso, toward the wall within +-10 deg) tips it toward the wall: the legs hold their
     stance through position servos but cannot stop the fall (a centre of mass carried past the feet's
     edge falls). It stays upright only if its right hand lands on a cube and holds: **there is nothing
     behind or between the cubes**, so a hand that lands in a gap, slides off an edge or stops short of

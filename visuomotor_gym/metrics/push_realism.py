@@ -64,10 +64,11 @@ def push_measures(trace) -> dict[str, float]:
     onsets = np.flatnonzero(np.asarray(trace.saccade_onset, dtype=bool) & (t > t_push))
     if onsets.size:
         out["saccade_after_push_s"] = float(t[onsets[0]] - dt) - t_push
-    block = int(getattr(trace, "hand_block", -1))
     contact = np.flatnonzero(np.asarray(trace.hand_on_block, dtype=bool))
     faces = np.asarray(trace.block_faces, dtype=float).reshape(-1, 3)
-    if contact.size and 0 <= block < len(faces):
+    if contact.size:
+        # the cube of the first contact: the face nearest the hand then
+        block = int(np.argmin(np.linalg.norm(faces - hand[contact[0]], axis=1)))
         ecc = angles_deg(np.asarray(trace.gaze_dir, dtype=float), faces[block] - np.asarray(trace.eye_pos, dtype=float))
         on = np.flatnonzero(ecc <= GAZE_ON_BLOCK_DEG)
         if on.size:

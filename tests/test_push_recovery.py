@@ -1,0 +1,198 @@
+"""PushRecovery-v0: a standing body that really falls, a wall of cubes that holds only where a cube is,
+and the eom_brace baseline (Eom et al. 2019, section 7) against its references.
+
+The family-independent checks (API checkers, docstring tables, determinism, pickling, bad input,
+reward terms, constant observations) run for every rung in tests/test_families.py."""
+
+from __future__ import annotations
+
+import math
+
+import gymnasium as gym
+import mujoco
+import numpy as np
+import pytest
+
+import visuomotor_gym  # noqa: F401  (registers the ids)
+from visuomotor_gym.agents import make_agent
+from visuomotor_gym.assets import asset_path
+from visuomotor_gym.body import standing as sn
+from visuomotor_gym.control.hand import HandControlParams
+from visuomotor_gym.tasks import push_recovery as pr
+
+ENV = "PushRecovery-v0"
+
+
+def _model():
+    return mujoco.MjModel.from_xml_path(str(asset_path(sn.SCENE)))
+
+
+def _bare_stance(force_n: float, duration_s: float = pr.PUSH_DURATION_S, seconds: float = 3.0):
+    """The standing body with its leg and arm servos holding still, a push toward the wall (-y) on the
+    torso at t = 1 s: (fell, largest pelvis roll in rad)."""
+    m = _model()
+    d = mujoco.MjData(m)
+    body = sn.StandingBody(m, HandControlParams(), 0.02)
+    torso = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "torso")
+    mujoco.mj_resetData(m, d)
+    body.reset_pose(d)
+    mujoco.mj_forward(m, d)
+    roll = 0.0
+    while d.time < seconds:
+        d.ctrl[body._leg_act] = sn.STANCE_RAD
+        d.ctrl[body._act] = 0.0  # the arm and waist hold their setpoints
+        d.xfrc_applied[torso, :3] = (0.0, -force_n, 0.0) if 1.0 <= d.time < 1.0 + duration_s else (0.0, 0.0, 0.0)
+        mujoco.mj_step(m, d)
+        r = d.xmat[body.pelvis]
+        roll = max(roll, math.atan2(float(r[7]), float(r[8])))
+    return body.head_height(d) < pr.FALL_HEAD_HEIGHT_M, roll
+
+
+def _play(agent_spec: str, seed: int, env_id: str = ENV, **env_kwargs):
+    env = gym.make(env_id, **env_kwargs)
+    agent = make_agent(agent_spec, env_id, env.action_space.shape[0], seed=seed)
+    obs, info = env.reset(seed=seed)
+    while True:
+        action, _ = agent.predict(obs)
+        obs, _r, terminated, truncated, info = env.step(action)
+        if terminated or truncated:
+            return env, agent, info
+
+
+# --- the scene and the body --------------------------------------------------------------------
+def test_every_name_exists_and_nothing_is_gravity_compensated():
+    m = _model()
+    kinds = {"body": mujoco.mjtObj.mjOBJ_BODY, "joint": mujoco.mjtObj.mjOBJ_JOINT,
+             "actuator": mujoco.mjtObj.mjOBJ_ACTUATOR, "geom": mujoco.mjtObj.mjOBJ_GEOM,
+             "site": mujoco.mjtObj.mjOBJ_SITE, "camera": mujoco.mjtObj.mjOBJ_CAMERA}
+    for kind, names in sn.ALL_NAMES.items():
+        for name in names:
+            assert mujoco.mj_name2id(m, kinds[kind], name) >= 0, (kind, name)
+    env = gym.make(ENV)
+    assert np.all(env.unwrapped.model.body_gravcomp == 0.0)  # the shared head asks for it: switched off
+
+
+def test_the_body_stands_on_its_feet_at_the_stance_origin():
+    env = gym.make(ENV, push_force_n=(0.0, 0.0))
+    env.reset(seed=0)
+    u = env.unwrapped
+    np.testing.assert_allclose(u.data.xpos[u.body.pelvis], sn.STANCE_ORIGIN, atol=0.01)
+    a = np.zeros(env.action_space.shape, np.float32)
+    a[:3] = sn.hand_target_action(u.body.hand_pos(u.data))
+    for _ in range(100):  # 2 s, no push
+        _obs, _r, terminated, _t, info = env.step(a)
+        assert not terminated
+    cop = env.unwrapped.body.centre_of_pressure(u.data)
+    assert cop[2] > 0.3 and cop[3] > 0.3  # both feet carry the body
+    assert abs(cop[2] + cop[3] - 1.0) < 0.05  # ... all of it: nothing else holds it up
+    assert u.body.head_height(u.data) > 1.4
+
+
+@pytest.mark.parametrize("force_n", [150.0, 250.0])
+def test_a_small_push_on_the_bare_stance_does_not_tip_it(force_n):
+    fell, roll = _bare_stance(force_n)
+    assert not fell and roll < 0.15, roll
+
+
+@pytest.mark.parametrize("force_n", [pr.PUSH_FORCE_N[0], pr.PUSH_FORCE_N[1]])
+def test_the_task_s_push_tips_the_bare_stance_over(force_n):
+    """Physics, not script: every push of the task's range topples the stance held by its servos."""
+    fell, roll = _bare_stance(force_n)
+    assert fell and roll > 1.0, roll
+
+
+def test_the_push_is_on_the_torso_for_its_duration_only():
+    env = gym.make(ENV)
+    _obs, info = env.reset(seed=3)
+    u = env.unwrapped
+    torso = mujoco.mj_name2id(u.model, mujoco.mjtObj.mjOBJ_BODY, "torso")
+    a = np.zeros(env.action_space.shape, np.float32)
+    impulse = np.zeros(3)
+    for _ in range(int((info["push_time"] + 0.5) / u.dt)):
+        u.task.before_physics(u.data)
+        impulse += u.data.xfrc_applied[torso, :3] * u.dt
+        env.step(a)
+    np.testing.assert_allclose(impulse, info["push_force"] * pr.PUSH_DURATION_S * info["push_dir"], rtol=1e-9)
+
+
+# --- falls and braces --------------------------------------------------------------------------
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_the_body_falls_without_bracing(seed):
+    """eom_brace with its hand kept at the ready point (use_hand=false): the same look, no hand: falls."""
+    env, _agent, info = _play("eom_brace:use_hand=false", seed)
+    assert info["fallen"] and not info["is_success"]
+    assert env.unwrapped.task.fall_geoms is not None
+
+
+def test_a_hand_in_a_gap_does_not_hold():
+    """The hand driven (true geometry) to the middle of the gap beside the cube nearest the shoulder: it
+    passes between the cubes and the body falls; the same hand on that cube's face holds it."""
+    outcomes = {}
+    for where in ("gap", "face"):
+        env = gym.make(ENV, vision="oracle")
+        _obs, info = env.reset(seed=4)
+        u = env.unwrapped
+        faces, halves = info["block_faces"], info["block_half_sizes"]
+        i = int(np.argmin(np.abs(faces[:, 0] - 0.05)))
+        j = i + 1
+        gap = 0.5 * ((faces[i, 0] + halves[i]) + (faces[j, 0] - halves[j]))
+        point = faces[i].copy() if where == "face" else np.array([gap, faces[i, 1], 0.5 * (faces[i, 2] + faces[j, 2])])
+        a = np.zeros(env.action_space.shape, np.float32)
+        a[3] = 1.0
+        while True:
+            pushed = u.data.time >= info["push_time"]
+            target = point + (0.0, -0.02, 0.0) if pushed else np.array([point[0], -0.4, point[2]])
+            a[:3] = sn.hand_target_action(target)
+            _obs, _r, terminated, truncated, step_info = env.step(a)
+            if terminated or truncated:
+                break
+        outcomes[where] = (step_info["is_success"], step_info["fallen"], step_info["first_contact_time"])
+    assert outcomes["gap"][1] and outcomes["gap"][2] < 0, outcomes  # fell, never touched a cube
+    assert outcomes["face"][2] > 0, outcomes  # touched the cube
+
+
+def test_eom_brace_keeps_the_body_upright_on_a_few_seeds():
+    for seed in (1, 2, 4):
+        env, agent, info = _play("eom_brace", seed)
+        assert info["is_success"] and not info["fallen"], (seed, env.unwrapped.task.fall_geoms)
+        kinds = [e for _t, e in agent.events]
+        assert kinds[:1] == ["detect"] and "hold" in kinds, kinds
+        assert info["first_contact_time"] > env.unwrapped.task.push_time
+
+
+def test_the_gaze_blind_twin_falls_where_eom_brace_stands():
+    """Held gaze looks straight ahead: the wall is outside the field of view, no cube is ever believed."""
+    for seed in (1, 2):
+        _env, agent, info = _play("gaze_blind:eom_brace", seed)
+        assert not info["is_success"], seed
+
+
+# --- metrics -------------------------------------------------------------------------------------
+def test_the_summary_and_realism_of_eom_brace_episodes():
+    from visuomotor_gym.bench.evaluate import evaluate
+
+    result = evaluate("eom_brace", ENV, episodes=3, seed=7, workers=1, keep_traces=True)  # seeds 7-9: upright
+    s = result.summary
+    assert s["episodes"] == 3 and s["success"] == 3
+    components = s["gaze_realism"]["components"]
+    lead = components["gaze_hand_lead_s"]["value"]
+    assert 0.0 < lead < 1.0, lead  # gaze reaches the cube before the hand (Land et al. 1999)
+    reaction = components["hand_reaction_s"]["value"]
+    assert 0.0 < reaction < 0.4, reaction
+
+
+# --- robustness ----------------------------------------------------------------------------------
+def test_random_actions_give_no_nan_and_no_mujoco_warning():
+    env = gym.make(ENV)
+    rng = np.random.default_rng(0)
+    steps = 0
+    for seed in range(6):
+        env.reset(seed=seed)
+        while True:
+            obs, _r, terminated, truncated, info = env.step(rng.uniform(-1, 1, env.action_space.shape).astype(np.float32))
+            steps += 1
+            assert np.all(np.isfinite(obs)) and not info["physics_diverged"]
+            if terminated or truncated:
+                break
+    assert sum(w.number for w in env.unwrapped.data.warning) == 0
+    assert steps > 200
