@@ -77,10 +77,11 @@ class EomBraceParams:
     unload_fraction: float = 0.05  # or the left foot carrying < 5 % of body weight (modelling choice)
     approach_offset_m: float = 0.10  # align the palm 10 cm in front of the believed face first (modelling choice)
     align_m: float = 0.04  # ... to within 4 cm along the wall, then move in (modelling choice)
+    align_timeout_s: float = 0.25  # ... or after this long, aligned or not (modelling choice)
     approach_speed_m_s: float = 1.0  # the last approach at <= 1 m/s: a hand that slams in bounces the body off
     reach_depth_m: float = 0.02  # aim 2 cm beyond the believed face, so the hand arrives pushing (modelling choice)
     contact_speed_m_s: float = 0.2  # the hand has stopped (on the cube, or short of it) (modelling choice)
-    min_reach_s: float = 0.04  # ... no sooner than two steps after the approach began (modelling choice)
+    min_reach_s: float = 0.06  # ... no sooner than this after the approach began (modelling choice)
     still_rad_s: float = 0.15  # trunk still: every vestibular rate below this (modelling choice)
     still_s: float = 0.5  # ... for this long before looking away (modelling choice)
     head_dead_zone_deg: float = 20.0  # Eyecatch Sec. 4.2 Eq. 17
@@ -221,9 +222,10 @@ class EomBraceAgent:
                 face = self.estimate(self.chosen)
                 if self.approach_since is None:
                     # Align first: in front of the face, then toward it (a hand that sweeps along the wall
-                    # catches an edge).
+                    # catches an edge); move in anyway once align_timeout_s has passed.
                     target = face + np.array([0.0, p.approach_offset_m, 0.0])
-                    if float(np.linalg.norm((hand - face)[[0, 2]])) < p.align_m:
+                    late = t - self.detected_at - p.reaction_latency_s >= p.align_timeout_s - 1e-9
+                    if float(np.linalg.norm((hand - face)[[0, 2]])) < p.align_m or late:
                         self.approach_since = t
                         self.events.append((t, "approach"))
                 if self.approach_since is not None:
