@@ -211,9 +211,10 @@ FAMILY = Family(
         contents="top and side view of the wall: cube faces, hand path, gaze point (coloured by time); gaze-to-"
                  "block angle, hand-to-block distance and centre of pressure over time, push and contact marked",
         trace_field="block_faces",
-        scene_view="scene_camera",
+        scene_view="front_camera",
         video_stride=1,
     ),
     doc_links=(("Eom et al. 2019: balancing after a push", "reproductions/eom.md"),),
-    doc_pictures=(("images/pushrecovery_record_frame.png", "The eom_brace agent bracing on the wall"),),
+    doc_pictures=(("images/pushrecovery_record_frame.png", "The eom_brace agent's hand on a cube after the push "
+                                                           "(seed 1, front camera; the green line: its gaze)"),),
 )

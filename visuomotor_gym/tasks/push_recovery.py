@@ -186,7 +186,7 @@ class PushRecoveryTask(Task):
 
     @staticmethod
     def trace_final_fields(info: dict) -> dict:
-        return {"fallen": bool(info["fallen"]), "hand_block": int(info["hand_block"])}
+        return {"fell": bool(info["fallen"]), "hand_block": int(info["hand_block"])}
 
     # --- physics ------------------------------------------------------------------------------
     def before_physics(self, data: mujoco.MjData) -> None:
