@@ -201,7 +201,7 @@ FAMILY = Family(
     body="standing",
     summariser="visuomotor_gym.metrics.push_realism:push_summary",
     miss_distance="visuomotor_gym.metrics.push_realism:hand_miss_distance",
-    outcome_labels=("upright rate", "time to first hand contact after the push (s)",
+    outcome_labels=("upright rate", "episode end of the upright episodes (s)",
                     "hand-to-nearest-face distance, falls (m)"),
     reaction_from_t0=False,
     agents=("eom_brace",),
