@@ -80,7 +80,7 @@ def test_the_body_stands_on_its_feet_at_the_stance_origin():
     a = np.zeros(env.action_space.shape, np.float32)
     a[:3] = sn.hand_target_action(u.body.hand_pos(u.data))
     for _ in range(100):  # 2 s, no push
-        _obs, _r, terminated, _t, info = env.step(a)
+        _obs, _r, terminated, _t, _info = env.step(a)
         assert not terminated
     cop = env.unwrapped.body.centre_of_pressure(u.data)
     assert cop[2] > 0.3 and cop[3] > 0.3  # both feet carry the body
@@ -163,7 +163,7 @@ def test_eom_brace_keeps_the_body_upright_on_a_few_seeds():
 def test_the_gaze_blind_twin_falls_where_eom_brace_stands():
     """Held gaze looks straight ahead: the wall is outside the field of view, no cube is ever believed."""
     for seed in (1, 2):
-        _env, agent, info = _play("gaze_blind:eom_brace", seed)
+        _env, _agent, info = _play("gaze_blind:eom_brace", seed)
         assert not info["is_success"], seed
 
 

@@ -188,7 +188,7 @@ if PushRecoveryEnv.__doc__:
 
 
 # ---------------------------------------------------------------- the family record (visuomotor_gym.family)
-from visuomotor_gym.family import Family, Viz  # noqa: E402
+from visuomotor_gym.family import Family, Viz
 
 PUSH_MAX_EPISODE_STEPS = 200  # 4 s at 50 Hz: the push by 1.4 s, then 2.5 s to stay upright (never reached)
 

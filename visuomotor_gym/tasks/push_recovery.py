@@ -128,7 +128,6 @@ class PushRecoveryTask(Task):
     def reset_episode(self, data: mujoco.MjData, rng: np.random.Generator) -> None:
         """Draw the wall (distance, then per cube: size, gap, height, offset), the push (time, force,
         direction) and the initial gaze jitter, in that order, from ``rng``."""
-        m = self.model
         wall = float(rng.uniform(*WALL_DISTANCE_M))
         x = float(rng.uniform(*FIRST_BLOCK_X_M))
         centres, faces, sizes = [], [], []
