@@ -45,6 +45,15 @@ CONDITIONS = {
                                                           "depth_pedestal_arcmin": 10.0}},
     "rough + all four": {"course_distribution": "rough", "vision_params": ALL_FOUR},
 }
+# The conditions name courses and eyes relative to the FIRST definition of SteppingStones-v0 ("default":
+# ALLSTEPS' course and the walk family's 20 deg cone); since the moving-eye redefinition "rough + all four"
+# is the id's default. Each condition spells out the course and the cone it starts from, so the names keep
+# their meaning (and the committed data stays reproducible).
+FIRST_EYE = {"field_shape": "cone", "field_of_view_deg": 20.0, "position_e2_deg": None, "crowding": False,
+             "depth_pedestal_arcmin": None}
+CONDITIONS = {name: {"course_distribution": kw.get("course_distribution", "allsteps"),
+                     "vision_params": {**FIRST_EYE, **kw.get("vision_params", {})}}
+              for name, kw in CONDITIONS.items()}
 # The observability ladder on the rough course with all four mechanisms: the other rungs' ids (their
 # registered kwargs: oracle, full view, 0.1 s delay, noise x2) with the same env keyword arguments; the
 # agent is built for the rung's id (its assumed delay) and given the env's VisionParams.

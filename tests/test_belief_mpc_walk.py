@@ -141,7 +141,9 @@ def test_dispatch_on_the_family():
     agent = make_agent("belief_mpc", ENV, env.action_space.shape[0])
     env.close()
     assert isinstance(agent, StonesBeliefMPCAgent)
-    assert agent.vision.field_of_view_deg == 20.0  # the env's own vision constants
+    from visuomotor_gym.registration import env_vision_params
+
+    assert agent.vision == env_vision_params(ENV) and agent.vision.crowding  # the env's own vision (the periphery)
     with pytest.raises(TypeError):
         make_agent("belief_mpc:no_such=1", ENV, 9)
     assert make_agent("belief_mpc:w_tsk=0", ENV, 9).params.w_tsk == 0.0

@@ -128,3 +128,42 @@ def test_bench_accepts_the_twin():
     result = evaluate("fixed_gaze", "EyeCatch-v0", episodes=2, seed=0, workers=1)
     assert result.agent == "fixed_gaze" and result.episodes == 2
     assert all(not tr.saccade_onset.any() for tr in result.traces)
+
+
+def test_the_twin_holds_vergence_only_when_the_eye_has_the_depth_law():
+    """SteppingStones-v0's eye has the depth law (vergence decides depth precision): the twin holds the
+    fixation block at 0 too; EyeCatch-v0's has not: the base agent's vergence passes. match_vision follows
+    the env's own vision (an override either way)."""
+    from visuomotor_gym.agents import match_vision
+    from visuomotor_gym.vision.foveation import VisionParams, human_periphery
+
+    def fixation_index(env_id):
+        start = 0
+        for name, size in gym.make(env_id).unwrapped.action_structure.items():
+            if name == "fixation":
+                return start
+            start += size
+        raise AssertionError("no fixation block")
+
+    stones = make_agent("gaze_blind:lookahead", "SteppingStones-v0", 9)
+    catch = make_agent("gaze_blind:eyecatch", "EyeCatch-v0", 7)
+    assert stones.hold_vergence and not catch.hold_vergence
+    assert stones.held[fixation_index("SteppingStones-v0")] and not catch.held[fixation_index("EyeCatch-v0")]
+    env = gym.make("SteppingStones-v0")
+    obs, _ = env.reset(seed=0)
+    base = make_agent("lookahead", "SteppingStones-v0", 9)
+    base.reset()
+    stones.reset()
+    fix = fixation_index("SteppingStones-v0")
+    moved = False
+    for _ in range(60):
+        a, _ = stones.predict(obs)
+        b, _ = base.predict(obs)
+        assert a[fix] == 0.0
+        moved |= b[fix] != 0.0  # the base agent verges on its gaze target: the twin does not
+        obs, *_ = env.step(a)
+    assert moved
+    match_vision(catch, human_periphery())
+    assert catch.hold_vergence and catch.held[fixation_index("EyeCatch-v0")]
+    match_vision(stones, VisionParams())
+    assert not stones.hold_vergence and not stones.held[fixation_index("SteppingStones-v0")]

@@ -30,23 +30,30 @@ def _inner(policy):
     return policy
 
 
+# The walk family's 20 deg cone without the periphery (ObstacleWalk's default; SteppingStones' first definition).
+CONE = {"field_shape": "cone", "field_of_view_deg": 20.0, "position_e2_deg": None, "crowding": False,
+        "depth_pedestal_arcmin": None}
+
+
 @pytest.mark.parametrize("env_id, agent, memory", [("ObstacleWalk-v0", "iwao", "memory"),
                                                     ("SteppingStones-v0", "lookahead", "memory"),
                                                     ("SteppingStones-v0", "belief_mpc", "memory")])
 @pytest.mark.parametrize("spec", ["{}", "gaze_blind:{}"])
 def test_the_memory_weights_samples_with_the_env_vision(env_id, agent, memory, spec):
-    env = gym.make(env_id, vision_params=dict(HUMAN))
+    from visuomotor_gym.registration import env_vision_params
+
+    registered = env_vision_params(env_id)
+    # an env whose eye is not the registered id's: the periphery where the id has the cone, and back
+    other = HUMAN if registered.field_shape == "cone" else CONE
+    env = gym.make(env_id, vision_params=dict(other))
     try:
         policy = make_agent(spec.format(agent), env_id, int(env.action_space.shape[0]))
         inner = _inner(policy)
-        # make_agent gives the registered id's vision (20 deg cone, no periphery)
-        assert getattr(inner, memory).vision.field_shape == "cone"
-        assert getattr(inner, memory).vision.field_of_view_deg == 20.0
+        assert getattr(inner, memory).vision == registered  # make_agent gives the registered id's vision
         match_vision(policy, env.unwrapped.vision_params)
         seen = getattr(inner, memory).vision
         assert seen is inner.vision is env.unwrapped.vision_params
-        assert (seen.field_shape, seen.position_e2_deg, seen.crowding, seen.depth_pedestal_arcmin) == \
-            ("human", 0.7, True, 10.0)
+        assert {k: getattr(seen, k) for k in other} == other
     finally:
         env.close()
 

@@ -304,6 +304,113 @@ def test_faraway_succeeds_and_beats_its_gaze_blind_twin():
     from visuomotor_gym.bench.results import validate_results  # noqa: F401  (the summary fits the schema)
 
 
+# --- faraway under the depth law (human_periphery) ------------------------------------------------
+def _faraway_with(vision):
+    from visuomotor_gym.baselines.faraway import FarawayAgent
+
+    from visuomotor_gym.agents import match_vision
+
+    agent = FarawayAgent()
+    match_vision(agent, vision)
+    return agent
+
+
+def test_faraway_models_the_depth_law_only_when_its_eye_has_it():
+    from visuomotor_gym.baselines.faraway import FarawayAgent
+
+    from visuomotor_gym.vision.foveation import VisionParams, human_periphery
+
+    assert not FarawayAgent().depth_law  # VisionParams(noise_scale, foveated) until match_vision
+    assert not _faraway_with(VisionParams()).depth_law
+    assert not _faraway_with(human_periphery(depth_pedestal_arcmin=None)).depth_law
+    assert not _faraway_with(human_periphery(foveated=False)).depth_law
+    assert _faraway_with(human_periphery()).depth_law
+
+
+def test_faraway_for_env_models_the_registered_eye_only_when_it_has_a_periphery_law():
+    # vmgym bench builds the agent through for_env (no match_vision): under human_periphery() it must model
+    # that eye; on today's ids it keeps the VisionParams it always had (golden digests).
+    from visuomotor_gym.baselines.faraway import FarawayAgent
+
+    from visuomotor_gym.static_gaze import registered_kwargs
+    from visuomotor_gym.vision.foveation import HUMAN_PERIPHERY, VisionParams
+
+    assert FarawayAgent.for_env("ShelfReach-v0").vision == VisionParams()
+    with registered_kwargs("ShelfReach-v0", {"vision_params": dict(HUMAN_PERIPHERY)}):
+        agent = FarawayAgent.for_env("ShelfReach-v0")
+        assert agent.depth_law and agent.vision.position_e2_deg == 0.7
+        assert not FarawayAgent.for_env("ShelfReach-v0", vision_noise_scale=2.0).depth_law  # the spec's own eye
+
+
+def test_faraway_depth_sigma_hand_computed():
+    # Eyecatch Eq. 2 depth std d * 5 % / alpha(theta), alpha = 2 deg / (2 deg + theta), times the depth
+    # law 1 + eta / 10 arcmin, eta = 0.063 m * |1/d - 1/d_fix|.
+    from visuomotor_gym.vision.foveation import human_periphery
+
+    a = _faraway_with(human_periphery())
+    assert a.depth_sigma(0.8, 0.0, 0.8) == pytest.approx(0.04, rel=1e-12)  # at the vergence distance
+    eta = 0.063 * abs(1 / 0.8 - 1 / 0.5)  # 0.04725 rad = 162.4 arcmin
+    assert eta / (10 * math.pi / 180 / 60) == pytest.approx(16.2434, abs=1e-4)
+    assert a.depth_sigma(0.8, 0.0, 0.5) == pytest.approx(0.04 * 17.2434, rel=1e-5)  # 0.690 m
+    assert a.depth_sigma(0.8, 2.0 * math.pi / 180, 0.8) == pytest.approx(0.08, rel=1e-12)  # alpha = 1/2 at 2 deg
+    grid = a.depth_sigma(np.array([[0.5, 0.8]]), np.zeros((1, 1)), np.array([[0.8]]))
+    assert grid.shape == (1, 2) and grid[0, 1] == pytest.approx(0.04)
+
+
+def test_faraway_depth_law_fusion_trusts_near_vergence_samples():
+    # An object 0.8 m straight ahead of the eye. Five foveal samples taken verged on it say 0.80 m; five
+    # taken verged at 0.4 m say 1.20 m. With the law the first weigh 1/0.04^2 = 625 each and the second
+    # 1/(0.04 * 28.07)^2 = 0.79 each (eta = 0.063 |1/0.8 - 1/0.4| = 270.7 arcmin): the estimate stays
+    # within 5 mm of 0.80 m (an equal-weight mean would say 1.00 m; the posterior mean sits ~3 mm nearer
+    # because each sample's std grows with the candidate's distance).
+    from visuomotor_gym.vision.foveation import human_periphery
+
+    a = _faraway_with(human_periphery())
+    eye, rot = np.array([0.1, 0.0, 0.63]), np.eye(3)
+    for _ in range(5):
+        a._fuse_depth_law(np.array([0.8, 0.0, 0.0]), rot, eye, 0.8, 0.0)
+        a._fuse_depth_law(np.array([1.2, 0.0, 0.0]), rot, eye, 0.4, 0.0)
+    est = a.estimate() - eye
+    assert est[0] == pytest.approx(0.8, abs=5e-3)
+    assert abs(est[1]) < 1e-3 and abs(est[2]) < 1e-3
+    assert a.estimate_std() < 0.04 / math.sqrt(5) * 1.1
+    # The vergence the other way round: the estimate follows the near-vergence samples, within one posterior
+    # std of theirs (0.06 / sqrt(5) = 0.027 m; the off-vergence ones pull a little, as their std is smaller
+    # for nearer candidates).
+    b = _faraway_with(human_periphery())
+    for _ in range(5):
+        b._fuse_depth_law(np.array([0.8, 0.0, 0.0]), rot, eye, 0.4, 0.0)
+        b._fuse_depth_law(np.array([1.2, 0.0, 0.0]), rot, eye, 1.2, 0.0)
+    assert (b.estimate() - eye)[0] == pytest.approx(1.2, abs=0.027)
+
+
+def test_faraway_without_the_depth_law_keeps_its_isotropic_fusion():
+    # The default eye: the depth-law state is never touched and the estimate is the isotropic weighted mean.
+    from visuomotor_gym.baselines.faraway import FarawayAgent
+
+    a = FarawayAgent()
+    eye, rot = np.array([0.1, 0.0, 0.63]), np.eye(3)
+    a._fuse(np.array([0.8, 0.0, 0.0]), rot, eye)
+    assert not a.depth_samples
+    assert np.allclose(a.estimate(), a.point_sum / a.weight_sum)
+
+
+@pytest.mark.slow
+def test_faraway_reaches_under_the_human_periphery():
+    from visuomotor_gym.agents import make_agent, match_vision
+    from visuomotor_gym.bench.trace import run_episode
+    from visuomotor_gym.vision.foveation import human_periphery
+
+    env = gym.make("ShelfReach-v0", vision_params=human_periphery())
+    agent = make_agent("faraway", "ShelfReach-v0", int(env.action_space.shape[0]))
+    match_vision(agent, env.unwrapped.vision_params)
+    assert agent.depth_law
+    wins = sum(bool(run_episode(env, agent, seed=s, env_id="ShelfReach-v0", agent="faraway").success)
+               for s in range(100, 120))
+    env.close()
+    assert wins >= 18, wins  # 97.5 % on the pinned seeds 0-199 (docs/reproductions/faraway.md)
+
+
 # --- realism measures ----------------------------------------------------------------------------
 class _Trace:
     def __init__(self, path, obj, success=True, dt=0.02):

@@ -1,4 +1,4 @@
-"""SteppingStones' opt-in "rough" course preset: reproducible, the same path as the default
+"""SteppingStones' "rough" course (the default): reproducible, the same path as the default
 course, hazards placed by the documented rule (a hand-computed case), hazards never hold a foot, no
 observation leak of unseen hazards or stones (counterfactual scenes; slot ids advance only on landings),
 the lookahead agent's periphery adaptations gated on its vision model, and the static-gaze search on env
@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import asdict
 
 import gymnasium as gym
 import numpy as np
@@ -16,6 +17,7 @@ import pytest
 import visuomotor_gym  # noqa: F401  (registers the ids)
 from visuomotor_gym.agents import make_agent, match_vision
 from visuomotor_gym.envs.stones import STONES_LAYOUT, SteppingStonesEnv
+from visuomotor_gym.envs.walk import WALK_VISION
 from visuomotor_gym.tasks.stepping_stones import (
     COURSE_PRESETS,
     K_SLOTS,
@@ -26,15 +28,17 @@ from visuomotor_gym.tasks.stepping_stones import (
     course_preset,
     sample_hazards,
 )
+from visuomotor_gym.vision.foveation import VisionParams
 
 ALL_FOUR = {"field_shape": "human", "position_e2_deg": 0.7, "crowding": True, "depth_pedestal_arcmin": 10.0}
 
 
-def test_rough_preset_is_reproducible_and_keeps_the_default_path():
-    """One seed, one scenario: the same seed gives the same stones and hazards; the path stones are the
-    default course's (the hazards are drawn after them), another seed gives another course."""
-    a, b, plain = SteppingStonesEnv(course_distribution="rough"), SteppingStonesEnv(course_distribution="rough"), \
-        SteppingStonesEnv()
+def test_rough_preset_is_the_default_reproducible_and_keeps_the_allsteps_path():
+    """One seed, one scenario: the same seed gives the same stones and hazards ("rough" is the default
+    course); the path stones are the "allsteps" course's (the hazards are drawn after them), another seed
+    gives another course."""
+    a, b, plain = SteppingStonesEnv(course_distribution="rough"), SteppingStonesEnv(), \
+        SteppingStonesEnv(course_distribution="allsteps")
     a.reset(seed=11)
     b.reset(seed=11)
     plain.reset(seed=11)
@@ -107,7 +111,7 @@ def test_hazards_never_hold_a_foot_and_are_drawn_beside_their_stones():
 
 
 def test_bad_presets_and_hazard_counts_are_refused():
-    with pytest.raises(ValueError, match="not a preset; allowed: \\['rough'\\]"):
+    with pytest.raises(ValueError, match="not a preset; allowed: \\['allsteps', 'rough'\\]"):
         SteppingStonesEnv(course_distribution="rocky")
     with pytest.raises(ValueError, match="hazards_per_stone \\* n_stones must be <= 32"):
         CourseDistribution(n_stones=14, hazards_per_stone=3)
@@ -210,8 +214,8 @@ def test_lookahead_adapts_only_when_its_vision_model_has_the_periphery():
     assert fixation_action(math.exp(0.5 * (lo + hi))) == pytest.approx(0.0)
     assert beyond_fovea([[1.0, 0.0, 0.0], [1.0, math.tan(math.radians(0.4)), 0.0],
                          [1.0, 0.0, math.tan(math.radians(0.6))]], math.radians(0.5)) == {2}
-    for fields in ({}, ALL_FOUR):
-        env = SteppingStonesEnv(course_distribution="rough", vision_params=fields)
+    for fields in ({}, ALL_FOUR):  # {}: the walk family's 20 deg cone, the first definition's eye
+        env = SteppingStonesEnv(course_distribution="rough", vision_params=VisionParams(**{**asdict(WALK_VISION), **fields}))
         agent = make_agent("lookahead", "SteppingStones-v0", 9)
         match_vision(agent, env.vision_params)
         obs, _ = env.reset(seed=0)

@@ -238,6 +238,7 @@ def match_vision(policy, vision) -> None:
     """
     inner = policy
     while isinstance(inner, GazeBlind):
+        inner.hold_vergence = has_depth_law(vision)
         inner = inner.base
     for agent in (inner, getattr(inner, "_agent", None)):  # PPO's belief features wrap an Eyecatch agent
         if agent is None or not hasattr(agent, "vision"):
@@ -259,7 +260,12 @@ class GazeBlind:
     the **gaze** change (0 holds gaze fixed in the world, so the eye stays where reset put it, on the
     thrower's hand, and never saccades; the vestibulo-ocular reflex keeps it there while the torso
     moves, up to the eye's range) and the **head** target (0 is the reset pose, straight ahead). The
-    fixation (vergence) action is the base agent's: it does not change what is seen.
+    fixation (vergence) action is the base agent's while vergence changes nothing that is seen; when the
+    eye has the depth law (``VisionParams.depth_pedestal_arcmin``: depth is precise only near the vergence
+    distance) vergence is an eye movement too and is held as well, at the fixation action 0 (the middle of
+    the log-mapped fixation range, ~1.4 m: modelling choice, a held eye has no target to verge on).
+    ``hold_vergence`` says which (set from the registered id by ``make_agent`` and from the env's own
+    vision by :func:`match_vision`).
 
     The base agent still runs its own filter on the observations, which report the held eye pose, so
     its estimate stays consistent; only where the eye looks changes. The action layout follows the
@@ -267,18 +273,30 @@ class GazeBlind:
     """
 
     HELD_BLOCKS = ("gaze", "head")
+    VERGENCE_BLOCK = "fixation"
 
-    def __init__(self, base: Policy, action_structure: dict[str, int]):
+    def __init__(self, base: Policy, action_structure: dict[str, int], hold_vergence: bool = False):
         if not isinstance(action_structure, dict) or not all(b in action_structure for b in self.HELD_BLOCKS):
             raise ValueError(
                 f"gaze_blind needs an action layout with 'gaze' and 'head' blocks, got {action_structure!r}"
             )
         self.base = base
+        self.action_structure = dict(action_structure)
         self.action_dim = sum(action_structure.values())
+        self.hold_vergence = bool(hold_vergence)
+
+    @property
+    def hold_vergence(self) -> bool:
+        return self._hold_vergence
+
+    @hold_vergence.setter
+    def hold_vergence(self, value: bool) -> None:
+        self._hold_vergence = bool(value)
+        blocks = self.HELD_BLOCKS + ((self.VERGENCE_BLOCK,) if self._hold_vergence else ())
         self.held = np.zeros(self.action_dim, dtype=bool)
         start = 0
-        for name, size in action_structure.items():
-            if name in self.HELD_BLOCKS:
+        for name, size in self.action_structure.items():
+            if name in blocks:
                 self.held[start : start + size] = True
             start += size
 
@@ -301,7 +319,7 @@ class GazeBlind:
         return action, state
 
     def __getattr__(self, name):  # the base agent's plotting state (events, filter, ...)
-        if name == "base":
+        if name in ("base", "_hold_vergence", "action_structure"):
             raise AttributeError(name)
         return getattr(self.base, name)
 
@@ -324,19 +342,32 @@ def env_action_structure(env_id: str) -> dict[str, int]:
     return dict(_registered_action_structure(env_id.removeprefix("visuomotor_gym:")))
 
 
-def gaze_blind(agent: Policy, action_structure: dict[str, int]) -> GazeBlind:
-    """``agent`` with its gaze and head held (see :class:`GazeBlind`)."""
-    return GazeBlind(agent, action_structure)
+def gaze_blind(agent: Policy, action_structure: dict[str, int], hold_vergence: bool = False) -> GazeBlind:
+    """``agent`` with its gaze and head held, and its vergence with ``hold_vergence`` (see :class:`GazeBlind`)."""
+    return GazeBlind(agent, action_structure, hold_vergence=hold_vergence)
+
+
+def has_depth_law(vision) -> bool:
+    """Whether an eye with these ``VisionParams`` perceives depth with the depth law (vergence then matters)."""
+    return bool(vision is not None and vision.foveated and vision.depth_pedestal_arcmin is not None)
+
+
+def _registered_depth_law(env_id: str) -> bool:
+    from visuomotor_gym.registration import env_vision_params
+
+    return has_depth_law(env_vision_params(env_id.removeprefix("visuomotor_gym:")))
 
 
 def _gaze_blind(env_id, action_dim, seed, base=None, **kw):
     if kw:
         raise TypeError(f"gaze_blind takes no overrides of its own; put them on the base agent: {sorted(kw)}")
-    return GazeBlind(make_agent(base, env_id, action_dim, seed=seed), env_action_structure(env_id))
+    return GazeBlind(make_agent(base, env_id, action_dim, seed=seed), env_action_structure(env_id),
+                     hold_vergence=_registered_depth_law(env_id))
 
 
 def _fixed_gaze(env_id, action_dim, seed, **kw):
-    return GazeBlind(_eyecatch(env_id, action_dim, seed, **kw), env_action_structure(env_id))
+    return GazeBlind(_eyecatch(env_id, action_dim, seed, **kw), env_action_structure(env_id),
+                     hold_vergence=_registered_depth_law(env_id))
 
 
 def _oracle(env_id, action_dim, seed, **kw):

@@ -21,6 +21,14 @@ The agent sees observations only (the object's position only as the eye's sample
    1999, gaze reaches an object ~0.56 s before the hand acts on it), longer when the peak speed would
    exceed ``max_peak_speed_m_s``. The fingers close from ``grasp_at_tau`` of the reach on.
 
+**With the depth law** (the eye's ``VisionParams.depth_pedestal_arcmin``, e.g. ``human_periphery()``: depth
+precise only near the vergence distance), step 1 changes (``_fuse_depth_law``): the direction is fused from
+every sample's lateral part, and the distance is the posterior over a grid of candidate distances in which
+each sample's depth counts with the std the law gives at the candidate's distance and the vergence the eye
+had when it took the sample; the agent verges on its estimate from the first saccade on, so its foveal
+samples soon sit near the vergence distance and fix the depth. With the default vision (no depth law) the
+agent is unchanged.
+
 ``gaze_blind=True`` is the gaze-blind twin (docs/gaze_gain.md): the same agent with gaze, vergence and
 head held (zero actions), reaching to whatever its peripheral samples tell it, when they tell it anything.
 """
@@ -38,9 +46,9 @@ from visuomotor_gym.core.frames import SEAT_ORIGIN
 from visuomotor_gym.core.observation import ObservationLayout
 from visuomotor_gym.envs.actions import NECK_RANGE_DEG, hand_action
 from visuomotor_gym.envs.reach import reach_observation
-from visuomotor_gym.registration import env_vision
+from visuomotor_gym.registration import env_vision, env_vision_params
 from visuomotor_gym.tasks.reach import SHELF_LAYOUT
-from visuomotor_gym.vision import foveation
+from visuomotor_gym.vision import foveation, periphery
 from visuomotor_gym.vision.foveation import VisionParams
 
 DEG = math.pi / 180.0
@@ -49,9 +57,14 @@ _S = _LAYOUT.slices
 # Peak of the Beta(1.63, 1.75) speed density (at its mode 0.457): peak speed = this x length / duration.
 PRIOR_STD_M = 0.5  # weak prior on the object: the shelves' centre +- 0.5 m (modelling choice)
 SAMPLE_DISTANCE_RANGE_M = (0.2, 1.6)  # samples outside are rejected: the shelves are 0.5-1.1 m from the eye (modelling choice)
+FAR_SHELF_M = 1.2  # beyond the farthest shelf target (1.1 m from the eye): the depth-law fusion takes every
+# sample's lateral std at this distance (modelling choice, see FarawayAgent._fuse_depth_law)
 PRIOR_DISTANCE_M = 0.8  # distance assumed for the first sample's noise: the shelves are 0.5-1.1 m from the eye
 PATH_REPLAN_M = 0.01  # recompute faraway_path when the end estimate moved more than this; in between the path is
 # shifted linearly in relative time onto the new end (cost: ~3 ms a call on a loaded core; modelling choice)
+# The depth-law fusion's candidate distances: SAMPLE_DISTANCE_RANGE_M on a 5 mm grid (flat prior: the object is on
+# the shelves; 5 mm is a tenth of the 6 cm success radius: modelling choice)
+_DEPTH_GRID = np.arange(SAMPLE_DISTANCE_RANGE_M[0], SAMPLE_DISTANCE_RANGE_M[1] + 1e-9, 0.005)
 _BETA_PEAK = float(np.max(np.diff(handpath.beta_progress(np.linspace(0.0, 1.0, 2001))) * 2000.0))
 
 
@@ -107,12 +120,19 @@ class FarawayAgent:
 
     @classmethod
     def for_env(cls, env_id: str, **overrides) -> FarawayAgent:
-        """An agent whose assumed vision matches the registered env (noise, foveation, latency)."""
+        """An agent whose assumed vision matches the registered env (noise, foveation, latency); when the
+        env's eye has a peripheral mechanism (``VisionParams.periphery_on``, e.g. ``human_periphery()``), the
+        agent models that whole eye (``registration.env_vision_params``), as ``agents.match_vision`` does,
+        unless the spec overrides the vision it assumes (``faraway:vision_noise_scale=5``)."""
         base = FarawayParams(**env_vision(env_id))
         unknown = sorted(set(overrides) - {f.name for f in fields(FarawayParams)})
         if unknown:
             raise TypeError(f"unknown faraway parameter(s) {unknown}; known: {[f.name for f in fields(FarawayParams)]}")
-        return cls(replace(base, **overrides))
+        agent = cls(replace(base, **overrides))
+        vision = env_vision_params(env_id)
+        if vision.periphery_on and not ({"vision_noise_scale", "foveated"} & set(overrides)):
+            agent.vision = vision
+        return agent
 
     def reset(self) -> None:
         """Forget the episode (called by the evaluator, and on ``episode_start``)."""
@@ -122,6 +142,13 @@ class FarawayAgent:
         self.weight_sum = 1.0 / PRIOR_STD_M**2
         self.point_sum = self.weight_sum * self.prior_mean
         self.samples = 0
+        # With the depth law (VisionParams.depth_pedestal_arcmin) the samples are fused with their full
+        # modelled covariance instead (``_fuse_depth_law``): information matrix and vector, same prior.
+        self.info = np.eye(3) * self.weight_sum
+        self.info_vec = self.info @ self.prior_mean
+        self.depth_samples: list[tuple[np.ndarray, np.ndarray, float, float, float]] = []
+        self._cached: tuple[np.ndarray, float] | None = None
+        self.prev_rot: np.ndarray | None = None
         self.poses: deque = deque(maxlen=self.delay_steps + 1)
         self.saccade_time: float | None = None  # when the first saccade to the object was commanded
         self.search_index = 1  # the gaze starts on tower 0
@@ -139,13 +166,37 @@ class FarawayAgent:
     def has_estimate(self) -> bool:
         return self.samples > 0
 
+    @property
+    def depth_law(self) -> bool:
+        """Whether the eye this agent models has the depth law (depth precise only near the vergence
+        distance, ``VisionParams.depth_pedestal_arcmin``; set by ``agents.match_vision``)."""
+        v = self.vision
+        return v.foveated and getattr(v, "depth_pedestal_arcmin", None) is not None
+
     def estimate(self) -> np.ndarray:
-        """Seat-frame estimate of the object centre: the precision-weighted mean of the samples and the prior."""
+        """Seat-frame estimate of the object centre: the precision-weighted mean of the samples and the prior
+        (with the depth law: :meth:`_depth_law_estimate`)."""
+        if self.depth_law:
+            return self._depth_law_estimate()[0]
         return self.point_sum / self.weight_sum
 
     def estimate_std(self) -> float:
         """Standard deviation (m) of the estimate along the worst (depth) direction."""
+        if self.depth_law:
+            return self._depth_law_estimate()[1]
         return float(1.0 / math.sqrt(self.weight_sum))
+
+    def depth_sigma(self, distance, eccentricity, fixation):
+        """The modelled depth std (m) of a sample of a point ``distance`` m away at ``eccentricity`` (rad),
+        seen with the vergence distance ``fixation`` m: Eyecatch Eq. 2's ``d * depth_std_fraction *
+        noise_scale / alpha(theta)`` times the depth law's ``1 + eta / eta_2``, ``eta = I |1/d - 1/d_fix|``
+        (:func:`visuomotor_gym.vision.periphery.depth_factor`, vectorised: arrays broadcast)."""
+        v = self.vision
+        d = np.asarray(distance, dtype=float)
+        e2 = v.fovea_e2_deg * DEG
+        base = d * v.depth_std_fraction * v.noise_scale * (1.0 + np.asarray(eccentricity, dtype=float) / e2)
+        eta = v.interocular_m * np.abs(1.0 / np.maximum(d, 1e-6) - 1.0 / np.asarray(fixation, dtype=float))
+        return base * (1.0 + eta / (v.depth_pedestal_arcmin * periphery.ARCMIN))
 
     def _fuse(self, pos_eye: np.ndarray, rot: np.ndarray, eye: np.ndarray) -> None:
         """Add one sample, weighted by its depth precision (Eyecatch Eq. 2 at its eccentricity).
@@ -168,6 +219,86 @@ class FarawayAgent:
         self.point_sum += w * (eye + rot @ pos_eye)
         self.samples += 1
 
+    def _fuse_depth_law(self, pos_eye: np.ndarray, rot: np.ndarray, eye: np.ndarray, fixation: float,
+                        retinal_speed: float) -> None:
+        """Add one sample when the eye has the depth law: its direction and its depth apart.
+
+        A sample is the object plus noise along its line of sight (depth) and across it (lateral),
+        Eyecatch Eq. 1-3. **Direction**: the lateral part is fused in information form
+        (``lat / sigma_lat^2``, the sample's own line of sight; the lateral std, with the eye's position law
+        and slip, at ``FAR_SHELF_M``, beyond the farthest shelf: a std taken at an underestimated distance lets two nearly
+        parallel lines of sight from a moving eye triangulate the object onto the eye). **Depth**: the
+        sample's distance along its line of sight is kept with the eye's position, line of sight,
+        eccentricity and vergence distance, for :meth:`_depth_law_estimate`, which weighs it with the
+        std the depth law gives *at each candidate distance* (far from the vergence distance depth is
+        poor, at it a foveal sample is precise). No range cut: the likelihood handles wide samples."""
+        dist = float(np.linalg.norm(pos_eye))
+        if dist <= 1e-6:
+            return
+        u_eye = pos_eye / dist
+        # The sample lies on the object's line of sight, on either side of the eye (a wide depth error can
+        # put it behind): the half-line is the one toward the current estimate (the prior's centre at first).
+        if float((rot @ u_eye) @ (self.estimate() - eye)) < 0.0:
+            u_eye = -u_eye
+        u = rot @ u_eye
+        ecc = math.acos(max(-1.0, min(1.0, float(u_eye[0]))))
+        lateral_std = float(foveation.standard_deviations(FAR_SHELF_M, ecc, retinal_speed, self.vision)[1])
+        w = (np.eye(3) - np.outer(u, u)) / max(lateral_std, 1e-9) ** 2
+        point = eye + rot @ pos_eye
+        self.info += w
+        self.info_vec += w @ point
+        self.depth_samples.append((eye.copy(), u, float(u @ (point - eye)), ecc, float(fixation)))
+        self.samples += 1
+        self._cached = None
+
+    def _depth_law_estimate(self) -> tuple[np.ndarray, float]:
+        """(estimate, std) with the depth law: the posterior over candidate points, one per distance.
+
+        The candidates ``c(lam) = c0 + lam g`` are, for each distance ``lam`` along the latest sample's line
+        of sight ``u0`` from its eye ``e0`` (``lam`` on ``_DEPTH_GRID``, flat prior: the object is on the
+        shelves), the point that best fits the lateral information at that distance (the minimum of the
+        lateral quadratic under a stiff constraint ``u0 . (c - e0) = lam``, which is linear in ``lam``).
+        A candidate's log-posterior is the lateral quadratic plus, for each kept sample ``i`` (eye ``e_i``,
+        line of sight ``u_i``, measured distance ``s_i``), ``log N(s_i; u_i . (c - e_i), sigma_i(c)^2)``
+        with ``sigma_i(c)`` = :meth:`depth_sigma` at the candidate's distance ``|c - e_i|`` and the sample's
+        own eccentricity and vergence distance: the exact depth law, so a sample taken far from its
+        vergence distance weighs little wherever the object is, and the estimate does not lock onto an
+        early wrong depth (which a covariance taken at the estimate, where the agent verges, would do:
+        there the pedestal is zero). The estimate is the posterior mean; its std the larger of the
+        posterior's and the lateral one."""
+        if self._cached is not None:
+            return self._cached
+        lateral = np.linalg.solve(self.info, self.info_vec)
+        if not self.depth_samples:
+            self._cached = (lateral, float(math.sqrt(max(np.linalg.eigvalsh(np.linalg.inv(self.info))[-1], 0.0))))
+            return self._cached
+        e0, u0 = self.depth_samples[-1][0], self.depth_samples[-1][1]
+        kappa = 1e4 * float(np.trace(self.info))
+        A = self.info + kappa * np.outer(u0, u0)
+        c0 = np.linalg.solve(A, self.info_vec + kappa * u0 * float(u0 @ e0))
+        g = np.linalg.solve(A, kappa * u0)
+        lam = _DEPTH_GRID
+        cand = c0 + lam[:, None] * g  # (K, 3)
+        dev = cand - lateral
+        loglik = -0.5 * np.einsum("kc,cd,kd->k", dev, self.info, dev)  # the lateral evidence
+        E = np.array([d[0] for d in self.depth_samples])  # (N, 3)
+        U = np.array([d[1] for d in self.depth_samples])
+        S = np.array([d[2] for d in self.depth_samples])
+        ecc = np.array([d[3] for d in self.depth_samples])
+        fix = np.array([d[4] for d in self.depth_samples])
+        rel = cand[None, :, :] - E[:, None, :]  # (N, K, 3)
+        pred = np.einsum("nkc,nc->nk", rel, U)
+        dist = np.linalg.norm(rel, axis=2)
+        sig = self.depth_sigma(dist, ecc[:, None], fix[:, None])
+        loglik = loglik + np.sum(-0.5 * ((S[:, None] - pred) / sig) ** 2 - np.log(sig), axis=0)
+        w = np.exp(loglik - loglik.max())
+        w /= w.sum()
+        mean = float(w @ lam)
+        std = float(math.sqrt(max(float(w @ (lam - mean) ** 2), 0.0)))
+        lat_std = float(math.sqrt(max(np.linalg.eigvalsh(np.linalg.inv(self.info))[0], 0.0)))
+        self._cached = (c0 + mean * g, max(std * float(np.linalg.norm(g)), lat_std))
+        return self._cached
+
     # --- policy -------------------------------------------------------------------------------
     def predict(self, observation, state=None, episode_start=None, deterministic=True):
         obs = np.asarray(observation, dtype=float)
@@ -187,10 +318,18 @@ class FarawayAgent:
         if not self.started:
             self.started = True
             self.home = hand.copy()
-        self.poses.append((rot.copy(), eye.copy()))
+        # The eye's turn since the last step (rad/s): the static object's retinal slip (depth-law fusion).
+        turn = 0.0
+        if self.prev_rot is not None:
+            turn = float(np.linalg.norm(np.cross(self.prev_rot[:, 0], rot[:, 0]))) / self.dt
+        self.prev_rot = rot.copy()
+        self.poses.append((rot.copy(), eye.copy(), float(obs[_S["fixation"]][0]), turn))
         if obs[_S["object_visible"]][0] > 0.5 and len(self.poses) == self.delay_steps + 1:
-            r0, e0 = self.poses[0]  # the eye pose when the sample was taken
-            self._fuse(obs[_S["object_pos"]].copy(), r0, e0)
+            r0, e0, f0, w0 = self.poses[0]  # the eye pose (and vergence) when the sample was taken
+            if self.depth_law:
+                self._fuse_depth_law(obs[_S["object_pos"]].copy(), r0, e0, f0, w0)
+            else:
+                self._fuse(obs[_S["object_pos"]].copy(), r0, e0)
 
         # --- gaze ---------------------------------------------------------------------------
         gaze = (0.0, 0.0)

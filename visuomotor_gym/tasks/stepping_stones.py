@@ -30,15 +30,15 @@ stone no foot has landed on yet): when the footstep onto stone ``n + 1`` is chos
 read) the slots reach two stones beyond it, as the walker must see >= 2 steps ahead (Matthis & Fajen
 2014) and ALLSTEPS' policy sees the next 2 targets. A stone not seen this step reads as zeros.
 
-**Rough terrain (opt-in)**: ``course_distribution="rough"`` (:data:`COURSE_PRESETS`) keeps the
-path of the default course for the same seed (its draws come first) and adds what makes footholds hard
-to localise without looking at them: smaller stones (``stone_radius_m``) and, beside each stone,
-``hazards_per_stone`` *hazards* (loose rocks: :func:`sample_hazards`; the scene ``stones_rough.xml``) that
-never hold a foot (a foot on one stands over the gap and falls). Hazards are seen as the stones are (the
-centre of the top, :class:`~visuomotor_gym.core.retina.PointTarget` of the same kind, so with
-``VisionParams.crowding`` a stone seen in the periphery is pooled with them) while the stone they flank
-is in a slot; they never appear in the observation's slots, which hold the stones only. Every default
-field leaves the course, the scene and the draws as they were.
+**Rough terrain (the default since the moving-eye redefinition)**: the course keeps ALLSTEPS' path
+(its draws come first, so ``course_distribution="allsteps"``, the first definition's course, has the same
+path for the same seed) and adds what makes footholds hard to localise without looking at them: smaller
+stones (``stone_radius_m``) and, beside each stone, ``hazards_per_stone`` *hazards* (loose rocks:
+:func:`sample_hazards`; the scene ``stones_rough.xml``) that never hold a foot (a foot on one stands over
+the gap and falls). Hazards are seen as the stones are (the centre of the top,
+:class:`~visuomotor_gym.core.retina.PointTarget` of the same kind, so with ``VisionParams.crowding`` a
+stone seen in the periphery is pooled with them) while the stone they flank is in a slot; they never
+appear in the observation's slots, which hold the stones only. :data:`COURSE_PRESETS` names both courses.
 """
 
 from __future__ import annotations
@@ -116,12 +116,14 @@ class CourseDistribution:
     turn_slack_deg: float = 5.0  # modelling choice: a steppable course needs turns 5 deg short of the gait's limit
     start_foot_x_m: float = 1.95 + FOOT_CENTRE_AHEAD_M  # nominal foot centre of the last foothold on the slab
     start_foot_y_m: float = -0.06  # ... (the right foot, half the 0.12 m nominal step width to the right)
-    # --- the "rough" terrain (off by default: the fields below leave the course as above) ---
-    # Radius of every stone (m); None: the scene's 0.25 m (ALLSTEPS).
-    stone_radius_m: float | None = None
+    # --- the rough terrain (COURSE_PRESETS: the default; "allsteps" sets stone_radius_m=None and
+    # hazards_per_stone=0, ALLSTEPS' course of the first definition) ---
+    # Radius of every stone (m); None: the scene's 0.25 m (ALLSTEPS). 0.15 m: modelling choice (a 30 cm
+    # stone, the midfoot must land within 15 cm of its centre).
+    stone_radius_m: float | None = 0.15
     # Hazards (loose rocks that do not hold a foot: a foot landing on one falls) drawn beside each stone;
-    # 0: none, and the plain scene (stones.xml) without them.
-    hazards_per_stone: int = 0
+    # 0: none, and the plain scene (stones.xml) without them. 2: modelling choice (see COURSE_PRESETS).
+    hazards_per_stone: int = 2
     hazard_radius_m: float = 0.12  # radius of a hazard (used only with hazards)
     hazard_distance_m: tuple[float, float] = (0.32, 0.45)  # centre of a hazard from its stone's centre (modelling choice)
     hazard_clearance_m: float = 0.05  # the least gap between a hazard's rim and any stone's or hazard's rim
@@ -138,7 +140,7 @@ class CourseDistribution:
         return ROUGH_SCENE if self.hazards_per_stone else STONES_SCENE
 
 
-# The opt-in course presets (``SteppingStonesEnv(course_distribution="rough")``). "rough" (its
+# The course presets (``SteppingStonesEnv(course_distribution="rough")``). "rough", the default (its
 # measurements in docs/reproductions/data/terrain/stepping_stones.md): footholds that must be located
 # precisely and early, among clutter where crowding acts. Stones of radius 0.15 m (modelling choice: a
 # 30 cm stone, the midfoot must land within 15 cm of its centre, where ALLSTEPS' 0.25 m stones leave 25 cm),
@@ -148,10 +150,13 @@ class CourseDistribution:
 # about twice its angular distance from the line of sight (Bouma's critical spacing, b = 0.5), the stone
 # is pooled with it (crowding, VisionParams.crowding): its perceived centre is the mean of the stone and
 # its crowding flankers, 16-22 cm toward a lone hazard (half their distance), beyond what the stone's radius
-# forgives (two hazards on opposite sides partly cancel).
+# forgives (two hazards on opposite sides partly cancel). "allsteps": the first definition's course,
+# ALLSTEPS' stones of 0.25 m and no hazards (a course one body-locked posture could cross: 79.5 % for the
+# best static twin of lookahead on the pinned seeds under the 20 deg cone).
 COURSE_PRESETS = {
     "rough": {"stone_radius_m": 0.15, "hazards_per_stone": 2, "hazard_radius_m": 0.12,
               "hazard_distance_m": (0.32, 0.45), "hazard_clearance_m": 0.05},
+    "allsteps": {"stone_radius_m": None, "hazards_per_stone": 0},
 }
 
 
