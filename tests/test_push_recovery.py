@@ -160,6 +160,16 @@ def test_eom_brace_keeps_the_body_upright_on_a_few_seeds():
         assert info["first_contact_time"] > env.unwrapped.task.push_time
 
 
+def test_a_brace_that_keeps_pushing_throws_the_body_over_its_other_foot():
+    """Seed 5: the hand strikes the cube; an arm that keeps pushing as the body moves back (yield off)
+    throws it away from the wall, over its left foot; the arm that yields keeps it upright."""
+    _env, _agent, info = _play("eom_brace", 5)
+    assert info["is_success"], info
+    env, _agent, info = _play("eom_brace:yield_speed_m_s=-1", 5)
+    assert info["fallen"] and info["first_contact_time"] > 0, info  # it touched a cube, then fell ...
+    assert info["pelvis_pos"][1] > 0.2, info["pelvis_pos"]  # ... away from the wall (the wall is at -y)
+
+
 def test_the_gaze_blind_twin_falls_where_eom_brace_stands():
     """Held gaze looks straight ahead: the wall is outside the field of view, no cube is ever believed."""
     for seed in (1, 2):

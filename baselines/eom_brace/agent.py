@@ -197,8 +197,8 @@ class EomBraceAgent:
             return
         v = self.vision
         ecc = foveation.eccentricity(pos_eye)
-        if ecc > self.params.fuse_max_ecc_deg * DEG:
-            return  # far periphery: crowded and coarse, not fused
+        if v.foveated and ecc > self.params.fuse_max_ecc_deg * DEG:
+            return  # far periphery: crowded and coarse, not fused (a full view has no periphery)
         depth_std = dist * v.depth_std_fraction * v.noise_scale / foveation.acuity(ecc, v)
         if v.depth_pedestal_arcmin is not None and v.foveated:
             # Depth is precise only near the vergence distance (the env's depth law, Blakemore 1970).

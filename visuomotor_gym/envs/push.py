@@ -62,6 +62,8 @@ class PushRecoveryEnv(VisuomotorEnv):
     wall (0-10 cm)
     are drawn per episode and reach the agent only as the eye's samples of the cubes' faces (foveated
     noise, field of view, saccadic suppression, delay): where the eye looks decides where the hand can go.
+    The eye has the **human periphery** (``vision.foveation.human_periphery()``: the human field, position
+    law E2 0.7 deg, crowding, depth pedestal 10 arcmin), as every family's.
 
     Physics 500 Hz, control 50 Hz. The observability ladder (Oracle, FullView, foveated, Delayed,
     PoorVision) is keyword arguments of this class (``visuomotor_gym.registration``).
@@ -109,7 +111,10 @@ class PushRecoveryEnv(VisuomotorEnv):
 
     ## Version History
 
-    * v0: initial release.
+    * v0: initial release. Redefined in place for the moving eye: the eye has the human periphery
+      (``human_periphery()``) instead of the acuity law with a 60 deg cone. On the pinned seeds 0-199 the
+      best static posture of the eye (with eom_brace) held 72 % of the bodies upright under the former
+      eye; see docs/reproductions/eom.md for this one. Former leaderboard entries are superseded.
     """
 
     render_cameras: ClassVar[dict[str, tuple[str, ...]]] = {
