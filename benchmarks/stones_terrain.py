@@ -49,8 +49,14 @@ CONDITIONS = {
 # ALLSTEPS' course and the walk family's 20 deg cone); since the moving-eye redefinition "rough + all four"
 # is the id's default. Each condition spells out the course and the cone it starts from, so the names keep
 # their meaning (and the committed data stays reproducible).
-FIRST_EYE = {"field_shape": "cone", "field_of_view_deg": 20.0, "position_e2_deg": None, "crowding": False,
-             "depth_pedestal_arcmin": None}
+def _first_eye() -> dict:
+    from visuomotor_gym.envs.walk import WALK_VISION
+    from visuomotor_gym.vision.foveation import HUMAN_PERIPHERY
+
+    return {k: getattr(WALK_VISION, k) for k in ("field_of_view_deg", *HUMAN_PERIPHERY)}
+
+
+FIRST_EYE = _first_eye()  # the walk family's 20 deg cone, every periphery mechanism off
 CONDITIONS = {name: {"course_distribution": kw.get("course_distribution", "allsteps"),
                      "vision_params": {**FIRST_EYE, **kw.get("vision_params", {})}}
               for name, kw in CONDITIONS.items()}

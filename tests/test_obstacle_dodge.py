@@ -6,6 +6,7 @@ reward terms, memory) run for every rung in tests/test_families.py."""
 
 from __future__ import annotations
 
+import contextlib
 import math
 from types import SimpleNamespace
 
@@ -20,6 +21,7 @@ from visuomotor_gym.envs.dodge import DODGE_LAYOUT, ObstacleDodgeEnv
 from visuomotor_gym.metrics.dodge_realism import dodge_gaze_realism, pedestrian_fixations
 from visuomotor_gym.registration import ENV_SPECS, FAMILIES
 from visuomotor_gym.tasks.obstacle_dodge import (
+    CROWD_PRESETS,
     N_PEDESTRIANS,
     CrowdDistribution,
     intercept_velocity,
@@ -83,7 +85,7 @@ def test_no_observation_leak_of_the_pedestrians_true_state(vision):
 
 
 def test_crowd_sampler_follows_its_distribution():
-    dist = CrowdDistribution()
+    dist = CrowdDistribution(group_size=(1, 1))  # the first definition's crowd: every pedestrian alone
     rng = np.random.default_rng(1)
     veer = []
     for _ in range(400):
@@ -270,7 +272,7 @@ def test_a_veer_lasts_one_second():
     """Jovancevic et al.: ~1 s. A veering pedestrian turns when it comes within its veer distance and
     takes up its first velocity again 1 s later."""
     assert CrowdDistribution().veer_s == 1.0
-    env = ObstacleDodgeEnv(crowd_distribution={"veer_p": 1.0})
+    env = ObstacleDodgeEnv(crowd_distribution={"veer_p": 1.0, "group_size": (1, 1)})
     env.reset(seed=0)
     task = env.task
     first = task.crowd.pedestrians[0, 3:5].copy()
@@ -301,17 +303,23 @@ def test_fajen_warren_also_predicts_a_veering_pedestrian_returning_to_its_course
     assert np.allclose(tracks[3, -1], (3.0 + 1.0 * (tau[-1] - 1.0), 2.0 - 1.3))  # 1 s at -1.3 m/s, then (1, 0)
 
 
-# --- groups (opt-in CrowdDistribution.group_size) --------------------------------------------------
+# --- groups (opt-in CrowdDistribution.group_size, preset "groups") ----------------------------------
 GROUPS = {"group_size": (2, 3)}
+SINGLE = "single"  # the default preset: every pedestrian alone
 
 
-def test_groups_off_keep_the_draws_of_v0():
-    """(1, 1) is today's sampler, draw for draw (the RNG stream untouched: tests/test_golden.py)."""
+def test_single_is_the_default_and_keeps_the_draws_of_v0():
+    """(1, 1) -- the default, preset "single" -- is v0's sampler draw for draw, whatever the spacing (the RNG
+    stream untouched: tests/test_golden.py); preset "groups" is pairs and triads."""
     for seed in range(5):
         a = sample_crowd(np.random.default_rng(seed), CrowdDistribution())
         b = sample_crowd(np.random.default_rng(seed), CrowdDistribution(group_size=(1, 1), group_spacing_m=(2, 3)))
         assert a.goal == b.goal and np.array_equal(a.pedestrians, b.pedestrians)
     assert not CrowdDistribution().groups and CrowdDistribution(**GROUPS).groups
+    assert CROWD_PRESETS[SINGLE] == CrowdDistribution() and CROWD_PRESETS["groups"] == CrowdDistribution(**GROUPS)
+    assert ObstacleDodgeEnv(crowd_distribution="groups").crowd_distribution == CrowdDistribution(**GROUPS)
+    with pytest.raises(ValueError, match=r"crowd_distribution.*presets"):
+        ObstacleDodgeEnv(crowd_distribution="pairs")
 
 
 @pytest.mark.parametrize("bad", [(0, 2), (2, 5), (1.5, 2), (3, 2)])
@@ -399,7 +407,7 @@ def test_with_groups_slot_ids_do_not_reveal_unseen_pedestrians():
     obs = {}
     for order, rows in (("seen first", [SEEN, UNSEEN, LATER, LATER]), ("seen second", [UNSEEN, SEEN, LATER, LATER])):
         for groups in (True, False):
-            env = ObstacleDodgeEnv(crowd_distribution=GROUPS if groups else None)
+            env = ObstacleDodgeEnv(crowd_distribution=GROUPS if groups else SINGLE)
             env.reset(seed=4)
             _set_crowd(env, rows)
             out = [env.step(np.zeros(7, dtype=np.float32))[0] for _ in range(25)]
@@ -466,12 +474,8 @@ def test_fajen_warren_models_groups_only_when_the_env_has_them():
 
     plain = FajenWarrenAgent.for_env("ObstacleDodge-v0")
     assert plain.params.companion_m == 0.0 and plain.params.dwell_saccade_s is None
-    kwargs = gym.registry["ObstacleDodge-v0"].kwargs
-    kwargs["crowd_distribution"] = dict(GROUPS)
-    try:
+    with _registered(crowd_distribution="groups"):
         grouped = FajenWarrenAgent.for_env("ObstacleDodge-v0")
-    finally:
-        kwargs.pop("crowd_distribution")
     assert grouped.params.companion_m == pytest.approx(0.8)
     # a lone known pedestrian, others unseen: companions abreast at 0.8 m either side, at its velocity
     grouped.filters[0].x = np.array([5.0, 3.0, 0.0, -1.2])
@@ -481,3 +485,112 @@ def test_fajen_warren_models_groups_only_when_the_env_has_them():
     grouped.filters[1].x = np.array([5.8, 3.0, 0.0, -1.2])  # its companion seen: no assumed ones
     grouped.filters[1].t = 0.0
     assert grouped._companions() == []
+
+
+# --- groups with the human periphery (the candidate definition, opt-in) -------------------------------
+@contextlib.contextmanager
+def _registered(**kw):
+    """Lay ``kw`` over the registered ObstacleDodge-v0 kwargs (so the agents' ``for_env`` sees them too)."""
+    kwargs = gym.registry["ObstacleDodge-v0"].kwargs
+    old = {k: kwargs[k] for k in kw if k in kwargs}
+    kwargs.update(kw)
+    try:
+        yield
+    finally:
+        for k in kw:
+            kwargs.pop(k, None)
+        kwargs.update(old)
+
+
+def _human():
+    from visuomotor_gym.vision.foveation import HUMAN_PERIPHERY
+
+    return dict(HUMAN_PERIPHERY)
+
+
+def test_fajen_warren_takes_every_constant_of_the_envs_eye():
+    from visuomotor_gym.baselines.fajen_warren import FajenWarrenAgent
+
+    from visuomotor_gym.vision.foveation import human_periphery
+
+    assert FajenWarrenAgent.for_env("ObstacleDodge-v0").vision.field_of_view_deg == 20.0  # the walk family's
+    with _registered(crowd_distribution="groups", vision_params=_human()):
+        agent = FajenWarrenAgent.for_env("ObstacleDodge-v0")
+    assert agent.vision == human_periphery(field_of_view_deg=20.0) and not agent._search
+
+
+@pytest.mark.parametrize("vision", ["foveated", "oracle"])
+def test_no_leak_of_pedestrians_outside_the_human_field(vision):
+    """Counterfactual scenes with groups and the human periphery (human field, crowding, depth law): pedestrians walking
+    behind the walker (beyond the field's 100 deg to either side) moved and sped up give identical
+    observations, slot ids included; the oracle rung (true state) is the positive control."""
+    behind = [(0.0, -5.0 - k, (-1.0) ** k * 1.5, -1.0, 0.0, 0.0, 0.0, 0.0, 4.0) for k in range(N_PEDESTRIANS)]
+    moved = [(0.0, -6.0 - k, (-1.0) ** k * 2.5, -1.3, 0.2, 0.0, 0.0, 0.0, 4.0) for k in range(N_PEDESTRIANS)]
+    out = []
+    for rows in (behind, moved):
+        env = ObstacleDodgeEnv(vision=vision, crowd_distribution="groups", vision_params=_human())
+        env.reset(seed=3)
+        _set_crowd(env, rows)
+        out.append(np.array([env.step(np.zeros(7, dtype=np.float32))[0] for _ in range(40)]))
+        if vision == "foveated":
+            assert not any(env.task.seen) and env.task.slot_of == [-1] * N_PEDESTRIANS  # no slot advanced
+        env.close()
+    assert np.array_equal(out[0], out[1]) == (vision == "foveated")
+
+
+def _synthetic_obs(samples, fixation=5.0, t=0.5):
+    """A flat observation: the eye at the origin of the path frame 1.6 m up, looking along the path (eye
+    frame = pelvis frame), the pedestrian slots ``samples`` ({slot: (position, velocity)} in the eye frame)."""
+    s = DODGE_LAYOUT.slices
+    obs = np.zeros(DODGE_LAYOUT.size)
+    obs[s["eye_rot"]] = np.eye(3).ravel()
+    obs[s["fixation"].start] = fixation
+    obs[s["time"].start] = t
+    for k, (p, v) in samples.items():
+        b = s[f"pedestrian_{k}"].start
+        obs[b] = 1.0
+        obs[b + 1:b + 4] = p
+        obs[b + 4:b + 7] = v
+    return obs
+
+
+def test_fajen_warren_fuses_a_crowded_sample_with_its_crowding_zone():
+    """Two pedestrians seen 0.05 m apart 40 deg off the line of sight (far inside the critical spacing
+    0.5 x 40 deg) are each given at least the zone's std, 0.25 x 40 deg x d (hand computed), and a lone one
+    its vision model's std (E2 0.7 deg: 1 arcmin x (1 + 40 / 0.7) x d laterally); velocities start from the
+    walking-speed prior (std <= 1.5 m/s). Without crowding in the vision model nothing is inflated."""
+    from visuomotor_gym.baselines.fajen_warren import FajenWarrenAgent
+
+    from visuomotor_gym.vision.foveation import human_periphery
+
+    d, ecc = 6.0, math.radians(40.0)
+    a = (d * math.cos(ecc), d * math.sin(ecc), 0.0)
+    b = (d * math.cos(ecc), d * math.sin(ecc) + 0.05, 0.0)
+    lone = (d * math.cos(ecc), -d * math.sin(ecc), 0.0)
+    zone = 0.25 * ecc * d  # 1.05 m
+    lateral = d * (1.0 + 40.0 / 0.7) * math.radians(1.0 / 60.0)  # 0.10 m
+    for crowding in (True, False):
+        agent = FajenWarrenAgent.for_env("ObstacleDodge-v0")
+        agent.vision = human_periphery(crowding=crowding, depth_pedestal_arcmin=None)
+        still = (0.0, 0.0, 0.0)  # no retinal slip: the slip factor is 1
+        obs = _synthetic_obs({0: (a, still), 1: (b, still), 2: (lone, still)})
+        ol = obs.tolist()
+        agent._perceive(ol, ((0.0, 0.0, 1.6), list(np.eye(3).ravel()), (0.0, 0.0, 0.0), 0.0, 0.5))
+        stds = [np.sqrt(np.linalg.eigvalsh(agent.filters[k].P[:2, :2])) for k in range(3)]
+        if crowding:
+            assert min(stds[0]) >= zone - 1e-9 and min(stds[1]) >= zone - 1e-9
+        else:
+            assert min(stds[0]) == pytest.approx(lateral, rel=1e-6)
+        assert min(stds[2]) == pytest.approx(lateral, rel=1e-6)  # the lone one: its own lateral std
+        for k in range(3):
+            assert np.sqrt(np.linalg.eigvalsh(agent.filters[k].P[2:, 2:])).max() <= 1.5 + 1e-9
+
+
+def test_fajen_warren_dodges_groups_its_held_twin_runs_into():
+    """Development seeds (outside the pinned 0-199) where the moving eye reaches the goal and the held eye
+    (gaze and head held level at the goal: the human field still sees every pedestrian, far in its
+    periphery) collides: looking at the group members is what tells where they are."""
+    seeds = (203, 207, 210)
+    with _registered(crowd_distribution="groups", vision_params=_human()):
+        assert _bench("fajen_warren", seeds) == len(seeds)
+        assert _bench("gaze_blind:fajen_warren", seeds) == 0

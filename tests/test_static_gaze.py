@@ -274,3 +274,13 @@ def test_vergence_is_searched_only_under_the_depth_law():
     plain = search("EyeCatch-v0", "eyecatch", **tiny)
     assert all(s["name"] != "fixation" for s in plain["stages"])
     assert {p["fix"] for p in plain["postures"]} == {2.0}
+
+
+def test_json_object_options_are_checked_naming_the_option():
+    from visuomotor_gym.static_gaze import parse_json_object
+
+    assert parse_json_object('{"crowding": true}', "--vision", "VisionParams fields") == {"crowding": True}
+    with pytest.raises(SystemExit, match="--env-kwargs: not JSON"):
+        parse_json_object("{crowding}", "--env-kwargs", "constructor arguments")
+    with pytest.raises(SystemExit, match="--vision: must be a JSON object of VisionParams fields"):
+        parse_json_object("[1, 2]", "--vision", "VisionParams fields")

@@ -200,3 +200,76 @@ def test_static_search_takes_env_kwargs(tmp_path):
     with pytest.raises(SystemExit, match="env-kwargs"):
         static_gaze_main(["search", "--env", "ObstacleWalk-v0", "--agent", "iwao", "--out", str(out),
                           "--postures", "0,-40", "--env-kwargs", "[1, 2]"])
+
+
+# --- the iwao memory under the human periphery (rough course) ---------------------------------------------
+HUMAN_ROUGH = {"course_distribution": "rough",
+               "vision_params": {"field_shape": "human", "position_e2_deg": 0.7, "crowding": True,
+                                 "depth_pedestal_arcmin": 10.0}}
+
+
+def test_height_prior_places_a_bearing_on_the_floor_plane():
+    """Hand-computed: the eye at (0, 0, 1.6) sees a point along the unit direction toward (2, 0, 0.06),
+    precisely across the line of sight (1 mm) and not at all along it (depth std 1 km). With the height
+    prior N(0.06, 0.1) the fused point is where that line meets the plane z = 0.06: (2, 0, 0.06); without
+    the prior the information matrix is singular along the line (the estimate is no number to trust)."""
+    from visuomotor_gym.baselines.iwao.perception import Corner
+
+    eye, target = np.array([0.0, 0.0, 1.6]), np.array([2.0, 0.0, 0.06])
+    u = (target - eye) / np.linalg.norm(target - eye)
+    far = eye + 5.0 * u  # a perceived point far along the same line (a large depth error)
+    corner = Corner((0.06, 0.1))
+    corner.add(tuple(far), tuple(u), 1000.0, 0.001)
+    pos, sd = corner.estimate()
+    np.testing.assert_allclose(pos, target, atol=1e-4)
+    assert sd[2] < 0.1 and sd[0] > sd[1]  # height from the prior; along the path from it through the angle
+    bare = Corner()
+    bare.add(tuple(far), tuple(u), 1000.0, 0.001)
+    assert np.linalg.cond(bare._matrix()) > 1e10
+
+
+def test_the_memory_gate_drops_a_sample_off_its_line_of_sight():
+    """Four samples of a point on the floor ahead, taken 0.25 m apart as the walker approaches, agree; a
+    fifth whose line of sight passes 0.2 m beside the point (a crowded percept pooled with a flanker,
+    far beyond its noise and the estimate's spread) is not fused with ``gate=2``, and is (moving the
+    estimate) without a gate."""
+    from visuomotor_gym.baselines.iwao.perception import ObstacleMemory
+
+    from visuomotor_gym.vision.foveation import human_periphery
+
+    eye_pos = [0.0, 0.0, 0.6]  # eye in the pelvis frame; pelvis height 1.0 in odo: eye at 1.6 m
+    point = np.array([3.0, 0.1, 0.05])
+    ex = (point - [0.0, 0.0, 1.6]) / np.linalg.norm(point - [0.0, 0.0, 1.6])  # the line of sight, on the point
+    ey = np.cross([0.0, 0.0, 1.0], ex)
+    ey /= np.linalg.norm(ey)
+    rot = np.column_stack([ex, ey, np.cross(ex, ey)])  # columns: the eye's axes in the pelvis frame
+
+    def sample(mem, x, lateral=0.0):
+        p = rot.T @ (point + np.array([-x, lateral, -1.6]))  # the point in the eye frame
+        mem.add(0, 0, tuple(p), eye_pos, rot.tolist(), (x, 0.0, 0.0, 1.0), vergence=float(np.linalg.norm(p)))
+
+    out = {}
+    for gate in (2.0, None):
+        mem = ObstacleMemory(human_periphery(), height_prior=(0.06, 0.1), gate=gate)
+        for k in range(4):
+            sample(mem, 0.25 * k)
+        before = mem.corners[0][0].estimate()[0].copy()
+        sample(mem, 1.0, lateral=0.2)
+        out[gate] = (mem.corners[0][0].n, float(np.abs(mem.corners[0][0].estimate()[0] - before).max()))
+    assert out[2.0] == (4, 0.0)
+    assert out[None][0] == 5 and out[None][1] > 0.01
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_iwao_crosses_the_rough_course_under_the_human_periphery_and_its_held_twin_does_not(seed):
+    from visuomotor_gym.agents import make_agent
+    from visuomotor_gym.bench.trace import run_episode
+
+    with registered_kwargs("ObstacleWalk-v0", HUMAN_ROUGH):
+        env = gym.make("ObstacleWalk-v0")
+        results = {}
+        for spec in ("iwao", "gaze_blind:iwao"):
+            policy = make_agent(spec, "ObstacleWalk-v0", 8, seed=seed)
+            results[spec] = bool(run_episode(env, policy, seed=seed, env_id="ObstacleWalk-v0", agent=spec).success)
+        env.close()
+    assert results == {"iwao": True, "gaze_blind:iwao": False}

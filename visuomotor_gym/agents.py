@@ -220,10 +220,11 @@ def _with_env_vision(agent, env_id, overrides):
     """``agent`` given every vision constant of the registered ``env_id`` (``for_env`` sets the noise
     scale, foveation and latency only; the paper-condition ids also change ``vision_params``), unless
     the spec overrides the vision the agent assumes (``eyecatch:vision_noise_scale=5``)."""
-    from visuomotor_gym.registration import env_vision_params
+    from visuomotor_gym.registration import agent_eye
 
-    if not ({"vision_noise_scale", "foveated"} & set(overrides)):
-        match_vision(agent, env_vision_params(env_id))
+    vision = agent_eye(env_id, overrides)
+    if vision is not None:
+        match_vision(agent, vision)
     return agent
 
 

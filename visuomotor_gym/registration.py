@@ -95,6 +95,17 @@ def env_vision_params(env_id: str):
     return vision_params_for(gym.spec(env_id).kwargs or {}, family_for(env_id).vision_defaults)
 
 
+# Agent-spec overrides that change the eye the agent assumes (``eyecatch:vision_noise_scale=5``): with one of
+# them an agent keeps the eye its own parameters build instead of the registered id's.
+ASSUMED_EYE_FIELDS = frozenset({"vision_noise_scale", "foveated"})
+
+
+def agent_eye(env_id: str, overrides):
+    """The ``VisionParams`` an agent built for ``env_id`` models (:func:`env_vision_params`), or None when
+    the agent spec's ``overrides`` change the eye it assumes (:data:`ASSUMED_EYE_FIELDS`)."""
+    return None if ASSUMED_EYE_FIELDS & set(overrides) else env_vision_params(env_id)
+
+
 def register_envs() -> None:
     """Register every id in :data:`ENV_SPECS` (idempotent)."""
     for spec in ENV_SPECS:

@@ -42,7 +42,7 @@ from pathlib import Path
 
 import numpy as np
 
-from visuomotor_gym.agents import GazeBlind, Policy, make_agent, parse_agent_spec
+from visuomotor_gym.agents import GazeBlind, Policy, has_depth_law, make_agent, parse_agent_spec
 
 DEAD_BAND_DEG = 3.0  # modelling choice: the plant's saccade threshold (OculomotorParams.saccade_threshold_deg,
 # 3 deg), so every non-zero request is a saccade and a sub-threshold request never drives pursuit
@@ -118,8 +118,7 @@ def vision_has_depth_law(env_id: str) -> bool:
 
     env = gym.make(env_id.removeprefix("visuomotor_gym:"))
     try:
-        v = env.unwrapped.vision_params
-        return bool(v.foveated and v.depth_pedestal_arcmin is not None)
+        return has_depth_law(env.unwrapped.vision_params)
     finally:
         env.close()
 
@@ -607,8 +606,8 @@ def _search(env_id: str, agent: str, *, design_seed: int, coarse_episodes: int, 
                 fixations = FIXATION_GRID_M if vision_has_depth_law(env_id) else ()
             best = scorer.rank(final, final_episodes)[0]
             lo, hi = geometry.fixation_m
-            verged = [replace(best, fix=float(f)) for f in fixations
-                      if lo <= f <= hi and replace(best, fix=float(f)) not in scorer.results]
+            verged = [p for p in (replace(best, fix=float(f)) for f in fixations if lo <= f <= hi)
+                      if p not in scorer.results]
             for p in verged:
                 scorer.play(p, final_episodes, "fixation", bar=scorer.bar(final_episodes, 1),
                             race=scorer.best_rate(final_episodes))
@@ -634,7 +633,7 @@ def _search(env_id: str, agent: str, *, design_seed: int, coarse_episodes: int, 
         "stages": stages,
         "rules": {"dead_band_deg": DEAD_BAND_DEG, "fixation_m": DEFAULT_FIXATION_M, "fixations_m": list(fixations or ()),
                   "ties": "higher success, then the line of sight nearer straight ahead, then the neck nearer "
-                          "straight ahead",
+                          "straight ahead, then the vergence nearer fixation_m",
                   "early_stop": "a posture stops once successes + remaining episodes < the score of the "
                                 "stage's early_stop_rank-th best complete posture (it can no longer be selected), "
                                 f"or (coarse, refine and neck stages, after {RACE_MIN_EPISODES} episodes) once the "
@@ -696,6 +695,18 @@ def _grid_text(stages: list) -> str:
     neck = by.get("neck")
     parts.append(f"neck +-{neck['step_deg']:g} deg" if neck and neck["step_deg"] > 0 else "no neck stage")
     return "; ".join(parts)
+
+
+def parse_json_object(text: str, option: str, what: str) -> dict:
+    """A command-line option holding a JSON object (``what``: what its keys are); SystemExit naming
+    ``option`` otherwise."""
+    try:
+        value = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise SystemExit(f"{option}: not JSON ({exc})") from None
+    if not isinstance(value, dict):
+        raise SystemExit(f"{option}: must be a JSON object of {what}, got {text!r}")
+    return value
 
 
 def parse_fixations(text: str):
@@ -804,14 +815,7 @@ def main(argv=None) -> int:
                 raise SystemExit(f"--postures: {item!r} is not az,el[,neck_yaw,neck_pitch]")
             postures.append(Posture(*values))
     log = None if args.quiet else (lambda line: print(line, flush=True))
-    env_kwargs = None
-    if args.env_kwargs:
-        try:
-            env_kwargs = json.loads(args.env_kwargs)
-        except json.JSONDecodeError as exc:
-            raise SystemExit(f"--env-kwargs: not JSON ({exc})") from None
-        if not isinstance(env_kwargs, dict):
-            raise SystemExit(f"--env-kwargs: must be a JSON object of constructor arguments, got {args.env_kwargs!r}")
+    env_kwargs = parse_json_object(args.env_kwargs, "--env-kwargs", "constructor arguments") if args.env_kwargs else None
     fixations = parse_fixations(args.fixations)
     record = search(args.env, args.agent, design_seed=args.design_seed, coarse_episodes=args.coarse_episodes,
                     final_episodes=args.final_episodes, coarse_step=args.coarse_step,

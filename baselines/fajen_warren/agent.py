@@ -62,6 +62,18 @@ next group is more urgent (``GROUP_SEARCH_WEIGHT``), since half the pedestrians 
 near group holds the gaze. Re-fixating each member follows from the risk rule: each member has its own
 slot and filter. See docs/reproductions/data/terrain/dodge_groups.md.
 
+**The human periphery** (only when the agent's eye -- every constant of the env's, from ``for_env`` --
+has the mechanisms of ``vision.periphery``; v0's agent otherwise; modelling choices, measured in
+docs/reproductions/data/terrain/dodge_groups.md): with the human field (100 deg to either side) no search
+(a pedestrian appearing at the side is seen wherever the eye looks ahead) but a look along the path
+(``path_urgency``) when no pedestrian needs one more; pedestrians beyond ``gaze_bearing_limit_deg`` of
+the heading (passing beside or behind) are not looked at, and one becomes a gaze target ``notice_s``
+after its first sight; a pedestrian first seen starts from a zero-mean velocity prior
+(``velocity_prior_std``, walking speeds) instead of one far-peripheral velocity sample; with crowding, a
+sample that may be pooled with another pedestrian's is fused with the spread of its crowding zone
+(``baselines.crowding``, as iwao and lookahead); the gaze risk also counts the position estimate's std
+(``pos_std_weight``): depth far in the periphery is poor.
+
 ``gaze_blind=True`` holds gaze and head (gaze action 0: gaze stays level at the goal; head straight):
 the gaze-blind twin (docs/gaze_gain.md), the same filter and steering.
 """
@@ -72,11 +84,12 @@ import math
 from dataclasses import dataclass, fields, replace
 
 import numpy as np
+from visuomotor_gym.baselines.crowding import crowd_std, crowded
 
 from visuomotor_gym.body.dodge_body import DodgeBody
 from visuomotor_gym.envs.dodge import DODGE_LAYOUT
 from visuomotor_gym.oculomotor.plant import OculomotorParams
-from visuomotor_gym.registration import env_vision
+from visuomotor_gym.registration import agent_eye, env_vision
 from visuomotor_gym.tasks.obstacle_dodge import K_SLOTS, NOMINAL_SPEED
 from visuomotor_gym.vision.foveation import DEG, VisionParams, _los_rows, _sigmas
 
@@ -160,6 +173,22 @@ class FajenWarrenParams:
     # at the amplitudes here (main sequence), plus the ~0.2 s saccade latency.
     dwell_saccade_s: float | None = None
     search_azimuths_deg: tuple = ()
+    # Search for pedestrians not seen yet: None = unless the vision has the human field (see ``_search``)
+    search: bool | None = None
+    # With the human periphery (``VisionParams.periphery_on``; modelling choices): the velocity prior of a
+    # pedestrian first seen (zero mean, this std in m/s; adults walk at 1.27-1.46 m/s, Bohannon 1997), and,
+    # without the search, the urgency of a look along the path ``search_distance_m`` ahead when no
+    # pedestrian still ahead or approaching needs a look more (pedestrians that have passed are not looked at)
+    velocity_prior_std: float = 1.5
+    path_urgency: float = 0.2
+    # ... and pedestrians further than this from the heading are passing beside or behind: not looked at
+    gaze_bearing_limit_deg: float = 75.0
+    # ... and a pedestrian becomes a gaze target only this long after it was first seen (modelling choice:
+    # with the saccade latency, the dwell on the present target and the saccade the first fixation then begins ~0.6 s after the
+    # appearance, as in Jovancevic, Sullivan & Hayhoe: 548-740 ms)
+    notice_s: float = 0.15
+    # ... and the risk counts the position estimate's std too, this many s per m (modelling choice)
+    pos_std_weight: float = 1.0
 
 
 def group_prior(env_id: str) -> dict:
@@ -167,13 +196,11 @@ def group_prior(env_id: str) -> dict:
     the agent's prior about the crowd, like the number of pedestrians (``K_SLOTS``)."""
     import gymnasium as gym
 
-    from visuomotor_gym.tasks.obstacle_dodge import CrowdDistribution
+    from visuomotor_gym.core import args
+    from visuomotor_gym.tasks.obstacle_dodge import CrowdDistribution, crowd_preset
 
     kw = gym.spec(env_id).kwargs or {}
-    crowd = kw.get("crowd_distribution")
-    if crowd is None:
-        return {}
-    dist = crowd if isinstance(crowd, CrowdDistribution) else CrowdDistribution(**dict(crowd))
+    dist = args.coerce(CrowdDistribution, crowd_preset(kw.get("crowd_distribution")), "crowd_distribution")
     if not dist.groups:
         return {}
     return {"companion_m": 0.5 * (dist.group_spacing_m[0] + dist.group_spacing_m[1]),
@@ -189,6 +216,7 @@ class PedestrianFilter:
         self.P = np.eye(4) * 1e6
         self.t = -1.0  # time of the last update (-1: never seen)
         self.t_seen = -math.inf
+        self.t_first = -math.inf  # time of the first sight
         self.history: list[tuple[float, float, float]] = []  # (t, vx, vy) of the estimate, per control step
 
     def velocity_at(self, t: float):
@@ -213,9 +241,22 @@ class PedestrianFilter:
         self.P = F @ self.P @ F.T + (q * q) * (G @ G.T)
         self.t = t
 
-    def update(self, t: float, z: np.ndarray, R: np.ndarray, q: float) -> None:
-        if not self.known:
+    def update(self, t: float, z: np.ndarray, R: np.ndarray, q: float, velocity_prior_std: float | None = None) -> None:
+        if not self.known and velocity_prior_std is not None:
+            # first sight: the position as seen, the velocity fused with a prior of walking speeds (zero
+            # mean, ``velocity_prior_std``) so that one far-peripheral look (velocity stds of several m/s)
+            # does not send the estimate away at tens of m/s
+            prior = np.eye(2) * velocity_prior_std ** 2
+            K = prior @ np.linalg.inv(prior + R[2:, 2:])
+            self.x = np.concatenate([z[:2], K @ z[2:]])
+            self.P = np.zeros((4, 4))
+            self.P[:2, :2] = R[:2, :2]
+            self.P[2:, 2:] = (np.eye(2) - K) @ prior
+            self.t = t
+        elif not self.known:
             self.x, self.P, self.t = z.copy(), R.copy(), t
+        if self.t_first == -math.inf:
+            self.t_first = t
         else:
             self.predict_to(t, q)
             S = self.P + R
@@ -266,6 +307,15 @@ class FajenWarrenAgent:
         self.gaze_range = p.gaze_action_range_deg * DEG
         self.reset()
 
+    @property
+    def _search(self) -> bool:
+        """Whether pedestrians not seen yet are searched for: not with the human field of view
+        (``VisionParams.field_shape="human"``: 100 deg to either side), in which a pedestrian appearing
+        4-6 m to the side of the path is seen wherever the eye looks ahead (modelling choice: the search
+        saccades, 90 deg from side to side, only blinded the eye)."""
+        return self.params.search if self.params.search is not None else \
+            getattr(self.vision, "field_shape", "cone") != "human"
+
     @classmethod
     def for_env(cls, env_id: str, **overrides) -> FajenWarrenAgent:
         base = FajenWarrenParams(**env_vision(env_id), **group_prior(env_id))
@@ -273,7 +323,13 @@ class FajenWarrenAgent:
         unknown = sorted(set(overrides) - known)
         if unknown:
             raise TypeError(f"unknown fajen_warren parameter(s) {unknown}; known: {sorted(known)}")
-        return cls(replace(base, **overrides))
+        agent = cls(replace(base, **overrides))
+        vision = agent_eye(env_id, overrides)
+        if vision is not None:
+            # every constant of the env's eye (the human periphery under groups + human_periphery()), as
+            # agents.match_vision gives it: the agent models the eye it sees with
+            agent.vision = vision
+        return agent
 
     def reset(self) -> None:
         self.filters = [PedestrianFilter() for _ in range(K_SLOTS)]
@@ -290,6 +346,7 @@ class FajenWarrenAgent:
         self.search_turn = {1: -1, -1: -1}  # which of search_azimuths_deg each side looks at
         self.log: list[tuple] = []  # (time, target, phi) per step
         self._in_saccade = False
+        self._odo = (0.0, 0.0, 0.0)
 
     def predict(self, observation, state=None, episode_start=None, deterministic=True):
         obs = np.asarray(observation, dtype=float)
@@ -327,6 +384,7 @@ class FajenWarrenAgent:
         g0 = _S["to_goal"].start
         c, s = math.cos(odo[2]), math.sin(odo[2])
         goal = (odo[0] + c * ol[g0] - s * ol[g0 + 1], odo[1] + s * ol[g0] + c * ol[g0 + 1])
+        self._odo = (odo[0], odo[1], odo[2])
         threats = self._threats(odo)
         self._steer(odo, goal, threats)
         v0 = _S["pelvis"].start
@@ -340,10 +398,14 @@ class FajenWarrenAgent:
     def _perceive(self, ol: list, pose) -> None:
         eye_pos, rot, odo, _, t = pose
         c, s = math.cos(odo[2]), math.sin(odo[2])
-        for k in range(K_SLOTS):
+        seen = [k for k in range(K_SLOTS) if ol[_S[f"pedestrian_{k}"].start] > 0.0]
+        # With crowding in the vision model, a sample that may be pooled with another pedestrian's (a
+        # neighbour within the critical spacing, on the perceived lines of sight) is fused with the spread
+        # of its crowding zone, as iwao and lookahead do (baselines.crowding; modelling choice)
+        pooled = {seen[n] for n in crowded([ol[_S[f"pedestrian_{k}"].start + 1:_S[f"pedestrian_{k}"].start + 4]
+                                            for k in seen], seen, self.vision)} if self.vision.crowding else set()
+        for k in seen:
             b = _S[f"pedestrian_{k}"].start
-            if ol[b] <= 0.0:
-                continue
             pe, ve = ol[b + 1:b + 4], ol[b + 4:b + 7]
             d = math.sqrt(pe[0] ** 2 + pe[1] ** 2 + pe[2] ** 2)
             if d <= 0.0:
@@ -351,6 +413,9 @@ class FajenWarrenAgent:
             ecc = math.acos(max(-1.0, min(1.0, pe[0] / d)))
             lateral_speed = math.sqrt(max(ve[0] ** 2 + ve[1] ** 2 + ve[2] ** 2 - (sum(a * b for a, b in zip(pe, ve)) / d) ** 2, 0.0))
             sig = _sigmas(d, ecc, lateral_speed / d, self.vision, ol[_FIXATION])  # vergence: the depth law
+            if k in pooled:
+                zone = crowd_std(d, ecc, self.vision)
+                sig = (max(sig[0], zone), max(sig[1], zone), max(sig[2], zone)) + tuple(sig[3:])
             los = np.array(_los_rows(pe[0] / d, pe[1] / d, pe[2] / d))
             Re = np.array(rot).reshape(3, 3)  # eye axes in the pelvis frame
             Rw = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]) @ Re @ los  # line-of-sight axes, path frame
@@ -363,7 +428,8 @@ class FajenWarrenAgent:
             R = np.zeros((4, 4))
             R[:2, :2] = cov_p[:2, :2]
             R[2:, 2:] = cov_v[:2, :2]
-            self.filters[k].update(t, z, R, self.params.accel_std)
+            self.filters[k].update(t, z, R, self.params.accel_std,
+                                   self.params.velocity_prior_std if self.vision.periphery_on else None)
 
     def _threats(self, odo) -> list[tuple]:
         """Per known pedestrian: (slot, closest-approach time, predicted closest distance, its position
@@ -511,18 +577,25 @@ class FajenWarrenAgent:
         if self.target is not None and t - self.target_since < p.min_dwell_s:
             return self.target
         best, best_u = None, -math.inf
+        if not self._search:
+            best, best_u = ("path", 0), p.path_urgency
         for k, tca, dmin, _, relevant in threats:
             f = self.filters[k]
+            if not self._search and (not relevant or not self._ahead(f) or t - f.t_first < p.notice_s):
+                continue
             age = min(t - f.t_seen, 3.0)
             w = 1.0 if relevant else 0.1
             if relevant and dmin < p.avoid_distance_m + 0.5:
                 w *= 3.0 * (1.0 + 2.0 / (1.0 + tca))
             vel_std = math.sqrt(max(0.5 * (f.P[2, 2] + f.P[3, 3]), 0.0))
-            u = (age + 0.05 + p.vel_std_weight * vel_std) * w
+            u = age + 0.05 + p.vel_std_weight * vel_std
+            if self.vision.periphery_on:  # the position too: depth from far in the periphery is poor
+                u += p.pos_std_weight * math.sqrt(max(0.5 * (f.P[0, 0] + f.P[1, 1]), 0.0))
+            u *= w
             if u > best_u:
                 best, best_u = ("ped", k), u
         unseen = sum(not f.known for f in self.filters)
-        if unseen:
+        if unseen and self._search:
             for side in (1, -1):
                 u = p.search_weight * min(t - self.scanned[side], 3.0)
                 if u > best_u:
@@ -534,6 +607,12 @@ class FajenWarrenAgent:
                 self.scanned[best[1]] = t
                 self.search_turn[best[1]] += 1
         return self.target
+
+    def _ahead(self, f: PedestrianFilter) -> bool:
+        """Whether the estimate of ``f`` lies within ``gaze_bearing_limit_deg`` of the walker's heading."""
+        x, y, yaw = self._odo
+        bearing = math.atan2(f.x[1] - y, f.x[0] - x) - yaw
+        return abs((bearing + math.pi) % (2.0 * math.pi) - math.pi) <= self.params.gaze_bearing_limit_deg * DEG
 
     def _look(self, pose, threats, t: float) -> list:
         p = self.params
@@ -548,6 +627,9 @@ class FajenWarrenAgent:
         if target[0] == "ped":
             x, y = self.filters[target[1]].x[:2].tolist()
             tx, ty, tz = x, y, 1.5
+        elif target[0] == "path":
+            c, s = math.cos(odo[2]), math.sin(odo[2])
+            tx, ty, tz = ex + p.search_distance_m * c, ey + p.search_distance_m * s, ez
         else:
             side = target[1]
             self.scanned[side] = t

@@ -46,7 +46,7 @@ from visuomotor_gym.core.frames import SEAT_ORIGIN
 from visuomotor_gym.core.observation import ObservationLayout
 from visuomotor_gym.envs.actions import NECK_RANGE_DEG, hand_action
 from visuomotor_gym.envs.reach import reach_observation
-from visuomotor_gym.registration import env_vision, env_vision_params
+from visuomotor_gym.registration import agent_eye, env_vision
 from visuomotor_gym.tasks.reach import SHELF_LAYOUT
 from visuomotor_gym.vision import foveation, periphery
 from visuomotor_gym.vision.foveation import VisionParams
@@ -129,8 +129,8 @@ class FarawayAgent:
         if unknown:
             raise TypeError(f"unknown faraway parameter(s) {unknown}; known: {[f.name for f in fields(FarawayParams)]}")
         agent = cls(replace(base, **overrides))
-        vision = env_vision_params(env_id)
-        if vision.periphery_on and not ({"vision_noise_scale", "foveated"} & set(overrides)):
+        vision = agent_eye(env_id, overrides)
+        if vision is not None and vision.periphery_on:
             agent.vision = vision
         return agent
 

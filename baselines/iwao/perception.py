@@ -55,9 +55,13 @@ class Corner:
 
     __slots__ = ("_dirty", "_est", "info", "n", "vec")
 
-    def __init__(self) -> None:
+    def __init__(self, height_prior: tuple[float, float] | None = None) -> None:
         self.info = [0.0] * 6  # xx, xy, xz, yy, yz, zz
         self.vec = [0.0, 0.0, 0.0]
+        if height_prior is not None:  # information on z alone: the point's height above the floor
+            mean, sd = height_prior
+            self.info[5] = 1.0 / (sd * sd)
+            self.vec[2] = mean / (sd * sd)
         self.n = 0
         self._est = None
         self._dirty = True
@@ -133,9 +137,15 @@ class ObstacleMemory:
     lateral extent assumed for a side whose corner was not seen (the obstacle may span the walkway)."""
 
     def __init__(self, vision: VisionParams,
-                 walkway_half_width_m: float = 0.5 * CourseDistribution().walkway_width_m) -> None:
+                 walkway_half_width_m: float = 0.5 * CourseDistribution().walkway_width_m,
+                 height_prior: tuple[float, float] | None = None, gate: float | None = None) -> None:
         self.vision = vision
         self.walkway_half_width_m = walkway_half_width_m
+        # (mean, std) in metres of a point's height above the floor before any sample, or None: no prior.
+        # A top face on the floor is placed by the angle of its line of sight below the horizon, given
+        # the eye's height (Ooi, Wu & He 2001, Nature 414:197); see IwaoParams.height_prior_m.
+        self.height_prior = height_prior
+        self.gate = gate  # outlier gate of add (in stds), or None: every sample fused (iwao v0)
         self.corners: dict[int, tuple[Corner, ...]] = {}
 
     def reset(self) -> None:
@@ -171,7 +181,7 @@ class ObstacleMemory:
         u = ((c * lx - s * ly) / d, (s * lx + c * ly) / d, lz / d)
         points = self.corners.get(index)
         if points is None:
-            points = self.corners[index] = tuple(Corner() for _ in range(N_POINTS))
+            points = self.corners[index] = tuple(Corner(self.height_prior) for _ in range(N_POINTS))
         corner = points[which]
         eye_w = (z[0] - d * u[0], z[1] - d * u[1], z[2] - d * u[2])  # the eye, path frame
         # The noise is spread along and across the *true* line of sight at the *true* distance, which the
@@ -199,6 +209,20 @@ class ObstacleMemory:
         s_depth, s_lat = _sigmas(d_ref, ecc, slip, self.vision, vergence)[:2]
         if crowded:
             s_depth, s_lat = max(s_depth, crowd_std(d_ref, ecc, self.vision)), max(s_lat, crowd_std(d_ref, ecc, self.vision))
+        if self.gate is not None and prior is not None and corner.n >= 3:
+            # Robust fusion: a sample whose line of sight misses the point's estimate by more than ``gate``
+            # times sqrt(its lateral variance + the estimate's variance summed over x, y, z) is an outlier
+            # (a crowded percept pooled with a flanker the agent could not flag: Bouma 1970) and is not
+            # fused. (The estimate's variance along the line of sight counts too: a lenient gate while
+            # the point is placed only along one line, modelling choice.)
+            px, py, pz = prior.tolist()
+            rx, ry, rz = px - z[0], py - z[1], pz - z[2]
+            along = rx * u[0] + ry * u[1] + rz * u[2]
+            miss2 = rx * rx + ry * ry + rz * rz - along * along
+            est_sd = corner.estimate()[1]
+            var = s_lat * s_lat + float(est_sd[0] ** 2 + est_sd[1] ** 2 + est_sd[2] ** 2)
+            if miss2 > self.gate * self.gate * var:
+                return
         corner.add(z, u, max(s_depth, MIN_STD_M), max(s_lat, MIN_STD_M))
 
     def obstacle(self, index: int) -> ObstacleEstimate | None:

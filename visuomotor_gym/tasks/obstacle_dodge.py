@@ -18,7 +18,8 @@ the walker if both kept their velocities) for ``veer_s`` = 1.0 s (the veer in Jo
 ~1 s; REFERENCES.md "(10 %, ~1 s)"), then resumes its course. (In the first definition of v0 ``veer_s`` was
 1.5 s, a modelling choice; docs/reproductions/dodge.md has both.)
 
-**Groups** (opt-in: ``CrowdDistribution.group_size`` other than (1, 1); :func:`sample_groups`): the same
+**Groups** (opt-in: ``CrowdDistribution.group_size`` other than (1, 1), e.g. the preset ``"groups"``;
+:func:`sample_groups`): the same
 4 pedestrians come as groups (e.g. ``group_size=(2, 3)``: pairs and triads, the commonest groups of
 Moussaid, Perozo, Garnier, Helbing & Theraulaz 2010, PLoS ONE 5:e10047, Fig. 1), one group per onset,
 members walking abreast ``group_spacing_m`` = 0.7-0.9 m apart (their "side by side" formation at low
@@ -31,7 +32,9 @@ are given in order of first sight (below), not of onset.
 **What the eye sees of a pedestrian**: one point on its axis at 1.5 m (upper chest, a modelling choice
 near the eyes' height so a level gaze sees it) with its velocity (:class:`PedestrianTarget`), sampled by
 the retina like any target (eccentricity-dependent noise on position and velocity, the walk family's 20
-deg recognition field, saccadic suppression, visual delay). The observation holds ``K_SLOTS`` = 4 slots,
+deg recognition field, saccadic suppression, visual delay; with ``vision_params=human_periphery()`` the
+human field, position noise growing with eccentricity, crowding between pedestrians closer than half
+their eccentricity and depth precise only near the vergence distance instead). The observation holds ``K_SLOTS`` = 4 slots,
 slot ``k`` = pedestrian ``k`` of the episode (in onset order; the number of pedestrians never exceeds the
 slots): seen flag, position and velocity in the eye frame (zeros when not seen this step). With groups,
 slot ``k`` = the ``k``-th pedestrian the eye has seen (those first seen on one step from left to right as
@@ -92,6 +95,17 @@ CROWD_RULES = {
 }
 
 
+def crowd_preset(value) -> CrowdDistribution | dict | None:
+    """``value`` itself, or the :data:`CROWD_PRESETS` entry it names (a ``ValueError`` naming the presets
+    for an unknown name)."""
+    if isinstance(value, str):
+        if value not in CROWD_PRESETS:
+            raise ValueError(f"crowd_distribution: unknown preset {value!r}; presets: {sorted(CROWD_PRESETS)}, "
+                             "or a CrowdDistribution, a dict of its fields or None")
+        return CROWD_PRESETS[value]
+    return value
+
+
 def _group_size(value, name: str) -> tuple[float, float]:
     lo, hi = Pair(Num(1.0, float(N_PEDESTRIANS)))(value, name)
     if lo != int(lo) or hi != int(hi):
@@ -117,7 +131,7 @@ class CrowdDistribution:
     veer_s: float = 1.0  # Jovancevic, Sullivan & Hayhoe: the veer lasted ~1 s
     min_crossing_m: float = 3.0  # crossing points between this far from the start ...
     goal_clear_m: float = 1.0  # ... and this far before the goal
-    # Groups (opt-in; (1, 1): every pedestrian alone, the draws of v0). Members per group, uniform over
+    # Groups (opt-in, preset "groups"; (1, 1): every pedestrian alone, the draws of v0). Members per group, uniform over
     # the whole numbers of the range (pairs the commonest group, then triads: Moussaid et al. 2010, Fig. 1),
     # walking abreast (Moussaid et al. 2010: at low density "group members tend to walk side by side,
     # forming a line perpendicular to the walking direction") with this centre-to-centre spacing between
@@ -133,6 +147,10 @@ class CrowdDistribution:
     def groups(self) -> bool:
         """Whether pedestrians walk in groups (``group_size`` other than (1, 1))."""
         return self.group_size != (1.0, 1.0)
+
+
+# "single": v0's default, every pedestrian alone; "groups": pairs and triads (Moussaid et al. 2010).
+CROWD_PRESETS = {"single": CrowdDistribution(), "groups": CrowdDistribution(group_size=(2.0, 3.0))}
 
 
 @dataclass(frozen=True)
@@ -174,12 +192,12 @@ def sample_groups(rng: np.random.Generator, dist: CrowdDistribution, n: int = N_
     """:func:`sample_crowd` with groups (``dist.group_size`` other than (1, 1)): the ``n`` pedestrians
     come as groups of ``group_size`` members (the last group cut to what is left), one group after the
     other (``onset_gap_s`` between groups). A group draws one side, start distance, speed, crossing
-    angle and timing like a lone pedestrian of v0 (its centre crosses where a lone one would), and its
+    angle and timing like a lone pedestrian (its centre crosses where a lone one would), and its
     members walk abreast: on a line through the centre perpendicular to their common velocity,
     ``group_spacing_m`` apart (one spacing per group). **A member veers alone**: with probability
     ``min(1, veer_p * size)`` the group's course misses (``veer_timing_s``, as a veering pedestrian's)
     and one member, drawn uniformly, veers onto a collision course within ``veer_distance_m``; the
-    others keep the course (so ``veer_p`` of the pedestrians veer, as in v0: Jovancevic, Sullivan &
+    others keep the course (so ``veer_p`` of the pedestrians veer, as without groups: Jovancevic, Sullivan &
     Hayhoe). Rows are in onset order, then left to right along the line as each member's own walking
     direction sees it. Each member's row has its own crossing point and timing."""
     goal = float(rng.uniform(*dist.goal_m))
@@ -466,5 +484,5 @@ def intercept_velocity(px: float, py: float, speed: float, wx: float, wy: float,
     return np.array([speed * dx / n, speed * dy / n])
 
 
-__all__ = ["K_SLOTS", "N_PEDESTRIANS", "Crowd", "CrowdDistribution", "ObstacleDodgeTask", "PedestrianTarget",
-           "intercept_velocity", "sample_crowd", "sample_groups"]
+__all__ = ["CROWD_PRESETS", "K_SLOTS", "N_PEDESTRIANS", "Crowd", "CrowdDistribution", "ObstacleDodgeTask",
+           "PedestrianTarget", "crowd_preset", "intercept_velocity", "sample_crowd", "sample_groups"]

@@ -153,9 +153,9 @@ class CourseDistribution:
 # forgives (two hazards on opposite sides partly cancel). "allsteps": the first definition's course,
 # ALLSTEPS' stones of 0.25 m and no hazards (a course one body-locked posture could cross: 79.5 % for the
 # best static twin of lookahead on the pinned seeds under the 20 deg cone).
+ROUGH_FIELDS = ("stone_radius_m", "hazards_per_stone", "hazard_radius_m", "hazard_distance_m", "hazard_clearance_m")
 COURSE_PRESETS = {
-    "rough": {"stone_radius_m": 0.15, "hazards_per_stone": 2, "hazard_radius_m": 0.12,
-              "hazard_distance_m": (0.32, 0.45), "hazard_clearance_m": 0.05},
+    "rough": {f: getattr(CourseDistribution(), f) for f in ROUGH_FIELDS},  # the defaults above
     "allsteps": {"stone_radius_m": None, "hazards_per_stone": 0},
 }
 

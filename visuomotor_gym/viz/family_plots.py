@@ -50,7 +50,6 @@ BODY_COLOR = "0.25"
 LEFT_FOOT_COLOR = "tab:blue"
 RIGHT_FOOT_COLOR = "tab:pink"
 TARGET_COLOR = "tab:brown"
-HAZARD_COLOR = (0.42, 0.30, 0.24)  # the loose rocks of the rough stones course (HAZARD_RGBA of tasks/stepping_stones.py)
 PEDESTRIAN_COLORS = ("tab:red", "tab:purple", "tab:orange", "tab:cyan", "tab:olive", "tab:pink")
 
 # Foothold detection (display only; modelling choices read off walker episodes: a planted sole sits
@@ -410,9 +409,11 @@ def stones_figure(trace: EpisodeTrace):
         side = (-1.0 if i % 2 else 1.0) * 1.6 * radius  # numbers beside the path, alternating sides
         top.annotate(str(i), (x - side * h[1], y + side * h[0]), ha="center", va="center", fontsize=9,
                      color="0.15", zorder=9)
+    from visuomotor_gym.tasks.stepping_stones import HAZARD_RGBA  # the rocks' colour in the scene
+
     hazards = np.asarray(getattr(trace, "hazards", np.zeros((0, 2))), float).reshape(-1, 2)
     for i, (x, y) in enumerate(hazards.tolist()):  # the rough course's loose rocks (they never hold a foot)
-        top.add_patch(Circle((x, y), float(trace.hazard_radius), facecolor=HAZARD_COLOR, alpha=0.55, zorder=1,
+        top.add_patch(Circle((x, y), float(trace.hazard_radius), facecolor=HAZARD_RGBA[:3], alpha=0.55, zorder=1,
                              hatch="xx", edgecolor="0.25", lw=0.5, label="loose rock (falls)" if i == 0 else None))
     top.plot(pelvis[:, 0], pelvis[:, 1], color=BODY_COLOR, lw=1.2, label="pelvis")
     _plot_feet(top, trace)

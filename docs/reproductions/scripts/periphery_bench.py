@@ -36,15 +36,10 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
 
     from visuomotor_gym.bench.evaluate import evaluate
-    from visuomotor_gym.static_gaze import registered_kwargs
+    from visuomotor_gym.static_gaze import parse_json_object, registered_kwargs
     from visuomotor_gym.vision.foveation import HUMAN_PERIPHERY
 
-    try:
-        overrides = json.loads(args.vision)
-    except json.JSONDecodeError as exc:
-        raise SystemExit(f"--vision: not JSON ({exc})") from exc
-    if not isinstance(overrides, dict):
-        raise SystemExit(f"--vision must be a JSON object of VisionParams fields, got {args.vision!r}")
+    overrides = parse_json_object(args.vision, "--vision", "VisionParams fields")
     vision = {**HUMAN_PERIPHERY, **overrides}
     out = Path(args.out)
     record = {"description": __doc__.splitlines()[0], "command": " ".join(sys.argv), "env_id": args.env,

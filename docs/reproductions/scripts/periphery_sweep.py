@@ -77,8 +77,6 @@ ROLES = ("baseline", "held", "static")
 FIRST_DEFINITION = {
     "SteppingStones-v0": {
         "kwargs": {"course_distribution": "allsteps"},
-        "vision": {"field_shape": "cone", "field_of_view_deg": 20.0, "position_e2_deg": None, "crowding": False,
-                   "depth_pedestal_arcmin": None},
         "static": "static_gaze:az=0,el=-35,neck_yaw=0,neck_pitch=-15,fix=2:{}",
     },
 }
@@ -109,7 +107,7 @@ def set_vision(env_id: str, fields: dict) -> None:
     first = FIRST_DEFINITION.get(env_id)
     if first is not None and fields is not None:
         kwargs.update(first["kwargs"])
-        fields = {**first["vision"], **fields}
+        fields = {**_cone_eye(), **fields}
     elif first is not None:
         for k in first["kwargs"]:
             kwargs.pop(k, None)
@@ -117,6 +115,14 @@ def set_vision(env_id: str, fields: dict) -> None:
         kwargs["vision_params"] = dict(fields)
     else:
         kwargs.pop("vision_params", None)
+
+
+def _cone_eye() -> dict:
+    """The walk family's 20 deg cone with every periphery mechanism off (the first stones definition's eye)."""
+    from visuomotor_gym.envs.walk import WALK_VISION
+    from visuomotor_gym.vision.foveation import HUMAN_PERIPHERY
+
+    return {k: getattr(WALK_VISION, k) for k in ("field_of_view_deg", *HUMAN_PERIPHERY)}
 
 
 def agent_spec(role: str, agent: str, env_id: str = "") -> str:

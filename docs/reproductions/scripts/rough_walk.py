@@ -86,6 +86,42 @@ def play(spec: str, kwargs: dict, seeds: list[int]) -> tuple[list[int], dict]:
     return ok, why
 
 
+def walk_measures(spec: str, kwargs: dict, seeds: list[int]) -> dict:
+    """Fixations per step (saccade onsets per 0.5 s step), the share of the resting rows whose gaze is
+    within ``ON_OBSTACLE_M`` of a hazard, and the look-ahead from the eye (median over episodes, in m,
+    steps and seconds at the nominal gait): the walking measures set beside Matthis, Yates & Hayhoe 2018."""
+    import gymnasium as gym
+    import numpy as np
+
+    from visuomotor_gym.agents import make_agent
+    from visuomotor_gym.bench.trace import run_episode
+    from visuomotor_gym.body.walker import GaitParams
+    from visuomotor_gym.metrics import walk_realism as wr
+    from visuomotor_gym.static_gaze import registered_kwargs
+
+    g = GaitParams()
+    rows = []
+    with registered_kwargs(ENV_ID, kwargs):
+        env = gym.make(ENV_ID)
+        policy = make_agent(spec, ENV_ID, int(env.action_space.shape[0]), seed=seeds[0])
+        for s in seeds:
+            tr = run_episode(env, policy, seed=s, env_id=ENV_ID, agent=spec)
+            rest = ~np.asarray(tr.in_saccade, bool)
+            eye, gaze = np.asarray(tr.eye_pos), np.asarray(tr.gaze_dir)
+            on = np.zeros(len(eye), bool)
+            for ob in np.asarray(tr.obstacles, dtype=float).reshape(-1, 6):
+                on |= wr._on(wr._gaze_hits(eye, gaze, ob[4]), ob, wr.ON_OBSTACLE_M)
+            steps = len(eye) * float(tr.dt) / g.step_s
+            rows.append((float(np.sum(np.asarray(tr.saccade_onset, bool))) / steps, float(on[rest].mean()),
+                         wr.travel_fixation_distance(tr)))
+        env.close()
+    r = np.array(rows, dtype=float)
+    ahead = float(np.nanmedian(r[:, 2]))
+    return {"fixations_per_step": float(np.nanmean(r[:, 0])), "hazard_fixation_share": float(np.nanmean(r[:, 1])),
+            "look_ahead_m": ahead, "look_ahead_steps": ahead / g.nominal_step_m,
+            "look_ahead_s": ahead / (g.nominal_step_m / g.step_s)}
+
+
 def main(argv=None) -> int:
     global ENV_ID
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -98,9 +134,16 @@ def main(argv=None) -> int:
     ap.add_argument("--bench", default=None, metavar="CONDITION", help="run vmgym bench --gaze-gain under it")
     ap.add_argument("--agent", default="iwao", help="with --bench: the agent")
     ap.add_argument("--static-twin", default=None, help="with --bench: the static twin's spec (its posture)")
+    ap.add_argument("--measures", default=None, metavar="CONDITION",
+                    help="print the walking measures (fixations per step, hazard share, look-ahead) of --agent")
     args = ap.parse_args(argv)
     ENV_ID = args.env
     _setup()
+    if args.measures:
+        course, vision = CONDITIONS[args.measures]
+        seeds = list(range(args.seed, args.seed + args.episodes))
+        print(json.dumps(walk_measures(args.agent, env_kwargs(course, vision), seeds)))
+        return 0
     if args.bench:
         from visuomotor_gym.cli import main as vmgym
         from visuomotor_gym.static_gaze import registered_kwargs

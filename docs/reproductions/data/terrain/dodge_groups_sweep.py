@@ -28,10 +28,12 @@ ENV_ID = "ObstacleDodge-v0"
 AGENT = "fajen_warren"
 GROUPS = {"group_size": (2, 3)}  # pairs and triads (Moussaid et al. 2010, Fig. 1); spacing: the default
 HUMAN = {"field_shape": "human", "position_e2_deg": 0.7, "crowding": True}  # periphery_sweep.py's (b)+(c)+(d)
+HUMAN_ALL = {**HUMAN, "depth_pedestal_arcmin": 10.0}  # vision.foveation.HUMAN_PERIPHERY: all four
 CONDITIONS = {
     "default": ({}, {}),
     "groups": (GROUPS, {}),
     "groups + field+E2+crowding": (GROUPS, HUMAN),
+    "groups + human periphery": (GROUPS, HUMAN_ALL),
 }
 
 
@@ -108,6 +110,9 @@ def main(argv=None) -> int:
     ap.add_argument("--coarse-episodes", type=int, default=8)
     ap.add_argument("--final-episodes", type=int, default=16)
     ap.add_argument("--out", required=True)
+    ap.add_argument("--crowd", default=None, help="JSON of CrowdDistribution fields laid over the condition's")
+    ap.add_argument("--agent", default=AGENT, help="the baseline's agent spec (e.g. fajen_warren:notice_s=0.2)")
+    ap.add_argument("--label", default=None, help="name of the condition in the record (default: --condition)")
     args = ap.parse_args(argv)
     sys.path.insert(0, str(ROOT / "benchmarks"))
     from gaze_gain_sweep import _use_checkout_baselines
@@ -119,6 +124,10 @@ def main(argv=None) -> int:
     out = Path(args.out)
     record = json.loads(out.read_text()) if out.exists() else {"env_id": ENV_ID, "agent": AGENT, "cells": []}
     crowd, vision = CONDITIONS[args.condition]
+    if args.crowd:
+        crowd = {**crowd, **json.loads(args.crowd)}
+        CONDITIONS[args.condition] = (crowd, vision)
+    label = args.label or args.condition
     seeds = list(range(args.seed, args.seed + args.episodes))
 
     def save(cell: dict) -> None:
@@ -140,9 +149,9 @@ def main(argv=None) -> int:
             else:
                 spec, search_record = f"static_gaze:{args.posture}:{AGENT}", None
         else:
-            spec, search_record = {"baseline": AGENT, "held": f"gaze_blind:{AGENT}"}[role], None
+            spec, search_record = {"baseline": args.agent, "held": f"gaze_blind:{args.agent}"}[role], None
         ok, why, traces = play(spec, seeds)
-        cell = {"condition": args.condition, "crowd_distribution": crowd, "vision_params": vision, "role": role,
+        cell = {"condition": label, "crowd_distribution": crowd, "vision_params": vision, "role": role,
                 "spec": spec, "seeds": [seeds[0], seeds[-1]], "successes": sum(ok), "episodes": len(ok),
                 "rate": sum(ok) / len(ok), "per_seed": ok, "failures": why, "seconds": round(time.time() - t0, 1)}
         if role == "baseline" or role == "static":
@@ -155,7 +164,7 @@ def main(argv=None) -> int:
         if search_record is not None:
             cell["search"] = search_record
         save(cell)
-        print(f"{args.condition} {role} {spec}: {sum(ok)}/{len(ok)} {why} realism={cell.get('gaze_realism')} "
+        print(f"{label} {role} {spec}: {sum(ok)}/{len(ok)} {why} realism={cell.get('gaze_realism')} "
               f"({cell['seconds']} s)", flush=True)
     set_condition(None)
     return 0
