@@ -339,3 +339,115 @@ def test_human_periphery_preset_sets_the_four_mechanisms_and_keeps_the_rest():
     assert human_periphery(depth_pedestal_arcmin=None).depth_pedestal_arcmin is None
     with pytest.raises(ValueError, match="position_e2_deg"):
         human_periphery(position_e2_deg=-1.0)
+
+
+# --- 5. positional disarray ---------------------------------------------------------------------
+def test_disarray_field_is_unit_variance_fixed_in_place_and_decorrelates_over_one_zone():
+    vp = VisionParams(position_e2_deg=0.7, position_disarray=0.5)
+    rng = np.random.default_rng(0)
+    # places (eccentricity deg, polar deg): a reference at 10 deg; 10 deg again; one Bouma zone
+    # (l theta) out in u; a quarter turn in polar angle
+    ecc = np.array([10.0, 10.0, 10.0 * math.exp(0.5) + 0.7 * (math.exp(0.5) - 1.0), 10.0]) * DEG
+    phi = np.array([30.0, 30.0, 30.0, 120.0]) * DEG
+    v = np.array([periphery.DisarrayField(vp, rng).values(ecc, phi) for _ in range(4000)])  # (n, 2, 4)
+    assert v.shape == (4000, 2, 4)
+    np.testing.assert_allclose(v[:, :, 0].var(axis=0), 1.0, atol=0.08)  # unit variance, each component
+    np.testing.assert_array_equal(v[:, :, 0], v[:, :, 1])  # one place, one value
+    # squared-exponential correlation: exp(-du^2 / 2 l^2) with du = l (one zone): exp(-1/2) = 0.61
+    assert np.corrcoef(v[:, 1, 0], v[:, 1, 2])[0, 1] == pytest.approx(math.exp(-0.5), abs=0.05)
+    # a polar step of pi/2 = 3.1 l: exp(-4.9) ~ 0.007 (the integer rounding of m adds a little)
+    assert abs(np.corrcoef(v[:, 1, 0], v[:, 1, 3])[0, 1]) < 0.06
+    assert abs(np.corrcoef(v[:, 0, 0], v[:, 1, 0])[0, 1]) < 0.06  # components independent
+
+
+@pytest.mark.parametrize("kwargs", [{"position_disarray": -0.1}, {"position_disarray": 1.5},
+                                    {"disarray_length": 0.0}, {"disarray_length": math.nan}])
+def test_disarray_fields_reject_bad_values_naming_the_field(kwargs):
+    name = next(iter(kwargs))
+    with pytest.raises((ValueError, TypeError), match=f"VisionParams.{name}"):
+        VisionParams(**kwargs)
+
+
+def _still_eye_errors(share, n=400, seed=5, ecc=12.0, depth=False):
+    """Lateral (or, with ``depth``, depth) errors (m) of ``n`` successive looks of a still eye at a
+    still target ``ecc`` deg below its fovea, 2 m away, with ``position_disarray=share``; one episode."""
+    env, u = _env_eye({"position_e2_deg": 0.7, "position_disarray": share})
+    env.reset(seed=seed)
+    eye, data = u.eye, u.unwrapped.data
+    direction = np.array(unit(0.0, -ecc))
+    t = _placed(direction, eye, 2.0, "t")
+    rng = np.random.default_rng(seed)
+    errs = np.array([np.array(u.retina._see_all(data, [t], eye, rng)[0][0]) for _ in range(n)]) - 2.0 * direction
+    env.close()
+    return errs @ direction if depth else errs - np.outer(errs @ direction, direction)
+
+
+def test_disarray_keeps_each_looks_std_and_a_still_eye_cannot_average_it_away():
+    sd = 2.0 * ARCMIN * (1.0 + 12.0 / 0.7)  # the position law's lateral std (closed form)
+    off = _still_eye_errors(0.0)
+    assert np.sqrt(np.mean(np.sum(off**2, axis=1)) / 2.0) == pytest.approx(sd, rel=0.1)
+    assert np.linalg.norm(off.mean(axis=0)) < 0.25 * sd  # independent looks average to ~sd / 20
+    # share 0.8: each look still has the law's std across episodes, but within one the looks share
+    # a fixed error: 0.8 of the variance the periphery adds, w = 0.8 (1 - 1/f^2), f = 1 + 12/0.7
+    w = 0.8 * (1.0 - 1.0 / (1.0 + 12.0 / 0.7) ** 2)
+    means, spreads = [], []
+    for seed in range(30):
+        e = _still_eye_errors(0.8, n=60, seed=seed)
+        means.append(e.mean(axis=0))
+        spreads.append(np.sqrt(np.mean(np.sum((e - e.mean(axis=0)) ** 2, axis=1)) / 2.0))
+    means = np.array(means)
+    assert np.sqrt(np.mean(np.sum(means**2, axis=1)) / 2.0) == pytest.approx(math.sqrt(w) * sd, rel=0.3)
+    assert np.mean(spreads) == pytest.approx(math.sqrt(1.0 - w) * sd, rel=0.15)  # what a frame adds
+
+
+def test_disarray_spares_the_fovea_and_depth():
+    # at the fovea the position law adds nothing: no fixed part, the looks average out
+    fovea = _still_eye_errors(1.0, n=400, ecc=0.0)
+    assert np.linalg.norm(fovea.mean(axis=0)) < 0.25 * 2.0 * ARCMIN
+    # depth keeps its per-step noise at any eccentricity (the mean of 400 looks ~ std / 20)
+    depth = _still_eye_errors(1.0, n=400, ecc=12.0, depth=True)
+    assert abs(depth.mean()) < 0.2 * depth.std()
+
+
+def test_disarray_draws_after_the_scenario_and_only_when_on():
+    base = {"position_e2_deg": 0.7}
+    envs = [gym.make("SteppingStones-v0", vision_params={**base, "position_disarray": s}) for s in (0.0, 0.8)]
+    full = gym.make("SteppingStones-v0", vision="full_view", vision_params={**base, "position_disarray": 0.8})
+    courses = []
+    for env in envs + [full]:
+        env.reset(seed=11)
+        courses.append(np.array([t.state(env.unwrapped.data)[0].copy() for t in env.unwrapped.task.all_targets]))
+    np.testing.assert_array_equal(courses[0], courses[1])  # one seed, one scenario
+    np.testing.assert_array_equal(courses[0], courses[2])
+    assert envs[0].unwrapped.retina._disarray is None and envs[1].unwrapped.retina._disarray is not None
+    assert full.unwrapped.retina._disarray is None  # FullView sees with the fovea everywhere
+    # the field is seeded: the same seed draws the same field
+    f1 = envs[1].unwrapped.retina._disarray.w.copy()
+    envs[1].reset(seed=11)
+    np.testing.assert_array_equal(f1, envs[1].unwrapped.retina._disarray.w)
+    for env in envs + [full]:
+        env.close()
+
+
+def test_believed_sigmas_size_the_disarray_for_a_stream_of_looks():
+    vp = VisionParams(position_e2_deg=0.7, position_disarray=0.8)
+    d, ecc, dt = 3.0, 15.0 * DEG, 0.02
+    base = fov._sigmas(d, ecc, 0.0, vp)
+    assert fov.believed_sigmas(d, ecc, 0.0, vp) == base  # no dt: the eye's own stds
+    assert fov.believed_sigmas(d, ecc, 0.0, VisionParams(position_e2_deg=0.7), None, dt) == \
+        fov._sigmas(d, ecc, 0.0, VisionParams(position_e2_deg=0.7))  # no disarray: unchanged
+    f = 1.0 + 15.0 / 0.7
+    w = 0.8 * (1.0 - 1.0 / f**2)
+    # a still image: one second of looks (50) read the same place
+    assert fov.disarray_looks(ecc, 0.0, vp, dt) == pytest.approx(50.0)
+    still = fov.believed_sigmas(d, ecc, 0.0, vp, None, dt)
+    assert still[1] == pytest.approx(base[1] * math.sqrt(1.0 + w * 49.0))
+    assert still[0] == base[0] and still[3:] == base[3:]  # depth and rates untouched
+    # an image crossing the retina at 20 deg/s leaves the place (0.5 x (15 + 0.7) deg) in 0.39 s
+    k = 1.0 + 0.5 * (15.0 + 0.7) / (20.0 * 0.02)
+    assert fov.disarray_looks(ecc, 20.0 * DEG, vp, dt) == pytest.approx(k)
+    # the covariance agents use carries the same lateral stds
+    u = np.array(unit(0.0, -15.0)) * d
+    cov = fov.covariance(u, 0.0, vp, dt=dt)
+    lat_axis = np.array(unit(0.0, 75.0))  # perpendicular to u, in its vertical plane
+    assert float(lat_axis @ cov[:3, :3] @ lat_axis) == pytest.approx(still[1] ** 2, rel=1e-9)

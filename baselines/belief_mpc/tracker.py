@@ -70,7 +70,8 @@ class ObjectBelief:
             pos = direction * (max(prior_dist, sample_dist) / max(math.sqrt(float(direction @ direction)), 1e-9))
             vel = rot.T @ f.x[3:]
         speed = max(EyecatchAgent._retinal_speed(pos, vel, eye_turn), EyecatchAgent._retinal_speed(pos, z[3:], eye_turn))
-        f.update(z, foveation.covariance(pos, speed, vision), rot, eye)
+        # self.dt: the positional disarray, if the eye has it, sized for a stream of looks (none without)
+        f.update(z, foveation.covariance(pos, speed, vision, dt=self.dt), rot, eye)
 
     def update_sigma(self, seen: bool, gaze_az: float, gaze_el: float, eye: np.ndarray,
                      noise: ObservationNoise, q: float, slip: float = 0.0) -> None:

@@ -372,7 +372,8 @@ class EyecatchAgent:
         pos = self._noise_point(z[:3], rot, eye, speed)
         # fixation: the eye's vergence distance (proprioception), for the depth law of
         # VisionParams.depth_pedestal_arcmin (no effect without it)
-        R_meas = foveation.covariance(pos, speed, self.vision, float(obs[_S["fixation"]][0]))
+        # dt: the positional disarray, if the eye has it, is sized for a stream of looks (no effect without)
+        R_meas = foveation.covariance(pos, speed, self.vision, float(obs[_S["fixation"]][0]), dt=self.dt)
         before = self.filter.resets
         self.filter.update(z, R_meas, rot, eye)
         if self.filter.resets != before:

@@ -91,7 +91,7 @@ from visuomotor_gym.envs.dodge import DODGE_LAYOUT
 from visuomotor_gym.oculomotor.plant import OculomotorParams
 from visuomotor_gym.registration import agent_eye, env_vision
 from visuomotor_gym.tasks.obstacle_dodge import K_SLOTS, NOMINAL_SPEED
-from visuomotor_gym.vision.foveation import DEG, VisionParams, _los_rows, _sigmas
+from visuomotor_gym.vision.foveation import DEG, VisionParams, _los_rows, believed_sigmas
 
 _S = DODGE_LAYOUT.slices
 _FIXATION = _S["fixation"].start  # the eye's vergence distance (m): proprioception
@@ -412,7 +412,8 @@ class FajenWarrenAgent:
                 continue
             ecc = math.acos(max(-1.0, min(1.0, pe[0] / d)))
             lateral_speed = math.sqrt(max(ve[0] ** 2 + ve[1] ** 2 + ve[2] ** 2 - (sum(a * b for a, b in zip(pe, ve)) / d) ** 2, 0.0))
-            sig = _sigmas(d, ecc, lateral_speed / d, self.vision, ol[_FIXATION])  # vergence: the depth law
+            # vergence: the depth law; control_dt: the positional disarray sized for a stream of looks
+            sig = believed_sigmas(d, ecc, lateral_speed / d, self.vision, ol[_FIXATION], self.params.control_dt)
             if k in pooled:
                 zone = crowd_std(d, ecc, self.vision)
                 sig = (max(sig[0], zone), max(sig[1], zone), max(sig[2], zone)) + tuple(sig[3:])

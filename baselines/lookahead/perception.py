@@ -21,7 +21,7 @@ import math
 from visuomotor_gym.baselines.crowding import crowd_std
 
 from visuomotor_gym.tasks.stepping_stones import STONE_TOP_Z
-from visuomotor_gym.vision.foveation import VisionParams, _sigmas
+from visuomotor_gym.vision.foveation import VisionParams, believed_sigmas
 
 EyePose = tuple  # (eye position (3), eye axes as rows of a 3x3, columns = axes) in the path frame
 
@@ -128,7 +128,8 @@ class StoneMemory:
             # choice; without it one such sample, taken for a foveal one, can move the estimate by metres).
             u = self._in_eye(pose, qx, qy, STONE_PLANE_Z)
             ecc = max(ecc, math.acos(max(-1.0, min(1.0, u[0]))))
-        s_lat = max(_sigmas(t, ecc, slip, self.vision)[1] * t / d, MIN_STD_M)
+        # dt: the positional disarray, if the eye has it, sized for a stream of looks (no effect without)
+        s_lat = max(believed_sigmas(t, ecc, slip, self.vision, None, dt)[1] * t / d, MIN_STD_M)
         if crowded:
             s_lat = max(s_lat, crowd_std(t, ecc, self.vision))
         h = math.hypot(hx, hy)

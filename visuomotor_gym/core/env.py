@@ -333,6 +333,7 @@ class VisuomotorEnv(gym.Env):
         self.head.reset(d)
         d.ctrl[:] = 0.0
         self.task.reset_episode(d, self.np_random)
+        self.retina.draw_field(self.np_random)  # after the scenario: draws only with positional disarray
         mujoco.mj_forward(m, d)
         # Live views of MuJoCo's bad-state warning counters (reading one costs ~0.1 us).
         self._warning_stats = [d.warning[i] for i in self._bad_warnings]

@@ -123,10 +123,20 @@ class Retina:
 
     def __setstate__(self, state: dict) -> None:
         self.__dict__.update(state)
+        self.__dict__.setdefault("_disarray", None)  # pickled before the positional disarray existed
         self._native = self._native and _native.enabled()  # unpickled where the extension is missing
 
     def reset(self) -> None:
         self._delay: deque = deque(maxlen=self.delay_steps + 1)
+        self._disarray = None
+
+    def draw_field(self, rng: np.random.Generator) -> None:
+        """Draw this episode's positional-disarray field from ``rng``
+        (:class:`~visuomotor_gym.vision.periphery.DisarrayField`): only on a foveated eye with
+        ``params.position_disarray`` > 0; otherwise nothing is drawn (the env's random stream is
+        untouched). The env calls it once per reset, after the task has drawn its scenario."""
+        if self.mode == "foveated" and self.params.foveated and self.params.position_disarray > 0.0:
+            self._disarray = periphery.DisarrayField(self.params, rng)
 
     def sample(self, data: mujoco.MjData, targets, eye, saccading: bool, rng: np.random.Generator) -> list:
         """One sample per target (in order), after the visual-delay line."""
@@ -219,7 +229,15 @@ class Retina:
         out = [nothing() for _ in targets]
         draw = foveation._draw_at
         fixation = eye.fixation
-        for i, (x, y, z), vel_eye, slip, _ in seen:
+        fixed = None
+        if self._disarray is not None and seen:  # the field at every seen point's place, in one go
+            eccs, polars = [], []
+            for _, (x, y, z), _, _, _ in seen:
+                d = math.sqrt(x * x + y * y + z * z)
+                eccs.append(math.acos(max(-1.0, min(1.0, x / d))) if d > 0.0 else 0.0)
+                polars.append(math.atan2(z, y))
+            fixed = self._disarray.values(eccs, polars).T.tolist()
+        for k, (i, (x, y, z), vel_eye, slip, _) in enumerate(seen):
             # A look at the (pooled) point, as foveation.perceive draws it once it is known to be seen
             # (a pooled point may lie just outside the field that holds its target: still seen).
             d = math.sqrt(x * x + y * y + z * z)
@@ -227,7 +245,7 @@ class Retina:
                 out[i] = ([x, y, z], list(vel_eye), True)
                 continue
             ecc = math.acos(max(-1.0, min(1.0, x / d)))
-            p, v = draw(x, y, z, d, ecc, vel_eye, slip, vp, rng, fixation)
+            p, v = draw(x, y, z, d, ecc, vel_eye, slip, vp, rng, fixation, None if fixed is None else fixed[k])
             out[i] = (p, v, True)
         return out
 

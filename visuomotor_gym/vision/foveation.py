@@ -123,6 +123,12 @@ class VisionParams:
         default=None, metadata={"bounds": (0.0, 600.0), "low_open": True, "optional": True})
     # Interocular distance for the pedestal: mean adult interpupillary distance ~63 mm (Dodgson 2004).
     interocular_m: float = field(default=0.063, metadata={"bounds": (0.0, 0.2), "low_open": True})
+    # Positional disarray (periphery.DisarrayField): the share of the lateral position variance the
+    # periphery adds to the fovea's that is fixed in retinal coordinates for the episode (Hess & Field
+    # 1993), the rest drawn every step; 0: off. The share is a modelling choice (swept); disarray_length: the field's
+    # correlation length in units of eccentricity, one crowding zone (Bouma 1970's 0.5; modelling choice).
+    position_disarray: float = field(default=0.0, metadata={"bounds": (0.0, 1.0)})
+    disarray_length: float = field(default=0.5, metadata={"bounds": (0.0, 4.0), "low_open": True})
     # Set by __post_init__: whether any of the mechanisms above acts (always False without foveation).
     periphery_on: ClassVar[bool] = False
 
@@ -133,7 +139,7 @@ class VisionParams:
         # Whether any peripheral mechanism acts (the retina then bypasses its compiled kernel).
         object.__setattr__(self, "periphery_on", self.foveated and (
             self.field_shape == "human" or self.position_e2_deg is not None or self.crowding
-            or self.depth_pedestal_arcmin is not None))
+            or self.depth_pedestal_arcmin is not None or self.position_disarray > 0.0))
 
     def scaled(self, factor: float) -> VisionParams:
         """A copy with ``noise_scale`` multiplied by ``factor``."""
@@ -224,6 +230,43 @@ def standard_deviations(distance: float, eccentricity_rad: float, retinal_speed:
     return np.array(_sigmas(distance, eccentricity_rad, retinal_speed, params, fixation))
 
 
+#: How long an agent's memory of a target's samples is taken to last when it sizes the positional
+#: disarray's share of a sample's error (:func:`disarray_looks`): modelling choice (one second, about
+#: the span over which the baselines' filters weigh old samples).
+DISARRAY_HORIZON_S = 1.0
+
+
+def disarray_looks(eccentricity_rad: float, retinal_speed: float, params: VisionParams, dt: float,
+                   horizon_s: float = DISARRAY_HORIZON_S) -> float:
+    """How many of an observer's successive samples (every ``dt`` s) of one target read the same place
+    of the positional-disarray field (:class:`~visuomotor_gym.vision.periphery.DisarrayField`): the
+    field decorrelates over ``disarray_length x (theta + theta_0)`` of retinal travel, covered at the
+    image's retinal speed (rad/s), so ``1 + l (theta + theta_0) / (speed dt)`` looks, at most
+    ``horizon_s / dt`` (a still image); 1 without the disarray."""
+    if params.position_disarray <= 0.0 or not params.foveated:
+        return 1.0
+    e2_deg = params.position_e2_deg if params.position_e2_deg is not None else params.fovea_e2_deg
+    span = params.disarray_length * (eccentricity_rad + e2_deg * DEG)
+    most = max(1.0, horizon_s / dt)
+    speed = abs(retinal_speed)
+    return most if speed * most * dt <= span else min(most, 1.0 + span / (speed * dt))
+
+
+def believed_sigmas(distance, eccentricity_rad, retinal_speed, params, fixation=None, dt=None):
+    """The stds an observer that knows its eye should give one sample when it fuses a stream of them
+    every ``dt`` s: :func:`standard_deviations`, with the lateral ones multiplied by ``sqrt(1 + w (k -
+    1))`` under the positional disarray (``w`` its share of the lateral variance at this eccentricity,
+    ``k`` = :func:`disarray_looks`): a filter that takes ``k`` looks as independent then ends with the
+    fixed part's variance unreduced. Without the disarray (or ``dt``) exactly :func:`standard_deviations`."""
+    sig = _sigmas(distance, eccentricity_rad, retinal_speed, params, fixation)
+    if dt is None or params.position_disarray <= 0.0 or not params.foveated:
+        return sig
+    f = periphery.position_factor(eccentricity_rad, params)
+    w = params.position_disarray * (1.0 - 1.0 / (f * f))
+    g = math.sqrt(1.0 + w * (disarray_looks(eccentricity_rad, retinal_speed, params, dt) - 1.0))
+    return (sig[0], sig[1] * g, sig[2] * g, sig[3], sig[4], sig[5])
+
+
 def _sigmas(distance, eccentricity_rad, retinal_speed, params, fixation=None):
     """``standard_deviations`` as a tuple of floats (the per-step path)."""
     k = distance * params.noise_scale / acuity(eccentricity_rad, params)
@@ -243,12 +286,13 @@ def _sigmas(distance, eccentricity_rad, retinal_speed, params, fixation=None):
 
 
 def covariance(position_eye: np.ndarray, retinal_speed: float, params: VisionParams,
-               fixation: float | None = None) -> np.ndarray:
+               fixation: float | None = None, dt: float | None = None) -> np.ndarray:
     """The 6x6 observation covariance A Sigma^2 A^T in the eye frame (Eyecatch Eq. 1-3); ``fixation``
-    (m): the vergence distance, for the depth law of ``depth_pedestal_arcmin``."""
+    (m): the vergence distance, for the depth law of ``depth_pedestal_arcmin``; ``dt`` (s): the
+    observer's sampling period, to size the positional disarray as :func:`believed_sigmas` does."""
     position_eye = np.asarray(position_eye, dtype=float)
     d = math.sqrt(float(position_eye @ position_eye))
-    sig = standard_deviations(d, eccentricity(position_eye), retinal_speed, params, fixation)
+    sig = np.array(believed_sigmas(d, eccentricity(position_eye), retinal_speed, params, fixation, dt))
     rot = line_of_sight_rotation(position_eye / d) if d > 0 else np.eye(3)
     a = np.zeros((6, 6))
     a[:3, :3] = rot
@@ -276,11 +320,21 @@ def perceive(position_eye, velocity_eye, retinal_speed: float, params: VisionPar
     return pos, vel, True
 
 
-def _draw_at(x, y, z, d, ecc, velocity_eye, retinal_speed, params, rng, fixation=None):
+def _draw_at(x, y, z, d, ecc, velocity_eye, retinal_speed, params, rng, fixation=None, fixed=None):
     """True state + A Sigma eps with eps ~ N(0, I6) (Eyecatch Eq. 1-3) for a point at distance ``d`` > 0
-    and eccentricity ``ecc`` (rad); float lists in and out."""
+    and eccentricity ``ecc`` (rad); float lists in and out. ``fixed``: the positional-disarray field's
+    two lateral values at the point's retinal place (:class:`~visuomotor_gym.vision.periphery.DisarrayField`):
+    the lateral position components of eps are then ``sqrt(w) fixed + sqrt(1 - w) eps`` with ``w = s (1 -
+    1 / f**2)``, ``s = params.position_disarray`` and ``f`` the position law's growth at ``ecc``
+    (:func:`~visuomotor_gym.vision.periphery.position_factor`): a share ``s`` of the variance the periphery
+    adds to the fovea's is fixed in place (the same unit variance; the same six draws from ``rng``)."""
     s0, s1, s2, s3, s4, s5 = _sigmas(d, ecc, retinal_speed, params, fixation)
     e0, e1, e2, e3, e4, e5 = rng.standard_normal(6).tolist()
+    if fixed is not None:
+        f = periphery.position_factor(ecc, params)
+        w = params.position_disarray * (1.0 - 1.0 / (f * f))
+        a, c = math.sqrt(w), math.sqrt(1.0 - w)
+        e1, e2 = a * fixed[0] + c * e1, a * fixed[1] + c * e2
     n0, n1, n2, n3, n4, n5 = s0 * e0, s1 * e1, s2 * e2, s3 * e3, s4 * e4, s5 * e5
     (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = _los_rows(x / d, y / d, z / d)
     vx, vy, vz = velocity_eye

@@ -33,6 +33,23 @@ them on its pure-Python path.
    pedestal (Blakemore 1970, J Physiol 211:599). The depth and depth-rate stds are multiplied by
    ``1 + eta / eta_2``, ``eta_2 = depth_pedestal_arcmin`` the pedestal at which they double (the linear
    form and its constant: modelling choice, to confirm against Blakemore's data).
+5. **Positional disarray** (``position_disarray``): a share of the lateral position error that the
+   periphery adds to the fovea's is fixed in retinal coordinates for the whole episode instead of drawn
+   afresh every step (at eccentricity ``theta`` a share ``s (1 - 1/f(theta)**2)`` of the lateral variance,
+   ``f`` the position law's growth; none at the fovea). The periphery's excess position
+   uncertainty behaves as an *uncalibrated disarray* of the retinotopic map rather than as sensor noise
+   (Hess & Field 1993, Vision Res 33:2663; Michel & Geisler 2011, J Vis 11(1):18: intrinsic position
+   uncertainty grows linearly with eccentricity): the same retinal place reports the same wrong position
+   each time it is read, so a still eye cannot average it away, while a saccade, pursuit or the target's
+   own motion across the retina reads it through other places. Depth keeps its per-step noise (the
+   source is about visual direction). Without it, 50 independent looks a second
+   at a target 20 deg off the fovea give a still eye a position ~7 times finer than the human threshold
+   each look is given (thresholds are measured on single presentations). The fixed part is a smooth,
+   unit-variance random field (:class:`DisarrayField`) over retinal log-polar coordinates, one per
+   lateral component, drawn from the env's ``np_random`` at each reset;
+   its correlation length ``disarray_length`` x the eccentricity is one crowding zone (Bouma's 0.5 theta:
+   modelling choice, swept). The share itself is a modelling choice, swept in
+   ``docs/reproductions/gaze_default.md``; the per-step marginal std of every sample is unchanged.
 
 Retinal slip (the lateral std grows above 2.5 deg/s, Westheimer & McKee 1975) is kept as it is.
 """
@@ -40,6 +57,8 @@ Retinal slip (the lateral std grows above 2.5 deg/s, Westheimer & McKee 1975) is
 from __future__ import annotations
 
 import math
+
+import numpy as np
 
 DEG = math.pi / 180.0
 ARCMIN = DEG / 60.0
@@ -170,3 +189,37 @@ def pooled(vectors, group) -> list[float]:
         sz += ez / n
     m = len(group)
     return [sx / m, sy / m, sz / m]
+
+
+# --- 5. positional disarray --------------------------------------------------------------------
+#: Random Fourier features per position component of :class:`DisarrayField` (modelling choice: enough
+#: for a near-Gaussian field value, 16 x 2 cosines per seen point and step).
+DISARRAY_FEATURES = 16
+
+
+class DisarrayField:
+    """The retinotopic part of the position error (module docstring, 5): two smooth random fields
+    ``g_c(u, phi)``, ``c`` = lateral 1, lateral 2, of zero mean and unit variance over retinal
+    log-polar coordinates ``u = ln(1 + theta / theta_0)`` (``theta`` the eccentricity, ``theta_0`` the
+    position law's E2 -- the acuity law's without it) and ``phi`` the polar angle. Each field is
+    ``sqrt(2 / K) sum_k cos(w_k u + m_k phi + b_k)`` (random Fourier features of a squared-exponential
+    kernel, Rahimi & Recht 2007): ``w_k ~ N(0, 1 / l**2)``, ``m_k`` the integer nearest to a draw of the
+    same law (so the field is periodic in ``phi``), ``b_k ~ U(0, 2 pi)``; ``l = disarray_length``.
+    An eccentricity step of ``l theta`` or a polar-angle step of ``l`` radians decorrelates it.
+    Draws ``2 K`` normals, ``2 K`` normals and ``2 K`` uniforms from ``rng``, in that order."""
+
+    def __init__(self, params, rng: np.random.Generator, features: int = DISARRAY_FEATURES) -> None:
+        scale = 1.0 / params.disarray_length
+        self.w = rng.normal(0.0, scale, (2, features, 1))
+        self.m = np.rint(rng.normal(0.0, scale, (2, features, 1)))
+        self.b = rng.uniform(0.0, 2.0 * math.pi, (2, features, 1))
+        self.amplitude = math.sqrt(2.0 / features)
+        e2_deg = params.position_e2_deg if params.position_e2_deg is not None else params.fovea_e2_deg
+        self.theta_0 = e2_deg * DEG
+
+    def values(self, eccentricities, polar_angles) -> np.ndarray:
+        """The two fields at each retinal place: an array of shape (2, n) for n places given by
+        their eccentricities (rad) and polar angles (rad)."""
+        u = np.log1p(np.asarray(eccentricities, dtype=float) / self.theta_0)
+        phase = self.w * u + self.m * np.asarray(polar_angles, dtype=float) + self.b
+        return self.amplitude * np.cos(phase).sum(axis=1)

@@ -34,6 +34,9 @@ CONDITIONS = {
     "groups": (GROUPS, {}),
     "groups + field+E2+crowding": (GROUPS, HUMAN),
     "groups + human periphery": (GROUPS, HUMAN_ALL),
+    # all four + the retinotopic positional disarray (vision.periphery.DisarrayField, Hess & Field 1993)
+    "groups + human periphery + disarray 0.8": (GROUPS, {**HUMAN_ALL, "position_disarray": 0.8}),
+    "groups + human periphery + disarray 0.5": (GROUPS, {**HUMAN_ALL, "position_disarray": 0.5}),
 }
 
 
