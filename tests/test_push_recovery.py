@@ -209,3 +209,67 @@ def test_random_actions_give_no_nan_and_no_mujoco_warning():
                 break
     assert sum(w.number for w in env.unwrapped.data.warning) == 0
     assert steps > 200
+
+
+# --- opt-in variants of the third pass (off in the definition) ---------------------------------
+def test_the_postural_response_is_off_by_default_and_flexes_the_hips_when_falling_backward(monkeypatch):
+    """Off (gains 0): the leg setpoints are the stance, exactly. On: a centre of mass moving backward
+    (a shove toward -x) flexes both hips and dorsiflexes both ankles, POSTURAL_LATENCY_S after it."""
+    m = _model()
+    d = mujoco.MjData(m)
+    body = sn.StandingBody(m, HandControlParams(), 0.02)
+    mujoco.mj_resetData(m, d)
+    body.reset_pose(d)
+    mujoco.mj_forward(m, d)
+    assert body._postural_response(d) == list(sn.STANCE_RAD)
+    monkeypatch.setattr(sn, "HIP_STRATEGY_GAIN", 4.0)
+    monkeypatch.setattr(sn, "ANKLE_STRATEGY_GAIN", 1.0)
+    body.reset_pose(d)
+    mujoco.mj_forward(m, d)
+    lag = round(sn.POSTURAL_LATENCY_S / 0.02)
+    outs = []
+    for k in range(lag + 2):
+        d.qvel[body._root_v] = -0.5  # the pelvis moving backward at 0.5 m/s
+        mujoco.mj_step(m, d, 10)
+        outs.append(body._postural_response(d))
+    # The extrapolated CoM is seen lag steps late: the first lag responses use the quiet stance's.
+    assert outs[0][1] == sn.STANCE_RAD[1]
+    hip, ankle = outs[-1][1] - sn.STANCE_RAD[1], outs[-1][3] - sn.STANCE_RAD[3]
+    assert 0.0 < hip <= sn.HIP_STRATEGY_MAX_RAD and outs[-1][6] - sn.STANCE_RAD[6] == hip
+    assert 0.0 < ankle <= sn.ANKLE_STRATEGY_MAX_RAD
+    if hip < sn.HIP_STRATEGY_MAX_RAD and ankle < sn.ANKLE_STRATEGY_MAX_RAD:  # neither clipped: gains 4 : 1
+        assert abs(hip / ankle - 4.0) < 1e-9
+
+
+def test_a_turned_wall_is_a_plane_at_its_yaw_and_the_push_goes_toward_it(monkeypatch):
+    monkeypatch.setattr(pr, "WALL_YAW_DEG", (30.0, 30.0))
+    env = gym.make(ENV)
+    _obs, info = env.reset(seed=4)
+    task = env.unwrapped.task
+    yaw = math.radians(30.0)
+    normal = np.array([math.sin(yaw), -math.cos(yaw), 0.0])
+    np.testing.assert_allclose(task.wall_normal, normal, atol=1e-12)
+    depth = task.block_faces @ normal  # every face on a plane parallel to the wall, 0-10 cm out of it
+    assert np.ptp(depth) <= pr.BLOCK_OFFSET_M[1] + 1e-9
+    assert pr.WALL_DISTANCE_M[0] - pr.BLOCK_OFFSET_M[1] - 1e-9 <= depth.min() and depth.max() <= pr.WALL_DISTANCE_M[1]
+    assert math.degrees(math.acos(float(info["push_dir"] @ normal))) <= pr.PUSH_AZIMUTH_DEG + 1e-9
+    q = env.unwrapped.data.mocap_quat[task._mocap[0]]
+    np.testing.assert_allclose(q, (math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)), atol=1e-12)
+
+
+def test_eom_brace_braces_along_the_fall_toward_a_turned_wall(monkeypatch):
+    """fall_direction=true: the push is detected from the vestibular fall direction, which points at the
+    turned wall, and the hand braces on a cube there (Oracle rung: the brace, not the eye)."""
+    monkeypatch.setattr(pr, "WALL_YAW_DEG", (25.0, 25.0))
+    env, agent, info = _play("eom_brace:fall_direction=true", 4, env_id="PushRecoveryOracle-v0")
+    normal = env.unwrapped.task.wall_normal
+    assert agent.detected_at is not None
+    assert math.degrees(math.acos(float(agent.normal[:2] @ normal[:2]))) < 25.0
+    assert info["is_success"] and env.unwrapped.task.first_contact_time is not None
+
+
+@pytest.mark.parametrize("spec", ["eom_brace:verge_on_sample=maybe", "eom_brace:fall_direction=2",
+                                  "eom_brace:scan_blocks=-1"])
+def test_the_new_options_refuse_bad_values(spec):
+    with pytest.raises(ValueError, match="EomBraceParams"):
+        make_agent(spec, ENV, 9)

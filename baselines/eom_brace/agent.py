@@ -56,6 +56,7 @@ _LOG_FIX = (math.log(_FIX[0]), math.log(_FIX[1]))
 N = sn.N_BLOCKS
 SHOULDER = np.array([0.0, -0.2, 0.4])  # right shoulder, stance frame (envs_assets/push.xml: upper_arm)
 FOOT_HALF_WIDTH_M = 0.045  # envs_assets/push.xml: the foot box's half width
+FOOT_HALF_LENGTH_M = 0.13  # ... and half length (the sole site is at the box's centre)
 SAMPLE_DISTANCE_RANGE_M = (0.2, 2.0)  # samples outside are rejected: the cubes are 0.5-1.5 m from the eye (modelling choice)
 
 
@@ -76,6 +77,14 @@ class EomBraceParams:
     scan_y_m: float = -0.75
     scan_z_m: float = 0.35
     scan_dwell_s: float = 0.3
+    # Options tried in the third pass of issue 25 (off by default; docs/reproductions/eom.md, "Tried in the
+    # third pass"): after the scan_x_m looks, fixate the scan_blocks believed cubes nearest the fall line in
+    # turn, scan_dwell_s each (0: keep looking at the wall's middle); verge on the fixated cube's latest
+    # sample distance when it lies within verge_ecc_deg of the fovea instead of on the belief's distance
+    # (modelling choices: both made the foveated agent worse on seeds 0-39, see the page).
+    scan_blocks: int = 0
+    verge_on_sample: bool = False
+    verge_ecc_deg: float = 5.0
     hand_ready: tuple = (0.1, -0.4, 0.27)  # stance frame: the hand waits beside the hip, toward the wall (modelling choice)
     # The reaction: saccade and hand start this long after the detection. Arm reactions to a perturbation
     # start ~100-150 ms after it (Maki & McIlroy's reviews, REFERENCES.md, unconfirmed): modelling choice.
@@ -86,7 +95,13 @@ class EomBraceParams:
     fuse_max_ecc_deg: float = 20.0
     reset_ratio: float = 10.0  # a sample this much more precise restarts a cube's mean (modelling choice)
     cop_margin_m: float = 0.01  # CoP within 1 cm of the foot's outer edge: leaving the polygon (modelling choice)
-    unload_fraction: float = 0.05  # or the left foot carrying < 5 % of body weight (modelling choice)
+    unload_fraction: float = 0.05  # or a foot carrying < 5 % of body weight (modelling choice)
+    # fall_direction: detect the push from the pelvis's velocity direction (vestibular; once faster than
+    # fall_speed_m_s) and the CoP within cop_margin_m of the support polygon's extent along it, then choose the
+    # cube nearest the fall line through the shoulder and brace along that direction, for a wall that is not
+    # beside the body (task WALL_YAW_DEG). Off: the definition's wall on the right, as before (bit for bit).
+    fall_direction: bool = False
+    fall_speed_m_s: float = 0.15  # the pelvis moving faster than this: its direction is the fall's (modelling choice)
     approach_offset_m: float = 0.10  # align the palm 10 cm in front of the believed face first (modelling choice)
     align_m: float = 0.04  # ... to within 4 cm along the wall, then move in (modelling choice)
     align_timeout_s: float = 0.25  # ... or after this long, aligned or not (modelling choice)
@@ -110,14 +125,17 @@ class EomBraceParams:
     def __post_init__(self) -> None:
         for f in fields(self):
             v = getattr(self, f.name)
-            if f.name in ("foveated", "gaze_blind", "use_hand"):
+            if f.name in ("foveated", "gaze_blind", "use_hand", "verge_on_sample", "fall_direction"):
                 if not isinstance(v, bool):
                     raise ValueError(f"EomBraceParams.{f.name} must be true or false, got {v!r}")
+            elif f.name == "scan_blocks":
+                if isinstance(v, bool) or not isinstance(v, int) or v < 0:
+                    raise ValueError(f"EomBraceParams.scan_blocks must be an integer >= 0, got {v!r}")
             elif isinstance(v, tuple):
                 if len(v) < 1 or not all(isinstance(x, (int, float)) and math.isfinite(x) for x in v):
                     raise ValueError(f"EomBraceParams.{f.name} must be finite numbers, got {v!r}")
             elif isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) \
-                    or (v < 0 and not f.name.startswith("scan_") and f.name not in ("yield_speed_m_s", "yield_brace")):
+                    or (v < 0 and f.name not in ("scan_y_m", "scan_z_m", "yield_speed_m_s", "yield_brace")):
                 raise ValueError(f"EomBraceParams.{f.name} must be a finite number >= 0, got {v!r}")
 
 
@@ -172,6 +190,10 @@ class EomBraceAgent:
         self.poses: deque = deque(maxlen=self.delay_steps + 1)
         self.home: np.ndarray | None = None
         self.detected_at: float | None = None
+        self.normal = np.array([0.0, -1.0, 0.0])
+        self._scan_order = None
+        self._scan_k = -1
+        self._scan_target = 0
         self.chosen: int | None = None
         self.hold: np.ndarray | None = None
         self.hold_eye: np.ndarray | None = None
@@ -241,59 +263,96 @@ class EomBraceAgent:
                 if vis[i] > 0.5:
                     self._fuse(i, pos[i].copy(), r0, e0, f0)
 
-        # --- detection: the CoP at the support polygon's edge (or the left foot unloaded) ----------------
+        # --- detection: the CoP at the support polygon's edge (or a foot unloaded) ---------------------
         cop = obs[_S["foot_pressure"]]
         feet = obs[_S["feet"]].reshape(2, 3)
-        if self.detected_at is None and (cop[2] + cop[3]) > 0:
+        vel = obs[_S["vestibular"]][5:8]
+        if self.detected_at is None and (cop[2] + cop[3]) > 0 and not p.fall_direction:
+            # The wall beside the body: the CoP at the right foot's outer edge, or the left foot unloaded.
             edge = feet[1, 1] - FOOT_HALF_WIDTH_M
             if cop[1] < edge + p.cop_margin_m or cop[2] < p.unload_fraction:
                 self.detected_at = t
                 self.events.append((t, "detect"))
+        elif self.detected_at is None and (cop[2] + cop[3]) > 0:
+            # Any direction: the fall's is the pelvis's horizontal velocity (vestibular), once it is a push's;
+            # detected when the CoP comes within cop_margin_m of the support polygon's extent along it (the
+            # soles' corners), or a foot unloads. The hand then braces along that direction.
+            vh = np.array([vel[0], vel[1], 0.0])
+            speed = float(np.linalg.norm(vh))
+            if speed > p.fall_speed_m_s:
+                u = vh / speed
+                ext = max(float(u[0] * (f[0] + sx * FOOT_HALF_LENGTH_M) + u[1] * (f[1] + sy * FOOT_HALF_WIDTH_M))
+                          for f in feet for sx in (-1, 1) for sy in (-1, 1))
+                if float(u[0] * cop[0] + u[1] * cop[1]) > ext - p.cop_margin_m \
+                        or min(cop[2], cop[3]) < p.unload_fraction:
+                    self.detected_at = t
+                    self.normal = u
+                    self.events.append((t, "detect"))
+        n = self.normal
 
         # --- which cube, and the hand ------------------------------------------------------------------
         target = self.home
         brace = 1.0
         look_at = None
-        if t >= p.look_latency_s - 1e-9:
-            k = int((t - p.look_latency_s + 1e-9) // p.scan_dwell_s) % len(p.scan_x_m)
-            look_at = np.array([p.scan_x_m[k], p.scan_y_m, p.scan_z_m])
+        look_block = None
         known = [i for i in range(N) if self.w[i] > 0]
+        if t >= p.look_latency_s - 1e-9:
+            k = int((t - p.look_latency_s + 1e-9) // p.scan_dwell_s)
+            if p.scan_blocks <= 0:
+                look_at = np.array([p.scan_x_m[k % len(p.scan_x_m)], p.scan_y_m, p.scan_z_m])
+            elif k < len(p.scan_x_m) or not known:
+                k = min(k, len(p.scan_x_m) - 1)
+                look_at = np.array([p.scan_x_m[k], p.scan_y_m, p.scan_z_m])
+            else:
+                # Then fixate the believed cubes nearest the shoulder in turn (they are where the hand may
+                # go): a fixated cube is localised by the fovea, laterally and, verged on, in depth.
+                if self._scan_order is None or k != self._scan_k:
+                    faces = np.array([self.estimate(i) for i in known]) - SHOULDER
+                    lateral = faces - np.outer(faces @ n, n)
+                    order = [known[j] for j in np.argsort(np.linalg.norm(lateral, axis=1))][:p.scan_blocks]
+                    self._scan_order = order
+                    self._scan_k = k
+                    self._scan_target = order[(k - len(p.scan_x_m)) % len(order)]
+                look_at = self.estimate(self._scan_target)
+                look_block = self._scan_target
         if self.detected_at is not None and known and t >= self.detected_at + p.reaction_latency_s - 1e-9:
             hand_speed = float(np.linalg.norm(obs[_S["hand_vel"]]))
             if self.hold is None:
-                # The nearest believed face to the right shoulder, along the wall (x, z).
-                faces = np.array([self.estimate(i) for i in known])
-                self.chosen = known[int(np.argmin(np.linalg.norm((faces - SHOULDER)[:, [0, 2]], axis=1)))]
+                # The nearest believed face to the line of the fall through the right shoulder.
+                faces = np.array([self.estimate(i) for i in known]) - SHOULDER
+                lateral = faces - np.outer(faces @ n, n)
+                self.chosen = known[int(np.argmin(np.linalg.norm(lateral, axis=1)))]
                 face = self.estimate(self.chosen)
                 if self.approach_since is None:
                     # Align first: in front of the face, then toward it (a hand that sweeps along the wall
                     # catches an edge); move in anyway once align_timeout_s has passed.
-                    target = face + np.array([0.0, p.approach_offset_m, 0.0])
+                    target = face - n * p.approach_offset_m
                     late = t - self.detected_at - p.reaction_latency_s >= p.align_timeout_s - 1e-9
-                    if float(np.linalg.norm((hand - face)[[0, 2]])) < p.align_m or late:
+                    off = hand - face
+                    if float(np.linalg.norm(off - n * float(off @ n))) < p.align_m or late:
                         self.approach_since = t
                         self.events.append((t, "approach"))
                 if self.approach_since is not None:
-                    goal = face + np.array([0.0, -p.reach_depth_m, 0.0])
+                    goal = face + n * p.reach_depth_m
                     step = goal - hand
-                    n = float(np.linalg.norm(step))
-                    target = hand + step * min(1.0, 2.0 * p.approach_speed_m_s * self.dt / max(n, 1e-9))
+                    dist = float(np.linalg.norm(step))
+                    target = hand + step * min(1.0, 2.0 * p.approach_speed_m_s * self.dt / max(dist, 1e-9))
                     if t - self.approach_since >= p.min_reach_s and hand_speed < p.contact_speed_m_s:
                         self.hold = hand.copy()
                         self.hold_eye = eye.copy()
                         self.events.append((t, "hold"))
             if self.hold is not None:
-                # The braced arm as a strut along the wall's normal: the hand keeps its distance from the
-                # head as the body leans (a hand held fixed in the room would let the arm fold).
-                target = self.hold + np.array([0.0, eye[1] - self.hold_eye[1], 0.0])
-            vy = float(obs[_S["vestibular"]][6])
-            if p.yield_speed_m_s >= 0 and vy > p.yield_speed_m_s:
+                # The braced arm as a strut along the fall's direction: the hand keeps its distance from
+                # the head as the body leans (a hand held fixed in the room would let the arm fold).
+                target = self.hold + n * float((eye - self.hold_eye) @ n)
+            if p.yield_speed_m_s >= 0 and -float(vel @ n) > p.yield_speed_m_s:
                 target = hand.copy()  # the body moves back over its feet: the arm yields
                 brace = p.yield_brace
                 if self.hold is not None:
                     self.hold = hand.copy()
                     self.hold_eye = eye.copy()
             look_at = self.estimate(self.chosen)
+            look_block = self.chosen
             rates = obs[_S["vestibular"]][2:5]
             if self.hold is not None and float(np.max(np.abs(rates))) < p.still_rad_s:
                 self.still_since = t if self.still_since is None else self.still_since
@@ -304,6 +363,7 @@ class EomBraceAgent:
                 self.still_since = None
             if self.looked_away:
                 look_at = eye + np.array([3.0, 0.0, 0.0])
+                look_block = None
 
         if not p.use_hand:
             target = self.home
@@ -315,6 +375,12 @@ class EomBraceAgent:
             az, el = math.atan2(d[1], d[0]), math.atan2(d[2], math.hypot(d[0], d[1]))
             head = (self._beyond_dead_zone(az, 0), self._beyond_dead_zone(el, 1))
             fixation = float(np.linalg.norm(d))
+            if p.verge_on_sample and look_block is not None and obs[_S["block_visible"]][look_block] > 0.5:
+                # Vergence follows the fixated cube's own disparity: its latest sample's distance when it is
+                # near the fovea (the vergence loop closes on the fixated target, not on the belief).
+                sample = obs[_S["block_pos"]].reshape(N, 3)[look_block]
+                if sample[0] > 0 and foveation.eccentricity(sample) < p.verge_ecc_deg * DEG:
+                    fixation = float(np.linalg.norm(sample))
         return encode(target, brace, gaze, fixation, head, self.gaze_range)
 
     def _beyond_dead_zone(self, angle: float, k: int) -> float:

@@ -23,6 +23,7 @@ while it sways or falls.
 from __future__ import annotations
 
 import math
+from collections import deque
 
 import mujoco
 import numpy as np
@@ -56,6 +57,36 @@ STANCE_HIP_ROLL_RAD = 0.08
 STANCE_ANKLE_PITCH_RAD = 0.03
 STANCE_RAD = (STANCE_HIP_ROLL_RAD, 0.0, 0.0, STANCE_ANKLE_PITCH_RAD, -STANCE_HIP_ROLL_RAD,
               -STANCE_HIP_ROLL_RAD, 0.0, 0.0, STANCE_ANKLE_PITCH_RAD, STANCE_HIP_ROLL_RAD)
+# The automatic postural response of the legs: OFF in the definition (every gain 0; the third pass of
+# issue 25 measured it, docs/reproductions/eom.md, "Tried in the third pass"). When on, each control step the
+# leg servos' setpoints are the stance plus offsets driven by the extrapolated centre of mass
+# (XCoM = x + v / omega0, Hof, Gazendam & Sinke 2005, J Biomech 38:1) seen POSTURAL_LATENCY_S earlier:
+# sagittally an ankle strategy (ankle pitch) and a hip strategy (hip pitch: the trunk bends to move the
+# centre of mass back over the feet; Horak & Nashner 1986, J Neurophysiol 55:1369: ankle strategy for small
+# perturbations, hip strategy for larger ones or a short support), laterally a hip load/unload strategy
+# (hip roll: mediolateral balance is a hip mechanism, Winter 1995, Gait & Posture 3:193). Signs: a positive
+# hip pitch offset moves the centre of mass forward, a positive hip roll offset (both hips) to the left
+# (measured on the model at rest: +0.1 rad gives +2.6 and +5 cm).
+# Latency of automatic postural responses: EMG onsets ~90-100 ms after a support-surface perturbation
+# (Horak & Nashner 1986; recalled, to confirm): 0.1 s.
+POSTURAL_LATENCY_S = 0.1
+OMEGA0 = math.sqrt(9.81 / 0.97)  # the inverted pendulum's eigenfrequency, l = the CoM's 0.97 m height
+POSTURE_REF_X_M = 0.05  # the CoM's x in quiet stance (measured: 4.9 cm ahead of the pelvis origin)
+POSTURE_DEAD_ZONE_M = 0.02  # within 2 cm the stiff stance alone holds (modelling choice)
+HIP_STRATEGY_GAIN = 0.0  # rad of hip pitch per m of XCoM error; 4 tried (modelling choice)
+HIP_STRATEGY_MAX_RAD = 0.5  # modelling choice
+ANKLE_STRATEGY_GAIN = 0.0  # rad of ankle pitch per m; 1 tried (modelling choice)
+ANKLE_STRATEGY_MAX_RAD = 0.15  # modelling choice
+HIP_ROLL_GAIN = 0.0  # rad of hip roll per m of lateral XCoM; 2 tried (modelling choice)
+HIP_ROLL_MAX_RAD = 0.3  # modelling choice
+
+
+def _dead_zone(e: float, width: float) -> float:
+    return 0.0 if abs(e) <= width else e - math.copysign(width, e)
+
+
+def _clip(v: float, limit: float) -> float:
+    return max(-limit, min(limit, v))
 N_BLOCKS = 6  # the pool of cube blocks in push.xml (block_0 ... block_5)
 BLOCKS = tuple(f"block_{i}" for i in range(N_BLOCKS))
 SCENE_CAMERA = "scene_camera"
@@ -165,6 +196,8 @@ class StandingBody(Body):
         self.brace_level = 1.0
         self._hand_prev = (0.0, 0.0, 0.0)
         self._cop = (0.0, 0.0, 0.0, 0.0)
+        self._com_prev: float | None = None
+        self._xcom: deque = deque(maxlen=max(1, round(POSTURAL_LATENCY_S / self.dt)) + 1)
 
     # --- episode ------------------------------------------------------------------------------
     def reset_pose(self, data: mujoco.MjData) -> None:
@@ -176,6 +209,8 @@ class StandingBody(Body):
         data.qpos[self._qpos] = self.ready
         data.act[self._actadr] = self.ready
         data.ctrl[self._leg_act] = STANCE_RAD
+        self._com_prev = None
+        self._xcom.clear()
         data.qpos[self._leg_q] = STANCE_RAD
         self._set_brace(1.0)
 
@@ -202,7 +237,39 @@ class StandingBody(Body):
         d.ctrl[self._act] = (new_setpoint - setpoint) / dt  # MuJoCo clamps to ctrlrange: a rate limit
         self._set_brace(0.5 * (al[3] + 1.0))
         d.ctrl[self._grasp_act] = 0.0
-        d.ctrl[self._leg_act] = STANCE_RAD  # the stance
+        d.ctrl[self._leg_act] = self._postural_response(d)  # the stance, and its automatic response
+
+    def _postural_response(self, data: mujoco.MjData) -> list:
+        """The leg servos' setpoints: the stance plus the automatic postural response to the extrapolated
+        centre of mass (x + v / omega0, Hof et al. 2005) seen :data:`POSTURAL_LATENCY_S` ago; the stance
+        alone while every gain is 0 (the definition)."""
+        if not (HIP_STRATEGY_GAIN or ANKLE_STRATEGY_GAIN or HIP_ROLL_GAIN):
+            return list(STANCE_RAD)
+        com = data.subtree_com[self.pelvis]
+        x, y = float(com[0]), float(com[1])
+        if self._com_prev is None:
+            vx = vy = 0.0
+        else:
+            vx = (x - self._com_prev[0]) / self.dt
+            vy = (y - self._com_prev[1]) / self.dt
+        self._com_prev = (x, y)
+        self._xcom.append((x + vx / OMEGA0, y + vy / OMEGA0))
+        if len(self._xcom) < self._xcom.maxlen:  # nothing seen POSTURAL_LATENCY_S ago yet: the stance
+            return list(STANCE_RAD)
+        cx, cy = self._xcom[0]
+        ex = _dead_zone(POSTURE_REF_X_M - cx, POSTURE_DEAD_ZONE_M)  # > 0: falling backward
+        ey = _dead_zone(-cy, POSTURE_DEAD_ZONE_M)  # > 0: falling to the right
+        hip = _clip(HIP_STRATEGY_GAIN * ex, HIP_STRATEGY_MAX_RAD)
+        ank = _clip(ANKLE_STRATEGY_GAIN * ex, ANKLE_STRATEGY_MAX_RAD)
+        roll = _clip(HIP_ROLL_GAIN * ey, HIP_ROLL_MAX_RAD)
+        out = list(STANCE_RAD)
+        out[0] += roll
+        out[5] += roll
+        out[1] += hip
+        out[6] += hip
+        out[3] += ank
+        out[8] += ank
+        return out
 
     # --- state --------------------------------------------------------------------------------
     def hand_pos(self, data: mujoco.MjData) -> np.ndarray:

@@ -63,6 +63,11 @@ PUSH_FORCE_N = (300.0, 350.0)
 # Direction: toward the wall (-y) within +-10 deg (modelling choice: "toward the wall"; the stance's
 # sagittal margin, 10 cm behind the centre of mass to the heels, is the body's weak direction once braced).
 PUSH_AZIMUTH_DEG = 10.0
+# The wall's yaw, drawn per episode (deg; its normal turned forward from the body's right; the push follows
+# the normal): (0, 0) in the definition, no draw. The third pass of issue 25 tried 0..30, 30..60, -30..0 and
+# -10..35 so that the cube the hand needs is not always beside the shoulder (docs/reproductions/eom.md,
+# "Tried in the third pass"): the braced stance falls on forward and backward components (modelling choice).
+WALL_YAW_DEG = (0.0, 0.0)
 
 # --- the outcome -----------------------------------------------------------------------------------
 HOLD_S = 2.5  # upright this long after the push's onset: success (modelling choice; Eom's clip ~2-3 s)
@@ -127,15 +132,14 @@ class PushRecoveryTask(Task):
 
     def reset_episode(self, data: mujoco.MjData, rng: np.random.Generator) -> None:
         """Draw the wall (distance, then per cube: size, gap, height, offset), the push (time, force,
-        direction) and the initial gaze jitter, in that order, from ``rng``."""
+        direction), the initial gaze jitter and (only when :data:`WALL_YAW_DEG` is a range) the wall's yaw,
+        in that order, from ``rng``."""
         wall = float(rng.uniform(*WALL_DISTANCE_M))
         x = float(rng.uniform(*FIRST_BLOCK_X_M))
-        centres, faces, sizes = [], [], []
+        rows = []
         for i in range(sn.N_BLOCKS):
             if i >= self.n_blocks:
-                data.mocap_pos[self._mocap[i]] = PARKED
-                data.mocap_pos[self._post_mocap[i]] = PARKED
-                self.targets[i].hidden = True
+                rows.append(None)
                 continue
             h = float(rng.uniform(*BLOCK_HALF_SIZE_M))
             gap = float(rng.uniform(*GAP_M))
@@ -144,25 +148,43 @@ class PushRecoveryTask(Task):
             if i > 0:
                 x += gap
             x += h
-            y_face = -(wall - off)
-            centre = (x, y_face - h, z)
+            rows.append((x, h, z, off))
             x += h
+        self.push_time = float(rng.uniform(*PUSH_TIME_S))
+        self.push_force = float(rng.uniform(*self.push_force_n))
+        az = float(rng.uniform(-PUSH_AZIMUTH_DEG, PUSH_AZIMUTH_DEG)) * DEG
+        self.gaze_offset = rng.normal(0.0, GAZE_JITTER_DEG * DEG, 2)
+        # The wall's yaw: its normal turned forward from the body's right by yaw (0: beside the body).
+        yaw = float(rng.uniform(*WALL_YAW_DEG)) * DEG if WALL_YAW_DEG[1] > WALL_YAW_DEG[0] else WALL_YAW_DEG[0] * DEG
+        self.wall_yaw = yaw
+        normal = np.array([math.sin(yaw), -math.cos(yaw), 0.0])  # from the body toward the wall
+        along = np.array([math.cos(yaw), math.sin(yaw), 0.0])  # along the wall, forward at yaw 0
+        self.wall_normal = normal
+        quat = (math.cos(0.5 * yaw), 0.0, 0.0, math.sin(0.5 * yaw))
+        centres, faces, sizes = [], [], []
+        for i, row in enumerate(rows):
+            if row is None:
+                data.mocap_pos[self._mocap[i]] = PARKED
+                data.mocap_pos[self._post_mocap[i]] = PARKED
+                self.targets[i].hidden = True
+                continue
+            xa, h, z, off = row
+            face = along * xa + normal * (wall - off) + np.array([0.0, 0.0, z])
+            centre = face + normal * h
             self._resize(i, h)
             data.mocap_pos[self._mocap[i]] = centre
+            data.mocap_quat[self._mocap[i]] = quat
             data.mocap_pos[self._post_mocap[i]] = (centre[0], centre[1], centre[2] - h)
-            self.targets[i].place(centre[0], y_face, z)
+            self.targets[i].place(float(face[0]), float(face[1]), float(face[2]))
             centres.append(centre)
-            faces.append((centre[0], y_face, z))
+            faces.append(face)
             sizes.append(h)
         self.wall_distance = wall
         self.block_centres = np.array(centres)
         self.block_faces = np.array(faces)
         self.block_half_sizes = np.array(sizes)
-        self.push_time = float(rng.uniform(*PUSH_TIME_S))
-        self.push_force = float(rng.uniform(*self.push_force_n))
-        az = float(rng.uniform(-PUSH_AZIMUTH_DEG, PUSH_AZIMUTH_DEG)) * DEG
-        self.push_dir = np.array([math.sin(az), -math.cos(az), 0.0])
-        self.gaze_offset = rng.normal(0.0, GAZE_JITTER_DEG * DEG, 2)
+        c, sn_ = math.cos(az), math.sin(az)
+        self.push_dir = np.array([c * normal[0] - sn_ * normal[1], sn_ * normal[0] + c * normal[1], 0.0])
         data.xfrc_applied[:] = 0.0
 
     def _resize(self, i: int, h: float) -> None:
