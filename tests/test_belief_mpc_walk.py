@@ -187,7 +187,7 @@ def test_dodge_dispatch_and_a_short_episode():
 
     env = gym.make("ObstacleDodge-v0")
     agent = make_agent("belief_mpc", "ObstacleDodge-v0", env.action_space.shape[0])
-    assert isinstance(agent, DodgeBeliefMPCAgent) and agent.plan_vision.field_of_view_deg == 20.0
+    assert isinstance(agent, DodgeBeliefMPCAgent) and agent.plan_vision == env.unwrapped.vision_params
     obs, _ = env.reset(seed=1)
     for _ in range(120):
         a, _ = agent.predict(obs)

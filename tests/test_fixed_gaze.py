@@ -103,13 +103,17 @@ def test_joint_control_layout_and_bad_layout():
 
 @pytest.mark.parametrize("env_id, base", [("ObstacleWalk-v0", "iwao"), ("ShelfReach-v0", "faraway")])
 def test_the_twin_holds_gaze_and_head_in_every_family(env_id, base):
-    """The twin reads the env's action_structure: the walk and reach layouts hold their own blocks."""
+    """The twin reads the env's action_structure: the walk and reach layouts hold their own blocks (and the
+    fixation block where the eye has the depth law: ShelfReach-v0's human periphery)."""
     env = gym.make(env_id)
     structure = env.unwrapped.action_structure
     blind = make_agent(f"gaze_blind:{base}", env_id, env.action_space.shape[0])
+    vp = env.unwrapped.vision_params
+    blocks = ("gaze", "head") + (("fixation",) if vp.foveated and vp.depth_pedestal_arcmin is not None else ())
+    assert ("fixation" in blocks) == (env_id == "ShelfReach-v0")
     start, held = 0, []
     for name, size in structure.items():
-        if name in ("gaze", "head"):
+        if name in blocks:
             held += list(range(start, start + size))
         start += size
     assert np.flatnonzero(blind.held).tolist() == held

@@ -704,7 +704,7 @@ def reach_traces():
     env = gym.make("ShelfReach-v0")
     try:
         out = []
-        for seed, agent in ((1, "faraway"), (0, "faraway")):
+        for seed, agent in ((1, "faraway"), (7, "faraway:gaze_blind=true")):  # 7: the held eye misses
             policy = make_agent(agent, "ShelfReach-v0", env.action_space.shape[0], seed=seed)
             out.append(run_episode(env, policy, seed=seed, env_id="ShelfReach-v0", agent=agent))
     finally:

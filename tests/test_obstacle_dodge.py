@@ -64,11 +64,13 @@ def _look_up(n):
 
 @pytest.mark.parametrize("vision", ["foveated", "oracle"])
 def test_no_observation_leak_of_the_pedestrians_true_state(vision):
-    """Looking up at the sky, the foveated walker's observations do not depend on where the pedestrians
-    walk (the same episode with every pedestrian shifted 1 m gives identical observations); the oracle rung
-    (true state) is the positive control."""
+    """Looking up at the sky through a 20 deg cone (the default human field reaches 75 deg below the line of
+    sight: test_no_leak_of_pedestrians_outside_the_human_field covers it), the foveated walker's
+    observations do not depend on where the pedestrians walk (the same episode with every pedestrian
+    shifted 1 m gives identical observations); the oracle rung (true state) is the positive control."""
     actions = _look_up(80)
-    a, b = ObstacleDodgeEnv(vision=vision), ObstacleDodgeEnv(vision=vision)
+    cone = {"field_shape": "cone", "field_of_view_deg": 20.0}
+    a, b = (ObstacleDodgeEnv(vision=vision, vision_params=cone) for _ in range(2))
     a.reset(seed=5)
     b.reset(seed=5)
     b.task.pos += np.array([1.0, 0.5])
@@ -200,7 +202,8 @@ def test_dodge_realism_measures_on_synthetic_traces():
 def _agent_with_pedestrian(x, y, vx, vy):
     from visuomotor_gym.baselines.fajen_warren import FajenWarrenAgent
 
-    agent = FajenWarrenAgent.for_env("ObstacleDodgeOracle-v0")
+    # one pedestrian alone: no assumed companions (the groups' prior of the default crowd)
+    agent = FajenWarrenAgent.for_env("ObstacleDodgeOracle-v0", companion_m=0.0)
     f = agent.filters[0]
     f.x = np.array([x, y, vx, vy], dtype=float)
     f.P = np.eye(4) * 1e-4
@@ -305,19 +308,20 @@ def test_fajen_warren_also_predicts_a_veering_pedestrian_returning_to_its_course
 
 # --- groups (opt-in CrowdDistribution.group_size, preset "groups") ----------------------------------
 GROUPS = {"group_size": (2, 3)}
-SINGLE = "single"  # the default preset: every pedestrian alone
+SINGLE = "single"  # the first definition's preset: every pedestrian alone
 
 
-def test_single_is_the_default_and_keeps_the_draws_of_v0():
-    """(1, 1) -- the default, preset "single" -- is v0's sampler draw for draw, whatever the spacing (the RNG
-    stream untouched: tests/test_golden.py); preset "groups" is pairs and triads."""
+def test_groups_is_the_default_and_single_keeps_the_first_definitions_draws():
+    """(1, 1) -- preset "single", the first definition's crowd -- draws the same crowds whatever the spacing (the
+    RNG stream untouched); the default, preset "groups", is pairs and triads."""
     for seed in range(5):
-        a = sample_crowd(np.random.default_rng(seed), CrowdDistribution())
+        a = sample_crowd(np.random.default_rng(seed), CROWD_PRESETS[SINGLE])
         b = sample_crowd(np.random.default_rng(seed), CrowdDistribution(group_size=(1, 1), group_spacing_m=(2, 3)))
         assert a.goal == b.goal and np.array_equal(a.pedestrians, b.pedestrians)
-    assert not CrowdDistribution().groups and CrowdDistribution(**GROUPS).groups
-    assert CROWD_PRESETS[SINGLE] == CrowdDistribution() and CROWD_PRESETS["groups"] == CrowdDistribution(**GROUPS)
-    assert ObstacleDodgeEnv(crowd_distribution="groups").crowd_distribution == CrowdDistribution(**GROUPS)
+    assert CrowdDistribution().groups and not CROWD_PRESETS[SINGLE].groups
+    assert CROWD_PRESETS["groups"] == CrowdDistribution() == CrowdDistribution(**GROUPS)
+    assert ObstacleDodgeEnv().crowd_distribution == CrowdDistribution(**GROUPS)
+    assert ObstacleDodgeEnv(crowd_distribution=SINGLE).crowd_distribution.group_size == (1.0, 1.0)
     with pytest.raises(ValueError, match=r"crowd_distribution.*presets"):
         ObstacleDodgeEnv(crowd_distribution="pairs")
 
@@ -472,10 +476,10 @@ def test_crowding_pools_group_members_within_the_critical_spacing():
 def test_fajen_warren_models_groups_only_when_the_env_has_them():
     from visuomotor_gym.baselines.fajen_warren import FajenWarrenAgent
 
-    plain = FajenWarrenAgent.for_env("ObstacleDodge-v0")
+    with _registered(crowd_distribution="single"):
+        plain = FajenWarrenAgent.for_env("ObstacleDodge-v0")
     assert plain.params.companion_m == 0.0 and plain.params.dwell_saccade_s is None
-    with _registered(crowd_distribution="groups"):
-        grouped = FajenWarrenAgent.for_env("ObstacleDodge-v0")
+    grouped = FajenWarrenAgent.for_env("ObstacleDodge-v0")  # the default crowd: groups
     assert grouped.params.companion_m == pytest.approx(0.8)
     # a lone known pedestrian, others unseen: companions abreast at 0.8 m either side, at its velocity
     grouped.filters[0].x = np.array([5.0, 3.0, 0.0, -1.2])
@@ -513,10 +517,11 @@ def test_fajen_warren_takes_every_constant_of_the_envs_eye():
 
     from visuomotor_gym.vision.foveation import human_periphery
 
-    assert FajenWarrenAgent.for_env("ObstacleDodge-v0").vision.field_of_view_deg == 20.0  # the walk family's
-    with _registered(crowd_distribution="groups", vision_params=_human()):
+    agent = FajenWarrenAgent.for_env("ObstacleDodge-v0")  # the default eye: DODGE_VISION
+    assert agent.vision == human_periphery(position_disarray=0.8) and not agent._search
+    with _registered(vision_params={"position_disarray": 0.0}):  # fields over the family's defaults
         agent = FajenWarrenAgent.for_env("ObstacleDodge-v0")
-    assert agent.vision == human_periphery(field_of_view_deg=20.0) and not agent._search
+    assert agent.vision == human_periphery()
 
 
 @pytest.mark.parametrize("vision", ["foveated", "oracle"])
@@ -590,7 +595,6 @@ def test_fajen_warren_dodges_groups_its_held_twin_runs_into():
     """Development seeds (outside the pinned 0-199) where the moving eye reaches the goal and the held eye
     (gaze and head held level at the goal: the human field still sees every pedestrian, far in its
     periphery) collides: looking at the group members is what tells where they are."""
-    seeds = (203, 207, 210)
-    with _registered(crowd_distribution="groups", vision_params=_human()):
-        assert _bench("fajen_warren", seeds) == len(seeds)
-        assert _bench("gaze_blind:fajen_warren", seeds) == 0
+    seeds = (202, 203, 206)  # the registered definition: groups, the human periphery with the disarray
+    assert _bench("fajen_warren", seeds) == len(seeds)
+    assert _bench("gaze_blind:fajen_warren", seeds) == 0

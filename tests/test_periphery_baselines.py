@@ -112,10 +112,14 @@ def test_plane_variance_follows_the_position_law_and_the_field():
 
 def test_dodge_planner_models_the_env_vision():
     env_id = "ObstacleDodge-v0"
-    env = gym.make(env_id, vision_params=dict(HUMAN))
+    env = gym.make(env_id, vision_params=CONE)  # the walk family's cone over the family's eye
     try:
         policy = make_agent("belief_mpc", env_id, int(env.action_space.shape[0]))
+        assert policy.plan_vision.field_shape == "human"  # the registered id's eye (DODGE_VISION)
+        match_vision(policy, env.unwrapped.vision_params)
         assert policy.plan_vision.field_of_view_deg == 20.0 and policy.plan_vision.field_shape == "cone"
+        env.close()
+        env = gym.make(env_id, vision_params=dict(HUMAN))
         before = policy.noise
         match_vision(policy, env.unwrapped.vision_params)
         assert policy.plan_vision is policy.vision is env.unwrapped.vision_params
@@ -167,3 +171,28 @@ def test_crowded_flags_only_targets_within_the_critical_spacing():
     assert 0 not in crowded([at(0.3), at(0.35)], [1, 2], v)
     assert crowded([at(10.0), at(14.9)], [1, 2], VisionParams()) == set()
     assert crowd_std(2.0, 10.0 * DEG, v) == pytest.approx(0.5 * 0.5 * 10.0 * DEG * 2.0)
+
+
+def _first_saccade_time(disarray: float, seed: int = 16) -> float:
+    env = gym.make("EyeCatch-v0", vision_params={**HUMAN, "position_disarray": disarray})
+    policy = make_agent("eyecatch", "EyeCatch-v0", int(env.action_space.shape[0]), seed=seed)
+    match_vision(policy, env.unwrapped.vision_params)
+    agent = _inner(policy)
+    obs, _ = env.reset(seed=seed)
+    for _ in range(40):
+        obs, *_ = env.step(policy.predict(obs)[0])
+        if agent.first_saccade_released:
+            break
+    env.close()
+    return next(t for t, e in agent.events if e == "first-saccade")
+
+
+def test_eyecatch_under_the_disarray_saccades_once_waiting_stops_paying(monkeypatch):
+    # seed 16, all four + disarray 0.8: the ball's believed retinal std never meets the 3 deg criterion;
+    # the agent goes as soon as it has stopped falling (0.1 s), not at the 0.5 s deadline
+    from visuomotor_gym.baselines.eyecatch import agent as eyecatch_agent
+
+    assert _first_saccade_time(0.0) == pytest.approx(0.18, abs=0.011)  # the criterion met at once
+    assert 0.18 <= _first_saccade_time(0.8) < 0.4
+    monkeypatch.setattr(eyecatch_agent, "FIRST_SACCADE_PLATEAU", math.inf)  # the plateau rule off
+    assert _first_saccade_time(0.8) == pytest.approx(0.5, abs=0.011)

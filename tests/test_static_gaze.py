@@ -284,3 +284,23 @@ def test_json_object_options_are_checked_naming_the_option():
         parse_json_object("{crowding}", "--env-kwargs", "constructor arguments")
     with pytest.raises(SystemExit, match="--vision: must be a JSON object of VisionParams fields"):
         parse_json_object("[1, 2]", "--vision", "VisionParams fields")
+
+
+def test_grid_vergence_and_the_fixation_stage_over_several_postures():
+    from visuomotor_gym.static_gaze import search
+
+    depth = {"vision_params": {"depth_pedestal_arcmin": 10.0}}
+    tiny = {"coarse_step": 90.0, "coarse_episodes": 1, "final_episodes": 1, "refine_steps": (), "finalists": 2,
+            "neck_step": 0.0}
+    record = search("EyeCatch-v0", "eyecatch", env_kwargs=depth, fixations=(4.0,), grid_fixation=0.8,
+                    fixation_top=2, **tiny)
+    grid = {p["fix"] for p in record["postures"] if p["stage"] != "fixation"}
+    assert grid == {0.8} and record["rules"]["grid_fixation_m"] == 0.8
+    stage = next(s for s in record["stages"] if s["name"] == "fixation")
+    assert len(stage["around_all"]) == 2 and stage["postures"] == 2  # both finalists tried at 4 m
+    verged = {(p["az"], p["el"]) for p in record["postures"] if p["stage"] == "fixation"}
+    assert len(verged) == 2
+    with pytest.raises(ValueError, match="grid_fixation"):
+        search("EyeCatch-v0", "eyecatch", grid_fixation=100.0, **tiny)
+    with pytest.raises(ValueError, match="fixation_top"):
+        search("EyeCatch-v0", "eyecatch", fixation_top=0, **tiny)

@@ -6,6 +6,7 @@ its foothold gaze on it, and the static posture search takes the env's arguments
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 
 import gymnasium as gym
 import numpy as np
@@ -17,6 +18,7 @@ from visuomotor_gym.static_gaze import main as static_gaze_main
 from visuomotor_gym.static_gaze import registered_kwargs
 from visuomotor_gym.tasks.obstacle_walk import (
     BOX,
+    DENSE_ROUGH_COURSE,
     K_SLOTS,
     MAT,
     N_POINTS,
@@ -77,8 +79,21 @@ def test_overlap_against_a_hand_computed_case():
     assert not _overlap(0.3, 0.2, -0.6, 0.2, row)
 
 
-def test_rough_courses_follow_their_geometry():
-    d = ROUGH_COURSE
+def test_the_dense_preset_is_the_rough_course_with_hazards_every_045_to_08_m():
+    assert replace(ROUGH_COURSE, rough_step_m=(0.45, 0.8)) == DENSE_ROUGH_COURSE
+    assert ObstacleWalkEnv(course_distribution="rough_dense").course_distribution == DENSE_ROUGH_COURSE
+    from visuomotor_gym.agents import make_agent
+
+    with registered_kwargs("ObstacleWalk-v0", {"course_distribution": "rough_dense"}):
+        assert make_agent("iwao", "ObstacleWalk-v0", 8, seed=0).params.gaze_mode == "footholds"
+    # denser: more hazards per course than the rough preset's, seeds 0-59
+    n = {d: sum(len(sample_course(np.random.default_rng(s), d, 16).obstacles) for s in range(60))
+         for d in (ROUGH_COURSE, DENSE_ROUGH_COURSE)}
+    assert n[DENSE_ROUGH_COURSE] > 1.05 * n[ROUGH_COURSE]
+
+
+@pytest.mark.parametrize("d", [ROUGH_COURSE, DENSE_ROUGH_COURSE], ids=["rough", "rough_dense"])
+def test_rough_courses_follow_their_geometry(d):
     half = 0.5 * d.walkway_width_m
     counts = []
     for seed in range(60):
@@ -273,3 +288,31 @@ def test_iwao_crosses_the_rough_course_under_the_human_periphery_and_its_held_tw
             results[spec] = bool(run_episode(env, policy, seed=seed, env_id="ObstacleWalk-v0", agent=spec).success)
         env.close()
     assert results == {"iwao": True, "gaze_blind:iwao": False}
+
+
+@pytest.mark.parametrize("ecc_deg", [5.0, 25.0])
+def test_the_memory_weights_a_peripheral_sample_as_shared_under_disarray(ecc_deg):
+    """Hand-computed: with positional disarray (share s) a sample's lateral information is divided by
+    1 + (K - 1) w, K = DISARRAY_LOOKS looks sharing one retinal place and w = s (1 - 1/f^2) the fixed
+    share of its lateral variance, f = 1 + theta / 0.7 deg the position law's growth (Hess & Field 1993;
+    VisionParams.position_disarray). The eye at 1.6 m looks level along x; the point lies ``ecc_deg`` below
+    the line of sight, 0.15 m above the floor: its lateral y axis is across the line of sight, so the
+    information matrix's yy entry is the sample's 1 / s_lat^2."""
+    import math
+
+    from visuomotor_gym.baselines.iwao.perception import DISARRAY_LOOKS, ObstacleMemory
+
+    from visuomotor_gym.vision.foveation import human_periphery
+
+    t = math.radians(ecc_deg)
+    d = 1.45 / math.sin(t)  # on the plane 0.15 m above the floor (the memory's first guess of a top)
+    p_eye = (d * math.cos(t), 0.0, -d * math.sin(t))  # eccentricity t from the eye's x axis
+    eye, rot, odo = [0.0, 0.0, 0.6], np.eye(3).tolist(), (0.0, 0.0, 0.0, 1.0)
+    info = {}
+    for share in (0.0, 0.8):
+        mem = ObstacleMemory(human_periphery(position_disarray=share), height_prior=(0.06, 0.1))
+        mem.add(0, 0, p_eye, eye, rot, odo, vergence=d)
+        info[share] = mem.corners[0][0].info[3]
+    f = 1.0 + math.degrees(t) / 0.7
+    w = 0.8 * (1.0 - 1.0 / f**2)
+    assert info[0.0] / info[0.8] == pytest.approx(1.0 + (DISARRAY_LOOKS - 1) * w, rel=1e-9)

@@ -384,10 +384,11 @@ def _grid(lo: float, hi: float, step: float) -> list[float]:
     return [k * step for k in range(math.ceil(lo / step), math.floor(hi / step) + 1)]
 
 
-def _los_posture(az: float, el: float, geometry: EyeGeometry) -> Posture | None:
-    """The posture of a line of sight with the neck along it, or None if the eye cannot hold it."""
+def _los_posture(az: float, el: float, geometry: EyeGeometry, fix: float = DEFAULT_FIXATION_M) -> Posture | None:
+    """The posture of a line of sight with the neck along it (vergence ``fix`` m), or None if the eye
+    cannot hold it."""
     ny, npitch = neck_along(az, el, geometry)
-    posture = Posture(float(az), float(el), float(ny), float(npitch))
+    posture = Posture(float(az), float(el), float(ny), float(npitch), float(fix))
     try:
         return check_posture(posture, geometry)
     except ValueError:
@@ -484,7 +485,8 @@ class _Scorer:
 def search(env_id: str, agent: str, *, design_seed: int = DESIGN_SEED, coarse_episodes: int = COARSE_EPISODES,
            final_episodes: int = FINAL_EPISODES, coarse_step: float = 20.0, refine_steps=(10.0, 5.0),
            refine_top: int = 3, finalists: int = 5, neck_step: float = 20.0, postures=None,
-           command: str | None = None, log=None, env_kwargs: dict | None = None, fixations=None) -> dict:
+           command: str | None = None, log=None, env_kwargs: dict | None = None, fixations=None,
+           grid_fixation: float | None = None, fixation_top: int = 1) -> dict:
     """Search the best static posture of ``agent`` on ``env_id``; returns the results record.
 
     Every posture is played with :func:`visuomotor_gym.bench.evaluate.run_chunk` in ``evaluate()``'s
@@ -504,7 +506,13 @@ def search(env_id: str, agent: str, *, design_seed: int = DESIGN_SEED, coarse_ep
        within the eye's fixation range), on ``final_episodes`` seeds. ``fixations=None`` (default):
        :data:`FIXATION_GRID_M` when the env's vision has the depth law (``depth_pedestal_arcmin``: depth
        precision then depends on the vergence distance, so the static twin's vergence is part of what is
-       searched), else none (vergence changes no sample); ``()``: none.
+       searched), else none (vergence changes no sample); ``()``: none. With ``fixation_top`` > 1 the
+       ``fixation_top`` best postures so far each get this stage (targets near the eye: a posture that
+       is poor at the grid's vergence may be the best at another).
+
+    ``grid_fixation`` (m; default :data:`DEFAULT_FIXATION_M`): the vergence of every posture of stages
+    1-4 (set it near the family's targets when they lie far from 2 m, e.g. a shelf or a wall at arm's
+    length, so that the line of sight is not chosen at a vergence no static eye would keep).
 
     A posture stops early once it cannot reach the score that selection needs (stages 1-2: the
     ``max(refine_top, finalists)``-th best on ``coarse_episodes`` seeds; 3-4: the best on
@@ -521,7 +529,8 @@ def search(env_id: str, agent: str, *, design_seed: int = DESIGN_SEED, coarse_ep
         record = _search(env_id, agent, design_seed=design_seed, coarse_episodes=coarse_episodes,
                          final_episodes=final_episodes, coarse_step=coarse_step, refine_steps=refine_steps,
                          refine_top=refine_top, finalists=finalists, neck_step=neck_step, postures=postures,
-                         command=command, log=log, fixations=fixations)
+                         command=command, log=log, fixations=fixations, grid_fixation=grid_fixation,
+                         fixation_top=fixation_top)
     if env_kwargs:
         record["env_kwargs"] = dict(env_kwargs)
     return record
@@ -529,7 +538,8 @@ def search(env_id: str, agent: str, *, design_seed: int = DESIGN_SEED, coarse_ep
 
 def _search(env_id: str, agent: str, *, design_seed: int, coarse_episodes: int, final_episodes: int,
             coarse_step: float, refine_steps, refine_top: int, finalists: int, neck_step: float, postures,
-            command: str | None, log, fixations=None) -> dict:
+            command: str | None, log, fixations=None, grid_fixation: float | None = None,
+            fixation_top: int = 1) -> dict:
     from visuomotor_gym.bench.evaluate import check_env_id
     from visuomotor_gym.bench.provenance import provenance
 
@@ -538,7 +548,12 @@ def _search(env_id: str, agent: str, *, design_seed: int, coarse_episodes: int, 
         raise ValueError(f"search takes an agent with its own gaze, got {agent!r}")
     if not 1 <= coarse_episodes <= final_episodes:
         raise ValueError(f"need 1 <= coarse_episodes <= final_episodes, got {coarse_episodes}, {final_episodes}")
+    if fixation_top < 1:
+        raise ValueError(f"fixation_top must be >= 1, got {fixation_top}")
     geometry = env_geometry(env_id)
+    gfix = DEFAULT_FIXATION_M if grid_fixation is None else float(grid_fixation)
+    if not geometry.fixation_m[0] <= gfix <= geometry.fixation_m[1]:
+        raise ValueError(f"grid_fixation must lie in the eye's fixation range {list(geometry.fixation_m)} m, got {gfix}")
     origin = provenance(command)  # the code that runs (taken before, not after, a long search)
     started = time.perf_counter()
     scorer = _Scorer(env_id, agent, design_seed, log=log)
@@ -552,7 +567,7 @@ def _search(env_id: str, agent: str, *, design_seed: int, coarse_episodes: int, 
             stages.append({"name": "explicit", "episodes": final_episodes, "postures": len(final)})
         else:
             coarse = [p for el in _grid(*geometry.los_el_deg, coarse_step) for az in _grid(*geometry.los_az_deg, coarse_step)
-                      if (abs(el) < 90.0 or az == 0.0) and (p := _los_posture(az, el, geometry)) is not None]
+                      if (abs(el) < 90.0 or az == 0.0) and (p := _los_posture(az, el, geometry, gfix)) is not None]
             coarse.sort(key=lambda p: (p.distance_from_ahead_deg(), p.az, p.el))
             for p in coarse:
                 scorer.play(p, coarse_episodes, "coarse", bar=scorer.bar(coarse_episodes, keep),
@@ -568,7 +583,7 @@ def _search(env_id: str, agent: str, *, design_seed: int, coarse_episodes: int, 
                 for c in centres:
                     for daz in (-step, 0.0, step):
                         for dele in (-step, 0.0, step):
-                            p = _los_posture(c.az + daz, c.el + dele, geometry)
+                            p = _los_posture(c.az + daz, c.el + dele, geometry, gfix)
                             if p is not None and p not in scorer.results and p not in new:
                                 new.append(p)
                 for p in new:
@@ -588,7 +603,7 @@ def _search(env_id: str, agent: str, *, design_seed: int, coarse_episodes: int, 
             necks = []
             for ny in sorted({ny0 + k for k in offsets}):
                 for npitch in sorted({np0 + k for k in offsets}):
-                    p = Posture(best.az, best.el, float(ny), float(npitch))
+                    p = Posture(best.az, best.el, float(ny), float(npitch), gfix)
                     try:
                         check_posture(p, geometry)
                     except ValueError:
@@ -604,15 +619,19 @@ def _search(env_id: str, agent: str, *, design_seed: int, coarse_episodes: int, 
             final = best_coarse + necks
             if fixations is None:
                 fixations = FIXATION_GRID_M if vision_has_depth_law(env_id) else ()
-            best = scorer.rank(final, final_episodes)[0]
+            tops = scorer.rank(final, final_episodes)[:fixation_top]
+            best = tops[0]
             lo, hi = geometry.fixation_m
-            verged = [p for p in (replace(best, fix=float(f)) for f in fixations if lo <= f <= hi)
-                      if p not in scorer.results]
+            verged = []
+            for top in tops:
+                verged += [p for p in (replace(top, fix=float(f)) for f in fixations if lo <= f <= hi)
+                           if p not in scorer.results and p not in verged]
             for p in verged:
                 scorer.play(p, final_episodes, "fixation", bar=scorer.bar(final_episodes, 1),
                             race=scorer.best_rate(final_episodes))
             if fixations:
                 stages.append({"name": "fixation", "episodes": final_episodes, "around": best.as_spec(),
+                               "around_all": [t.as_spec() for t in tops],
                                "fixations_m": [float(f) for f in fixations], "postures": len(verged),
                                "early_stop_rank": 1})
             final = final + verged
@@ -631,7 +650,7 @@ def _search(env_id: str, agent: str, *, design_seed: int, coarse_episodes: int, 
                          "note": "episode i resets with design_seed + i (the common evaluator's rule); disjoint "
                                  "from the pinned evaluation seeds 0-199 and 200-399"},
         "stages": stages,
-        "rules": {"dead_band_deg": DEAD_BAND_DEG, "fixation_m": DEFAULT_FIXATION_M, "fixations_m": list(fixations or ()),
+        "rules": {"dead_band_deg": DEAD_BAND_DEG, "fixation_m": DEFAULT_FIXATION_M, "grid_fixation_m": gfix, "fixations_m": list(fixations or ()),
                   "ties": "higher success, then the line of sight nearer straight ahead, then the neck nearer "
                           "straight ahead, then the vergence nearer fixation_m",
                   "early_stop": "a posture stops once successes + remaining episodes < the score of the "
@@ -779,6 +798,11 @@ def main(argv=None) -> int:
                    help="vergence distances (m) tried at the best posture: 'auto' (the default) tries "
                         f"{','.join(f'{f:g}' for f in FIXATION_GRID_M)} when the env's vision has the depth law, "
                         "'none' tries none, or a comma-separated list")
+    s.add_argument("--grid-fixation", type=float, default=None, metavar="M",
+                   help=f"vergence (m) of the grid, refine, final and neck stages (default {DEFAULT_FIXATION_M:g}); "
+                        "set it near the targets when they lie at arm's length")
+    s.add_argument("--fixation-top", type=int, default=1, metavar="N",
+                   help="how many of the best postures get the vergence stage (default 1)")
     s.add_argument("--quiet", action="store_true")
     p = sub.add_parser("pinned", help="add the pinned-seed evaluation to an existing results JSON")
     p.add_argument("results")
@@ -821,7 +845,8 @@ def main(argv=None) -> int:
                     final_episodes=args.final_episodes, coarse_step=args.coarse_step,
                     refine_steps=tuple(float(x) for x in args.refine_steps.split(",") if x),
                     refine_top=args.refine_top, finalists=args.finalists, neck_step=args.neck_step,
-                    postures=postures, command=command, log=log, env_kwargs=env_kwargs, fixations=fixations)
+                    postures=postures, command=command, log=log, env_kwargs=env_kwargs, fixations=fixations,
+                    grid_fixation=args.grid_fixation, fixation_top=args.fixation_top)
     if args.pinned:
         evaluate_pinned(record, episodes=args.pinned, workers=args.workers)
     out = Path(args.out)

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from visuomotor_gym.vision import periphery
 from visuomotor_gym.vision.foveation import DEG, VisionParams
 
 
@@ -54,8 +55,7 @@ def field_limit_eye(uy, uz, vision: VisionParams):
 def position_e2_rad(vision: VisionParams) -> float:
     """E2 (rad) of the lateral position std: ``position_e2_deg`` when the position law is on, else the
     acuity law's ``fovea_e2_deg`` (``periphery.position_factor``)."""
-    e2 = vision.position_e2_deg if vision.position_e2_deg is not None else vision.fovea_e2_deg
-    return e2 * DEG
+    return periphery.position_e2_deg(vision) * DEG
 
 
 __all__ = ["field_limit", "field_limit_eye", "position_e2_rad"]

@@ -59,6 +59,10 @@ from .kalman import BallKalmanFilter, KalmanParams
 _S = ObservationLayout().slices
 DEG = math.pi / 180.0
 SHOULDER_WORLD = np.array([0.0, -0.2, 0.9])  # right shoulder at the reset posture
+# Under the positional disarray the first saccade also goes once the ball's retinal std has fallen by
+# less than 10 % over the last 0.1 s (five looks): modelling choices (see EyecatchAgent._first_saccade_due).
+FIRST_SACCADE_PLATEAU = 0.9
+FIRST_SACCADE_PLATEAU_S = 0.1
 
 
 @dataclass(frozen=True)
@@ -234,6 +238,7 @@ class EyecatchAgent:
         self.t = 0.0
         self.started = False
         self.first_saccade_released = False
+        self._std_history: list[tuple[float, float]] = []  # (t, retinal std): the first saccade's plateau
         self.next_update = math.inf
         self.proactive = False
         self.grasp = False
@@ -346,7 +351,21 @@ class EyecatchAgent:
             return False
         if t >= p.first_saccade_deadline_s - 1e-9:
             return True
-        return self._retinal_std(delay + p.saccade_lead_s) < p.first_saccade_retinal_std_deg * DEG
+        std = self._retinal_std(delay + p.saccade_lead_s)
+        if std < p.first_saccade_retinal_std_deg * DEG:
+            return True
+        if self.vision.position_disarray > 0.0 and math.isfinite(std):
+            # With the positional disarray more looks from the same retinal place reduce little of the
+            # error: release once the estimate has stopped improving (less than FIRST_SACCADE_PLATEAU in
+            # FIRST_SACCADE_PLATEAU_S; modelling choice: Eyecatch 4.1's "significance" is then reached
+            # as far as this place of the retina can give it).
+            self._std_history.append((t, std))
+            while self._std_history and self._std_history[0][0] < t - FIRST_SACCADE_PLATEAU_S - 0.25 * self.dt:
+                self._std_history.pop(0)
+            t0, s0 = self._std_history[0]
+            if t - t0 >= FIRST_SACCADE_PLATEAU_S - 0.25 * self.dt and std > FIRST_SACCADE_PLATEAU * s0:  # float32 times
+                return True
+        return False
 
     def _fuse(self, obs: np.ndarray) -> None:
         rot, eye = self.pose_history[0] if self.delay_steps else self.pose_history[-1]

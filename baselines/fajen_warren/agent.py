@@ -412,8 +412,18 @@ class FajenWarrenAgent:
                 continue
             ecc = math.acos(max(-1.0, min(1.0, pe[0] / d)))
             lateral_speed = math.sqrt(max(ve[0] ** 2 + ve[1] ** 2 + ve[2] ** 2 - (sum(a * b for a, b in zip(pe, ve)) / d) ** 2, 0.0))
+            # Every std is proportional to the *true* distance: under the depth law depth noise can put a
+            # sample far nearer than the pedestrian, and its lateral stds taken at the sample's own distance
+            # would then be far too small; the larger of the sample's and the estimate's distance is used
+            # (as eyecatch's noise point does; modelling choice, only with the periphery).
+            d_noise = d
+            f = self.filters[k]
+            if self.vision.periphery_on and f.known:
+                ex_w = odo[0] + c * eye_pos[0] - s * eye_pos[1]
+                ey_w = odo[1] + s * eye_pos[0] + c * eye_pos[1]
+                d_noise = max(d, math.hypot(f.x[0] - ex_w, f.x[1] - ey_w))
             # vergence: the depth law; control_dt: the positional disarray sized for a stream of looks
-            sig = believed_sigmas(d, ecc, lateral_speed / d, self.vision, ol[_FIXATION], self.params.control_dt)
+            sig = believed_sigmas(d_noise, ecc, lateral_speed / d, self.vision, ol[_FIXATION], self.params.control_dt)
             if k in pooled:
                 zone = crowd_std(d, ecc, self.vision)
                 sig = (max(sig[0], zone), max(sig[1], zone), max(sig[2], zone)) + tuple(sig[3:])

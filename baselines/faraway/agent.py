@@ -147,8 +147,11 @@ class FarawayAgent:
         self.info = np.eye(3) * self.weight_sum
         self.info_vec = self.info @ self.prior_mean
         self.depth_samples: list[tuple[np.ndarray, np.ndarray, float, float, float]] = []
+        self._reference = 0  # the kept sample whose line of sight the candidates run along (least lateral std)
+        self._reference_std = math.inf
         self._cached: tuple[np.ndarray, float] | None = None
         self.prev_rot: np.ndarray | None = None
+        self.prev_eye: np.ndarray | None = None
         self.poses: deque = deque(maxlen=self.delay_steps + 1)
         self.saccade_time: float | None = None  # when the first saccade to the object was commanded
         self.search_index = 1  # the gaze starts on tower 0
@@ -242,21 +245,33 @@ class FarawayAgent:
             u_eye = -u_eye
         u = rot @ u_eye
         ecc = math.acos(max(-1.0, min(1.0, float(u_eye[0]))))
-        lateral_std = float(foveation.standard_deviations(FAR_SHELF_M, ecc, retinal_speed, self.vision)[1])
+        # dt: under the positional disarray (VisionParams.position_disarray) a stream of looks at one place of
+        # the retina shares its fixed error, so each look counts for less (foveation.believed_sigmas; no effect
+        # without the disarray).
+        lateral_std = float(foveation.believed_sigmas(FAR_SHELF_M, ecc, retinal_speed, self.vision, None, self.dt)[1])
+        # The line of sight is the eye-to-sample ray, whose angle errs by the lateral error over the sample's
+        # distance: a sample that depth noise put near the eye (|s| << d) has no direction to speak of.
+        # At the object's distance d <= FAR_SHELF_M the ray is off by d * (d k) / |s| <= lateral_std * FAR / |s|
+        # (k: the angular lateral std), so the lateral std grows by FAR_SHELF_M / |s| below FAR_SHELF_M.
+        lateral_std *= max(1.0, FAR_SHELF_M / dist)
         w = (np.eye(3) - np.outer(u, u)) / max(lateral_std, 1e-9) ** 2
         point = eye + rot @ pos_eye
         self.info += w
         self.info_vec += w @ point
         self.depth_samples.append((eye.copy(), u, float(u @ (point - eye)), ecc, float(fixation)))
+        if lateral_std <= self._reference_std:  # the surest line of sight so far (ties: the latest)
+            self._reference, self._reference_std = len(self.depth_samples) - 1, lateral_std
         self.samples += 1
         self._cached = None
 
     def _depth_law_estimate(self) -> tuple[np.ndarray, float]:
         """(estimate, std) with the depth law: the posterior over candidate points, one per distance.
 
-        The candidates ``c(lam) = c0 + lam g`` are, for each distance ``lam`` along the latest sample's line
-        of sight ``u0`` from its eye ``e0`` (``lam`` on ``_DEPTH_GRID``, flat prior: the object is on the
-        shelves), the point that best fits the lateral information at that distance (the minimum of the
+        The candidates ``c(lam) = c0 + lam g`` are, for each distance ``lam`` along the line of sight ``u0``
+        from the eye ``e0`` of the kept sample with the least lateral std (the surest direction; ties: the
+        latest. The latest sample's ray, taken before, may be one that depth noise put near the eye, tens
+        of degrees off, and then no candidate lies near the object: seed 73 under ``human_periphery()``)
+        (``lam`` on ``_DEPTH_GRID``, flat prior: the object is on the shelves), the point that best fits the lateral information at that distance (the minimum of the
         lateral quadratic under a stiff constraint ``u0 . (c - e0) = lam``, which is linear in ``lam``).
         A candidate's log-posterior is the lateral quadratic plus, for each kept sample ``i`` (eye ``e_i``,
         line of sight ``u_i``, measured distance ``s_i``), ``log N(s_i; u_i . (c - e_i), sigma_i(c)^2)``
@@ -272,7 +287,7 @@ class FarawayAgent:
         if not self.depth_samples:
             self._cached = (lateral, float(math.sqrt(max(np.linalg.eigvalsh(np.linalg.inv(self.info))[-1], 0.0))))
             return self._cached
-        e0, u0 = self.depth_samples[-1][0], self.depth_samples[-1][1]
+        e0, u0 = self.depth_samples[self._reference][0], self.depth_samples[self._reference][1]
         kappa = 1e4 * float(np.trace(self.info))
         A = self.info + kappa * np.outer(u0, u0)
         c0 = np.linalg.solve(A, self.info_vec + kappa * u0 * float(u0 @ e0))
@@ -318,11 +333,13 @@ class FarawayAgent:
         if not self.started:
             self.started = True
             self.home = hand.copy()
-        # The eye's turn since the last step (rad/s): the static object's retinal slip (depth-law fusion).
+        # The static object's retinal slip over the last step (rad/s; depth-law fusion), as the retina
+        # computes it (``core.eye.Eye.retinal_speed``) with the object at the current estimate.
         turn = 0.0
         if self.prev_rot is not None:
-            turn = float(np.linalg.norm(np.cross(self.prev_rot[:, 0], rot[:, 0]))) / self.dt
+            turn = self._retinal_slip(rot, eye)
         self.prev_rot = rot.copy()
+        self.prev_eye = eye.copy()
         self.poses.append((rot.copy(), eye.copy(), float(obs[_S["fixation"]][0]), turn))
         if obs[_S["object_visible"]][0] > 0.5 and len(self.poses) == self.delay_steps + 1:
             r0, e0, f0, w0 = self.poses[0]  # the eye pose (and vergence) when the sample was taken
@@ -380,6 +397,22 @@ class FarawayAgent:
                 target = np.array([np.interp(tau * (n - 1), np.arange(n), path[:, k]) for k in range(3)])
             grasp = tau >= p.grasp_at_tau
         return hand_action(target + SEAT_ORIGIN, grasp, gaze, head, fixation, self.gaze_range)
+
+    def _retinal_slip(self, rot: np.ndarray, eye: np.ndarray) -> float:
+        """Speed (rad/s) of the static object's image on the retina over the last step: the angular
+        velocity of its line of sight, from the eye's own translation (the head's turn carries the eye,
+        which sits off the neck's axes), minus the gaze's angular velocity, perpendicular to the line of
+        sight; the object taken at the current estimate (before the first sample: the prior's centre).
+        Counting the gaze's turn alone misses the translation: a head turn with the gaze held in the body
+        frame slips a shelf object 0.7 m away by ~50 deg/s (seed 78 under ``human_periphery()``)."""
+        r = self.estimate() - eye
+        dist2 = max(float(r @ r), 1e-6)
+        rel_vel = -(eye - self.prev_eye) / self.dt  # the object's velocity relative to the eye
+        los = np.cross(r, rel_vel) / dist2
+        gaze = np.cross(self.prev_rot[:, 0], rot[:, 0]) / self.dt
+        slip = los - gaze
+        slip = slip - (slip @ r) / dist2 * r
+        return float(np.linalg.norm(slip))
 
     def _beyond_dead_zone(self, angle: float, k: int) -> float:
         """Head angle (rad) that leaves at most the dead zone to the eye (Eyecatch Eq. 17), within the neck's range."""

@@ -470,7 +470,9 @@ def _registered_course_is_rough(env_id: str) -> bool:
     except gym.error.Error:
         return False
     if isinstance(course, str):
-        return course == "rough"
+        from visuomotor_gym.tasks.obstacle_walk import COURSE_PRESETS
+
+        return course in COURSE_PRESETS and COURSE_PRESETS[course].rough
     if isinstance(course, dict):
         return course.get("layout") == "rough"
     return isinstance(course, CourseDistribution) and course.rough

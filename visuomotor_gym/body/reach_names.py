@@ -23,6 +23,11 @@ PANELS = tuple(f"panel_{t}" for t in TOWER_KEYS)
 OBJECT = "reach_object"
 OBJECT_GEOM = "reach_object"
 
+# The shelf clutter: 29 distractors (one for each other target), mocap bodies with one cylinder geom each
+# (body and geom share the name), parked below the floor while unused.
+N_DISTRACTORS = 29
+DISTRACTORS = tuple(f"reach_distractor_{i:02d}" for i in range(N_DISTRACTORS))
+
 # Cameras (the eye camera comes with the head fragment: visuomotor_gym.body.names.EYE_CAMERA).
 SCENE_CAMERA = "scene_camera"
 OVER_SHOULDER_CAMERA = "over_shoulder"
@@ -30,7 +35,7 @@ TOP_CAMERA = "top_camera"
 CAMERAS = (SCENE_CAMERA, OVER_SHOULDER_CAMERA, TOP_CAMERA)
 
 ALL_NAMES = {
-    "body": (*TOWERS, OBJECT),
-    "geom": BOARDS + PANELS + (OBJECT_GEOM,),
+    "body": (*TOWERS, OBJECT, *DISTRACTORS),
+    "geom": BOARDS + PANELS + (OBJECT_GEOM, *DISTRACTORS),
     "camera": CAMERAS,
 }

@@ -229,22 +229,21 @@ class Retina:
         out = [nothing() for _ in targets]
         draw = foveation._draw_at
         fixation = eye.fixation
-        fixed = None
-        if self._disarray is not None and seen:  # the field at every seen point's place, in one go
-            eccs, polars = [], []
-            for _, (x, y, z), _, _, _ in seen:
-                d = math.sqrt(x * x + y * y + z * z)
-                eccs.append(math.acos(max(-1.0, min(1.0, x / d))) if d > 0.0 else 0.0)
-                polars.append(math.atan2(z, y))
-            fixed = self._disarray.values(eccs, polars).T.tolist()
-        for k, (i, (x, y, z), vel_eye, slip, _) in enumerate(seen):
-            # A look at the (pooled) point, as foveation.perceive draws it once it is known to be seen
-            # (a pooled point may lie just outside the field that holds its target: still seen).
+        # A look at each (pooled) point, as foveation.perceive draws it once it is known to be seen (a
+        # pooled point may lie just outside the field that holds its target: still seen): its distance and
+        # eccentricity, then the disarray field at every point's place in one go (when the eye has it).
+        looks = []
+        for _, (x, y, z), _, _, _ in seen:
             d = math.sqrt(x * x + y * y + z * z)
+            looks.append((d, math.acos(max(-1.0, min(1.0, x / d))) if d > 0.0 else 0.0))
+        fixed = None
+        if self._disarray is not None and seen:
+            fixed = self._disarray.values([e for _, e in looks], [math.atan2(p[2], p[1]) for _, p, *_ in seen]).T.tolist()
+        for k, (i, (x, y, z), vel_eye, slip, _) in enumerate(seen):
+            d, ecc = looks[k]
             if d <= 0.0:
                 out[i] = ([x, y, z], list(vel_eye), True)
                 continue
-            ecc = math.acos(max(-1.0, min(1.0, x / d)))
             p, v = draw(x, y, z, d, ecc, vel_eye, slip, vp, rng, fixation, None if fixed is None else fixed[k])
             out[i] = (p, v, True)
         return out

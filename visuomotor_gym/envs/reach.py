@@ -33,8 +33,18 @@ from visuomotor_gym.tasks.reach import (
     TIME_BLOCK,
     ReachTask,
 )
+from visuomotor_gym.vision.foveation import human_periphery
 
-__all__ = ["ShelfReachEnv", "reach_observation"]
+__all__ = ["REACH_VISION", "ShelfReachEnv", "reach_observation"]
+
+# The human periphery (vision.foveation.HUMAN_PERIPHERY: the human field of Spector 1990, the position law
+# E2 0.7 deg, crowding b = 0.5 after Bouma 1970, the depth pedestal 10 arcmin), in place of the catch
+# family's +-60 deg field with the acuity law alone.
+REACH_VISION = human_periphery()
+# Full shelves: every other target holds a distractor of the object's kind (modelling choice: a stocked shelf,
+# as a cupboard a person fetches one cup from; with the object alone the periphery's position law already
+# guides a reach from a still eye -- docs/reproductions/faraway.md).
+SHELF_CLUTTER = reach_names.N_DISTRACTORS
 
 REWARD_MODES = ("sparse", "shaped")
 RENDER_CAMERAS = ("both", "scene", "eye", "over_shoulder", "top")
@@ -56,9 +66,16 @@ class ShelfReachEnv(VisuomotorEnv):
     layout of Faraway, Reed & Wang (2007), whose Bézier model of human hand paths is the
     realism reference of this family (``visuomotor_gym.handpath``). The object is seen **only through
     the eye**: its position reaches the agent as samples of the foveated noise model (Eyecatch Eq. 1-3;
-    depth noise 5 % of the distance at the fovea, growing with eccentricity), nothing outside the
-    +-60 deg field of view or during a saccade. The gaze starts on the front tower, so an accurate
-    reach needs a saccade (and for the right-hand tower a head turn) to the object first.
+    depth noise 5 % of the distance at the fovea, growing with eccentricity), nothing during a saccade,
+    with the **human periphery** (``vision.foveation.human_periphery``): the human field (60 deg up, 75
+    down, 100 to each side; Spector 1990), position precision falling with eccentricity (E2 0.7 deg after
+    Levi, Klein & Aitsebaomo 1985), crowding (Bouma 1970) and depth precise only near the vergence
+    distance (the fixation action). The shelves are **full**: the other 29 targets each hold a distractor,
+    a cylinder of the object's size (``shelf_clutter``), which the eye sees as objects of the same kind,
+    so that in the periphery crowding pools them with the object (a sample at the mean of the group);
+    the observation carries the object's sample only (the agent knows which object it fetches). The gaze
+    starts on the front tower; a saccade (and for the right-hand tower a head turn) to the object makes
+    its position and depth precise.
 
     Physics 500 Hz, control 50 Hz. The observability ladder (Oracle, FullView, foveated, Delayed,
     PoorVision) is keyword arguments of this class (``visuomotor_gym.registration``).
@@ -95,9 +112,11 @@ class ShelfReachEnv(VisuomotorEnv):
     The body sits upright with the hand at its home posture, in front of the belly near the midline
     (~(0.32, -0.05, 0.74) m: the seated analogue of Faraway et al.'s home shelf). The target is drawn
     uniformly from the 30, with a +-1 cm jitter on its board; the gaze starts on the front tower's middle
-    level between its two depths, with a 2 deg Gaussian jitter. The same seed gives the same target on
-    every rung of the ladder. ``info`` at reset: ``target_index`` (0-29: tower-major, then level, then
-    depth), ``tower``, ``level``, ``depth``, ``object_pos``, ``hand_home``.
+    level between its two depths, with a 2 deg Gaussian jitter. Then ``shelf_clutter`` of the other 29
+    targets (all of them by default) are drawn to hold a distractor, at the target's centre. The same seed
+    gives the same target and the same distractors on every rung of the ladder, and the same target for
+    any ``shelf_clutter``. ``info`` at reset: ``target_index`` (0-29: tower-major, then level, then
+    depth), ``tower``, ``level``, ``depth``, ``object_pos``, ``hand_home``, ``distractor_indices``.
 
     ## Episode End
 
@@ -105,8 +124,10 @@ class ShelfReachEnv(VisuomotorEnv):
     ``reach_radius`` of the catch site with the fingers closed beyond ``grasp_closed_fraction`` and the
     hand slower than ``arrival_speed_m_s``; on a **panel touch** (``info["panel_hit"]``: any contact between
     the body and a tower's back panel, checked every physics substep); or on a physics divergence.
-    Truncated by the registered ``max_episode_steps`` (150 steps = 3 s). The boards under the objects are
-    seen but not touched (see ``envs_assets/README.md``, ShelfReach).
+    Truncated by the registered ``max_episode_steps`` (150 steps = 3 s). The boards under the objects and
+    the distractors are seen but not touched: the hand passes through a distractor (modelling choice: the
+    task is to find and reach the object, not to avoid its neighbours; see ``envs_assets/README.md``,
+    ShelfReach).
 
     ## Arguments
 
@@ -114,7 +135,16 @@ class ShelfReachEnv(VisuomotorEnv):
 
     ## Version History
 
-    * v0: initial release.
+    * v0: initial release. Redefined in place: the eye has the human periphery (``human_periphery()``)
+      instead of the +-60 deg field with the acuity law alone (``vision_params=VisionParams()`` gives the
+      former eye). On the pinned seeds 0-199 faraway reaches 100 %, its held twin 82.5 % and the best
+      static posture of the eye 99.0 % (docs/reproductions/faraway.md). Former leaderboard entries are
+      superseded.
+    * v0: redefined in place again: full shelves (``shelf_clutter=29``: a distractor of the object's size
+      on each of the other 29 targets, crowding pools them with the object in the periphery;
+      ``shelf_clutter=0`` gives the scene above). The same seed draws the same object as before. On the
+      pinned seeds 0-199 faraway reaches 99.5 %, its held twin 23.5 % and the best static posture 29.0 %:
+      gaze gain +70.5 (docs/reproductions/faraway.md). Former leaderboard entries are superseded.
     """
 
     render_cameras: ClassVar[dict[str, tuple[str, ...]]] = {
@@ -126,6 +156,7 @@ class ShelfReachEnv(VisuomotorEnv):
     }
     eye_camera = names.EYE_CAMERA
 
+    vision_defaults = REACH_VISION
     reward_terms = REWARD_TERMS
     scene = reach_names.SCENE
     argument_meanings = {  # noqa: RUF012  (read only: the generated Arguments table)
@@ -138,6 +169,11 @@ class ShelfReachEnv(VisuomotorEnv):
         "grasp_closed_fraction": "finger closure above which the hand counts as closed",
         "arrival_speed_m_s": ("the hand must be slower than this (m/s) to count as arrived (modelling choice: "
                               "arriving, not sweeping past)"),
+        "vision_params": ("``VisionParams`` or a dict of its fields; the default is the human periphery "
+                          "(``vision.foveation.human_periphery()``: human field, position law, crowding, depth law)"),
+        "shelf_clutter": ("how many of the other 29 targets hold a distractor (a cylinder of the object's size, seen "
+                          "as a target of its kind: crowding pools it with the object), drawn per episode; 0 gives "
+                          "the former scene with the object alone"),
         "vision": '``"foveated"``, ``"full_view"`` or ``"oracle"`` (true object position)',
         "render_camera": ('``"both"`` (scene beside eye view), ``"scene"``, ``"eye"``, ``"over_shoulder"``, '
                           '``"top"``'),
@@ -154,6 +190,7 @@ class ShelfReachEnv(VisuomotorEnv):
         reach_radius: float = 0.06,
         grasp_closed_fraction: float = 0.6,
         arrival_speed_m_s: float = 0.5,
+        shelf_clutter: int = SHELF_CLUTTER,
         **shared: Any,
     ):
         self.control = args.choice(control, CONTROL_MODES, "control")
@@ -166,6 +203,7 @@ class ShelfReachEnv(VisuomotorEnv):
                                                low_open=True)
         self.arrival_speed_m_s = args.real(arrival_speed_m_s, "arrival_speed_m_s", low=0.0, high=100.0, low_open=True)
         self.reward_mode = args.choice(reward, REWARD_MODES, "reward")
+        self.shelf_clutter = args.integer(shelf_clutter, "shelf_clutter", low=0, high=reach_names.N_DISTRACTORS)
         super().__init__(render_mode, **shared)
 
     def _default_reward_weights(self) -> dict[str, float]:
@@ -176,7 +214,7 @@ class ShelfReachEnv(VisuomotorEnv):
         task = ReachTask(
             self.model, body, reach_radius=self.reach_radius, grasp_closed_fraction=self.grasp_closed_fraction,
             arrival_speed_m_s=self.arrival_speed_m_s, reward_weights=self.reward_weights, dt=self.dt,
-            visual_delay_s=self.visual_delay_s,
+            visual_delay_s=self.visual_delay_s, clutter=self.shelf_clutter,
         )
         self.hand = body.hand
         return body, task
@@ -228,6 +266,7 @@ FAMILY = Family(
     max_episode_steps=REACH_MAX_EPISODE_STEPS,
     oracle_sees="object",
     body="seated",
+    vision_defaults=REACH_VISION,  # the human periphery (vision.foveation.human_periphery)
     summariser="visuomotor_gym.metrics.reach_realism:reach_summary",
     miss_distance="visuomotor_gym.metrics.reach_realism:closest_distance",
     outcome_labels=("success rate", "time to success (s)", "closest distance, failed reaches (m)"),

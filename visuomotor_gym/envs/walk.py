@@ -184,7 +184,8 @@ class ObstacleWalkEnv(WalkerEnv):
     reward_terms = REWARD_TERMS
     argument_meanings = {  # noqa: RUF012  (read only: the generated Arguments table)
         "course_distribution": ('``CourseDistribution``, dict, or a preset name: ``"walkway"`` (the default) or '
-                                '``"rough"`` (``ROUGH_COURSE``: small hazards on most footholds, opt-in)'),
+                                '``"rough"`` (``ROUGH_COURSE``: small hazards on most footholds, opt-in) or ``"rough_dense"`` '
+                                '(``DENSE_ROUGH_COURSE``: the same, a hazard every 0.45-0.8 m, opt-in)'),
         "vision": ('``"foveated"``, ``"full_view"`` (foveal noise everywhere, no field-of-view limit, no saccadic '
                    'blindness) or ``"oracle"`` (true corners)'),
         "vision_params": ("``VisionParams`` or a dict of its fields; the default is the catch family's except "

@@ -18,7 +18,8 @@ the walker if both kept their velocities) for ``veer_s`` = 1.0 s (the veer in Jo
 ~1 s; REFERENCES.md "(10 %, ~1 s)"), then resumes its course. (In the first definition of v0 ``veer_s`` was
 1.5 s, a modelling choice; docs/reproductions/dodge.md has both.)
 
-**Groups** (opt-in: ``CrowdDistribution.group_size`` other than (1, 1), e.g. the preset ``"groups"``;
+**Groups** (the default: ``CrowdDistribution.group_size`` = (2, 3), the preset ``"groups"``; ``"single"``,
+``group_size=(1, 1)``, gives the first definition's crowds;
 :func:`sample_groups`): the same
 4 pedestrians come as groups (e.g. ``group_size=(2, 3)``: pairs and triads, the commonest groups of
 Moussaid, Perozo, Garnier, Helbing & Theraulaz 2010, PLoS ONE 5:e10047, Fig. 1), one group per onset,
@@ -88,7 +89,7 @@ CROWD_RULES = {
     "veer_s": Num(0.0, 20.0),
     "min_crossing_m": Num(0.0, 200.0),
     "goal_clear_m": Num(0.0, 200.0),
-    # groups (opt-in): whole members per group, at most the episode's pedestrians; spacings of people
+    # groups: whole members per group, at most the episode's pedestrians; spacings of people
     # walking abreast, short of a street's width (modelling choice)
     "group_size": lambda v, name: _group_size(v, name),
     "group_spacing_m": Pair(Num(0.0, 5.0, low_open=True)),
@@ -131,13 +132,14 @@ class CrowdDistribution:
     veer_s: float = 1.0  # Jovancevic, Sullivan & Hayhoe: the veer lasted ~1 s
     min_crossing_m: float = 3.0  # crossing points between this far from the start ...
     goal_clear_m: float = 1.0  # ... and this far before the goal
-    # Groups (opt-in, preset "groups"; (1, 1): every pedestrian alone, the draws of v0). Members per group, uniform over
+    # Groups (the default since ObstacleDodge-v0's redefinition; preset "single", (1, 1): every pedestrian alone,
+    # the first definition's draws). Members per group, uniform over
     # the whole numbers of the range (pairs the commonest group, then triads: Moussaid et al. 2010, Fig. 1),
     # walking abreast (Moussaid et al. 2010: at low density "group members tend to walk side by side,
     # forming a line perpendicular to the walking direction") with this centre-to-centre spacing between
     # neighbours (around the 0.8 m preferred distance d_o of their fitted model, Fig. 4; the range is a
     # modelling choice).
-    group_size: tuple[float, float] = (1.0, 1.0)
+    group_size: tuple[float, float] = (2.0, 3.0)
     group_spacing_m: tuple[float, float] = (0.7, 0.9)
 
     def __post_init__(self) -> None:
@@ -149,8 +151,9 @@ class CrowdDistribution:
         return self.group_size != (1.0, 1.0)
 
 
-# "single": v0's default, every pedestrian alone; "groups": pairs and triads (Moussaid et al. 2010).
-CROWD_PRESETS = {"single": CrowdDistribution(), "groups": CrowdDistribution(group_size=(2.0, 3.0))}
+# "groups": the default, pairs and triads (Moussaid et al. 2010); "single": the first definition's crowds,
+# every pedestrian alone.
+CROWD_PRESETS = {"groups": CrowdDistribution(), "single": CrowdDistribution(group_size=(1.0, 1.0))}
 
 
 @dataclass(frozen=True)

@@ -9,6 +9,12 @@ away from it). Success: the object's centre inside the catch volume (``reach_rad
 catch family) with the fingers closed and the hand nearly still (``arrival_speed_m_s``), before the
 time limit, without touching a tower's back panel (MuJoCo contact). Episodes end on success, on a
 touch, or by the registered step limit.
+
+The shelf clutter (``clutter``: 0-29, the default env has 29): distractors stand on that many of the
+other 29 targets, drawn per episode after the scenario. Each is a cylinder of the object's size, seen by
+the retina as a target of the object's kind, so that crowding (Bouma 1970; compulsory averaging, Parkes
+et al. 2001) pools it with the object in the periphery; the observation still carries only the object's
+sample (the agent knows which object it reaches for, as a person told to fetch "the red cup").
 """
 
 from __future__ import annotations
@@ -105,13 +111,17 @@ FOVEATION_WIDTH_DEG = 5.0  # as the catch family's shaping term
 
 
 class ShelfObject(VisualTarget):
-    """The object on its shelf: a mocap body (still; velocity zero)."""
+    """A still mocap body on the shelves (velocity zero): the object (``body_name`` ``reach_names.OBJECT``,
+    shown from the start) or one distractor of the shelf clutter (a body of the object's size and kind, so
+    crowding pools it with the object: modelling choice; ``hidden``, parked below the floor, until
+    :meth:`place` stands it on a target)."""
 
-    name = "object"
-
-    def __init__(self, model: mujoco.MjModel) -> None:
-        body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, reach_names.OBJECT)
+    def __init__(self, model: mujoco.MjModel, body_name: str = reach_names.OBJECT, name: str = "object",
+                 hidden: bool = False) -> None:
+        body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, body_name)
+        self.name = name
         self.mocap = int(model.body_mocapid[body])
+        self.hidden = hidden
         self._zero = np.zeros(3)
 
     def state(self, data: mujoco.MjData) -> tuple[np.ndarray, np.ndarray]:
@@ -119,6 +129,7 @@ class ShelfObject(VisualTarget):
 
     def place(self, data: mujoco.MjData, position) -> None:
         data.mocap_pos[self.mocap] = position
+        self.hidden = False
 
 
 class ReachTask(Task):
@@ -128,7 +139,8 @@ class ReachTask(Task):
     trace_flag_fields = ("object_visible",)
 
     def __init__(self, model: mujoco.MjModel, body, *, reach_radius: float, grasp_closed_fraction: float,
-                 arrival_speed_m_s: float, reward_weights: dict, dt: float, visual_delay_s: float) -> None:
+                 arrival_speed_m_s: float, reward_weights: dict, dt: float, visual_delay_s: float,
+                 clutter: int = 0) -> None:
         self.model = model
         self.body = body
         self.reach_radius = reach_radius
@@ -138,7 +150,13 @@ class ReachTask(Task):
         self.dt = dt
         self.visual_delay_s = visual_delay_s
         self.object = ShelfObject(model)
-        self.targets = [self.object]
+        # The clutter's distractors follow the object in the retina's target list (the observation reads
+        # only the first sample, the object's); the unused mocap bodies stay parked below the floor.
+        self.clutter = args.integer(clutter, "clutter", low=0, high=reach_names.N_DISTRACTORS)
+        self.distractors = [ShelfObject(model, b, f"distractor_{i:02d}", hidden=True)
+                            for i, b in enumerate(reach_names.DISTRACTORS[: self.clutter])]
+        self.targets = [self.object, *self.distractors]
+        self.distractor_indices: tuple[int, ...] = ()
         self.positions = SHELF_LAYOUT.targets()
         self.home = home_hand_position(model)
         self._panels = {mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, n) for n in reach_names.PANELS}
@@ -157,7 +175,9 @@ class ReachTask(Task):
         self._hand_prev = None
 
     def reset_episode(self, data: mujoco.MjData, rng: np.random.Generator) -> None:
-        """Draw the target (index, jitter) and the initial gaze jitter, in that order, from ``rng``."""
+        """Draw the target (index, jitter) and the initial gaze jitter, in that order, from ``rng``; then,
+        with clutter, which of the other targets hold a distractor (one ``rng.integers`` seeding a generator
+        of its own: the scenario above is the former scene's for the same seed)."""
         self.target_index = int(rng.integers(N_TARGETS))
         jitter = rng.uniform(-TARGET_JITTER_M, TARGET_JITTER_M, 2)
         self.gaze_offset = rng.normal(0.0, GAZE_JITTER_DEG * DEG, 2)
@@ -165,6 +185,19 @@ class ReachTask(Task):
         pos[:2] += jitter
         self.object_pos = pos
         self.object.place(data, pos)
+        self.place_clutter(data, rng)
+
+    def place_clutter(self, data: mujoco.MjData, rng: np.random.Generator) -> None:
+        """Stand the distractors on ``clutter`` of the other targets (uniformly, without replacement), at
+        the targets' centres (no jitter: modelling choice). Draws nothing without clutter."""
+        if not self.clutter:
+            return
+        g = np.random.default_rng(int(rng.integers(2**31)))
+        others = [i for i in range(N_TARGETS) if i != self.target_index]
+        chosen = g.choice(others, self.clutter, replace=False)
+        self.distractor_indices = tuple(int(k) for k in chosen)
+        for d, k in zip(self.distractors, self.distractor_indices):
+            d.place(data, self.positions[k])
 
     def initial_gaze(self) -> tuple[np.ndarray, tuple[float, float]]:
         return self._gaze_point, (float(self.gaze_offset[0]), float(self.gaze_offset[1]))
@@ -172,7 +205,8 @@ class ReachTask(Task):
     def reset_info(self) -> dict:
         tower, level, depth = ShelfLayout.describe(self.target_index)
         return {"target_index": self.target_index, "tower": tower, "level": level, "depth": depth,
-                "object_pos": self.object_pos.copy(), "hand_home": self.home.copy()}
+                "object_pos": self.object_pos.copy(), "hand_home": self.home.copy(),
+                "distractor_indices": self.distractor_indices}
 
     # --- what the evaluator records ----------------------------------------------------------
     def trace_episode_fields(self) -> dict:

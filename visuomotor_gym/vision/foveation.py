@@ -245,8 +245,7 @@ def disarray_looks(eccentricity_rad: float, retinal_speed: float, params: Vision
     ``horizon_s / dt`` (a still image); 1 without the disarray."""
     if params.position_disarray <= 0.0 or not params.foveated:
         return 1.0
-    e2_deg = params.position_e2_deg if params.position_e2_deg is not None else params.fovea_e2_deg
-    span = params.disarray_length * (eccentricity_rad + e2_deg * DEG)
+    span = params.disarray_length * (eccentricity_rad + periphery.position_e2_deg(params) * DEG)
     most = max(1.0, horizon_s / dt)
     speed = abs(retinal_speed)
     return most if speed * most * dt <= span else min(most, 1.0 + span / (speed * dt))
@@ -261,8 +260,7 @@ def believed_sigmas(distance, eccentricity_rad, retinal_speed, params, fixation=
     sig = _sigmas(distance, eccentricity_rad, retinal_speed, params, fixation)
     if dt is None or params.position_disarray <= 0.0 or not params.foveated:
         return sig
-    f = periphery.position_factor(eccentricity_rad, params)
-    w = params.position_disarray * (1.0 - 1.0 / (f * f))
+    w = periphery.disarray_weight(eccentricity_rad, params)
     g = math.sqrt(1.0 + w * (disarray_looks(eccentricity_rad, retinal_speed, params, dt) - 1.0))
     return (sig[0], sig[1] * g, sig[2] * g, sig[3], sig[4], sig[5])
 
@@ -331,8 +329,7 @@ def _draw_at(x, y, z, d, ecc, velocity_eye, retinal_speed, params, rng, fixation
     s0, s1, s2, s3, s4, s5 = _sigmas(d, ecc, retinal_speed, params, fixation)
     e0, e1, e2, e3, e4, e5 = rng.standard_normal(6).tolist()
     if fixed is not None:
-        f = periphery.position_factor(ecc, params)
-        w = params.position_disarray * (1.0 - 1.0 / (f * f))
+        w = periphery.disarray_weight(ecc, params)
         a, c = math.sqrt(w), math.sqrt(1.0 - w)
         e1, e2 = a * fixed[0] + c * e1, a * fixed[1] + c * e2
     n0, n1, n2, n3, n4, n5 = s0 * e0, s1 * e1, s2 * e2, s3 * e3, s4 * e4, s5 * e5

@@ -96,14 +96,19 @@ def in_field(x: float, y: float, z: float, params) -> bool:
 
 
 # --- 2. position law ---------------------------------------------------------------------------
+def position_e2_deg(params) -> float:
+    """E2 (deg) of the lateral position std: ``position_e2_deg`` when the position law is on, else the
+    acuity law's ``fovea_e2_deg``."""
+    return params.position_e2_deg if params.position_e2_deg is not None else params.fovea_e2_deg
+
+
 def position_factor(eccentricity_rad: float, params) -> float:
     """Growth of the lateral position std with eccentricity: ``1 + theta / E2_pos`` with
     ``E2_pos = position_e2_deg`` (position judgements, Levi, Klein & Aitsebaomo 1985); without it the
     acuity law ``1 / alpha(theta) = 1 + theta / fovea_e2_deg``; 1 without foveation."""
     if not params.foveated:
         return 1.0
-    e2_deg = params.position_e2_deg if params.position_e2_deg is not None else params.fovea_e2_deg
-    return 1.0 + eccentricity_rad / (e2_deg * DEG)
+    return 1.0 + eccentricity_rad / (position_e2_deg(params) * DEG)
 
 
 # --- 4. depth and the vergence distance --------------------------------------------------------
@@ -192,6 +197,14 @@ def pooled(vectors, group) -> list[float]:
 
 
 # --- 5. positional disarray --------------------------------------------------------------------
+def disarray_weight(eccentricity_rad: float, params) -> float:
+    """The share ``w = s (1 - 1/f**2)`` of the lateral position variance at this eccentricity that the
+    positional disarray fixes in place (``s = position_disarray``, ``f`` = :func:`position_factor`): ``s``
+    of the variance the periphery adds to the fovea's; 0 at the fovea."""
+    f = position_factor(eccentricity_rad, params)
+    return params.position_disarray * (1.0 - 1.0 / (f * f))
+
+
 #: Random Fourier features per position component of :class:`DisarrayField` (modelling choice: enough
 #: for a near-Gaussian field value, 16 x 2 cosines per seen point and step).
 DISARRAY_FEATURES = 16
@@ -214,8 +227,7 @@ class DisarrayField:
         self.m = np.rint(rng.normal(0.0, scale, (2, features, 1)))
         self.b = rng.uniform(0.0, 2.0 * math.pi, (2, features, 1))
         self.amplitude = math.sqrt(2.0 / features)
-        e2_deg = params.position_e2_deg if params.position_e2_deg is not None else params.fovea_e2_deg
-        self.theta_0 = e2_deg * DEG
+        self.theta_0 = position_e2_deg(params) * DEG
 
     def values(self, eccentricities, polar_angles) -> np.ndarray:
         """The two fields at each retinal place: an array of shape (2, n) for n places given by

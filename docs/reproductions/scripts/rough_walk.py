@@ -29,12 +29,18 @@ HUMAN_FIELD = {"field_shape": "human"}  # Spector 1990 (visuomotor_gym.vision.pe
 POSITION_E2 = {"position_e2_deg": 0.7}  # Levi, Klein & Aitsebaomo 1985, as quoted (unconfirmed)
 CROWDING = {"crowding": True}  # Bouma 1970, b = 0.5; Parkes et al. 2001
 DEPTH = {"depth_pedestal_arcmin": 10.0}  # Blakemore 1970; the constant a modelling choice
+DISARRAY = {"position_disarray": 0.8}  # Hess & Field 1993; the share a modelling choice (the lead's 0.8)
 CONDITIONS = {
     "walkway, default vision": ({}, {}),
     "rough, default vision": ("rough", {}),
     "rough, human field": ("rough", dict(HUMAN_FIELD)),
     "rough, field + E2 + crowding": ("rough", {**HUMAN_FIELD, **POSITION_E2, **CROWDING}),
     "rough, all four": ("rough", {**HUMAN_FIELD, **POSITION_E2, **CROWDING, **DEPTH}),
+    # human_periphery(position_disarray=0.8): the four mechanisms and the retinotopic disarray
+    "rough, all four + disarray 0.8": ("rough", {**HUMAN_FIELD, **POSITION_E2, **CROWDING, **DEPTH, **DISARRAY}),
+    # the denser rough course (preset "rough_dense": hazards every 0.45-0.8 m) under the same eye
+    "rough dense, all four + disarray 0.8": ("rough_dense", {**HUMAN_FIELD, **POSITION_E2, **CROWDING, **DEPTH,
+                                                             **DISARRAY}),
     # a variant: the rough course with flat patches only (no rocks), ROUGH_COURSE with kind_p = (0, 0, 1)
     "rough patches only, field + E2 + crowding": ("rough patches", {**HUMAN_FIELD, **POSITION_E2, **CROWDING}),
 }

@@ -37,6 +37,7 @@ CONDITIONS = {
     # all four + the retinotopic positional disarray (vision.periphery.DisarrayField, Hess & Field 1993)
     "groups + human periphery + disarray 0.8": (GROUPS, {**HUMAN_ALL, "position_disarray": 0.8}),
     "groups + human periphery + disarray 0.5": (GROUPS, {**HUMAN_ALL, "position_disarray": 0.5}),
+    "groups + human periphery + disarray 1.0": (GROUPS, {**HUMAN_ALL, "position_disarray": 1.0}),
 }
 
 
