@@ -165,7 +165,7 @@ def test_a_brace_that_keeps_pushing_throws_the_body_over_its_other_foot():
     throws it away from the wall, over its left foot; the arm that yields keeps it upright."""
     _env, _agent, info = _play("eom_brace", 5)
     assert info["is_success"], info
-    env, _agent, info = _play("eom_brace:yield_speed_m_s=-1", 5)
+    _env, _agent, info = _play("eom_brace:yield_speed_m_s=-1", 5)
     assert info["fallen"] and info["first_contact_time"] > 0, info  # it touched a cube, then fell ...
     assert info["pelvis_pos"][1] > 0.2, info["pelvis_pos"]  # ... away from the wall (the wall is at -y)
 
@@ -228,7 +228,7 @@ def test_the_postural_response_is_off_by_default_and_flexes_the_hips_when_fallin
     mujoco.mj_forward(m, d)
     lag = round(sn.POSTURAL_LATENCY_S / 0.02)
     outs = []
-    for k in range(lag + 2):
+    for _k in range(lag + 2):
         d.qvel[body._root_v] = -0.5  # the pelvis moving backward at 0.5 m/s
         mujoco.mj_step(m, d, 10)
         outs.append(body._postural_response(d))
@@ -271,5 +271,70 @@ def test_eom_brace_braces_along_the_fall_toward_a_turned_wall(monkeypatch):
 @pytest.mark.parametrize("spec", ["eom_brace:verge_on_sample=maybe", "eom_brace:fall_direction=2",
                                   "eom_brace:scan_blocks=-1"])
 def test_the_new_options_refuse_bad_values(spec):
+    with pytest.raises(ValueError, match="EomBraceParams"):
+        make_agent(spec, ENV, 9)
+
+
+# --- fourth pass (issue 25): the active hold, crowded samples, choosing by the line of sight ----------
+def test_the_active_hold_keeps_a_body_upright_that_the_strut_lets_lean_over():
+    """Oracle rung, seed 6: with the plain strut the hand rests on the cube's edge while the body leans on
+    its right foot's outer edge and slowly tips into the wall (upper arm on a cube); the arm that pushes with
+    the trunk's lean (hold_lean_gain) brings it back over its feet. The brace, not the eye."""
+    _env, _agent, info = _play("eom_brace", 6, env_id="PushRecoveryOracle-v0")
+    assert info["fallen"] and not info["is_success"]
+    env, _agent, info = _play("eom_brace:hold_lean_gain=2,hold_lean_damp=0.1", 6, env_id="PushRecoveryOracle-v0")
+    assert info["is_success"] and env.unwrapped.task.first_contact_time is not None
+
+
+def _still_obs(block_pos: dict) -> np.ndarray:
+    """A flat observation: eye at the stance origin looking along +x (identity rotation), the given cube
+    samples (eye frame) visible, no foot contact (no detection)."""
+    from visuomotor_gym.baselines.eom_brace.agent import _LAYOUT, _S
+
+    obs = np.zeros(_LAYOUT.size)
+    obs[_S["eye_rot"]] = np.eye(3).reshape(-1)
+    obs[_S["fixation"]] = 1.0
+    pos = obs[_S["block_pos"]].reshape(sn.N_BLOCKS, 3)
+    vis = obs[_S["block_visible"]]
+    for i, p in block_pos.items():
+        pos[i] = p
+        vis[i] = 1.0
+    obs[_S["block_pos"]] = pos.reshape(-1)
+    obs[_S["block_visible"]] = vis
+    return obs
+
+
+@pytest.mark.parametrize("drop", [False, True])
+def test_drop_crowded_leaves_two_cubes_within_the_critical_spacing_unfused(drop):
+    """Two cube samples 30 and 35 deg off the line of sight: 5 deg apart, within Bouma's 0.5 x 30 deg, so
+    either may carry the other's position (compulsory averaging); a third, alone at 0 deg, is fused either way."""
+    agent = make_agent(f"eom_brace:drop_crowded={str(drop).lower()},fuse_max_ecc_deg=40", ENV, 9)
+    d = 0.8
+    samples = {0: (d, 0.0, 0.0)}
+    for i, deg in ((1, 30.0), (2, 35.0)):
+        a = math.radians(deg)
+        samples[i] = (d * math.cos(a), -d * math.sin(a), 0.0)
+    agent.predict(_still_obs(samples))
+    assert agent.w[0] > 0
+    assert (agent.w[1] > 0) == (not drop) and (agent.w[2] > 0) == (not drop)
+
+
+def test_choose_by_ray_cuts_each_belief_s_line_of_sight_with_the_expected_wall_plane():
+    agent = make_agent("eom_brace:choose_by_ray=true,ray_plane_m=0.7", ENV, 9)
+    eye = np.array([0.05, 0.0, 0.55])
+    n = np.array([0.0, -1.0, 0.0])
+    ray = np.array([0.3, -0.8, -0.4]) / np.linalg.norm([0.3, -0.8, -0.4])
+    faces = np.array([eye + 2.0 * ray, eye + 0.4 * ray])  # one believed far, one near, on the same line
+    cuts = agent._ray_cuts(faces, eye, n)
+    for c in cuts:
+        assert float(c @ n) == pytest.approx(0.7)
+        np.testing.assert_allclose(np.cross(c - eye, ray), 0.0, atol=1e-12)
+    behind = agent._ray_cuts(np.array([eye + np.array([1.0, 0.1, 0.0])]), eye, n)
+    np.testing.assert_allclose(behind[0], eye + np.array([1.0, 0.1, 0.0]))  # does not reach the plane: kept
+
+
+@pytest.mark.parametrize("spec", ["eom_brace:drop_crowded=1", "eom_brace:choose_by_ray=yes",
+                                  "eom_brace:hold_lean_gain=-1", "eom_brace:wall_normal=0"])
+def test_the_fourth_pass_options_refuse_bad_values(spec):
     with pytest.raises(ValueError, match="EomBraceParams"):
         make_agent(spec, ENV, 9)

@@ -37,6 +37,7 @@ from collections import deque
 from dataclasses import dataclass, fields, replace
 
 import numpy as np
+from visuomotor_gym.baselines.crowding import crowded
 
 from visuomotor_gym.body import standing as sn
 from visuomotor_gym.core.head import neck_range_deg
@@ -83,6 +84,30 @@ class EomBraceParams:
     # sample distance when it lies within verge_ecc_deg of the fovea instead of on the belief's distance
     # (modelling choices: both made the foveated agent worse on seeds 0-39, see the page).
     scan_blocks: int = 0
+    # wall_normal: the scan_blocks looks choose the cubes nearest the line through the shoulder along the wall's
+    # normal as the believed faces give it (a line fitted through them on the floor plane; the push comes
+    # toward the wall), not along the body's right (modelling choice; for a wall turned per episode).
+    wall_normal: bool = False
+    # choose_by_ray: after the detection, choose the cube by the DIRECTION of its believed face from the eye,
+    # not by its believed position: each belief's line of sight is cut with the plane ray_plane_m from the
+    # stance origin along the fall's direction (the wall's expected distance: modelling choice, the middle of
+    # the task's 0.60-0.80 m), and the cube whose cut lies nearest the fall line through the shoulder is
+    # chosen. A peripheral sample's direction is precise and its depth coarse (the vision model), so a far
+    # cube believed near is not chosen; the hand still goes to the belief (modelling choice).
+    choose_by_ray: bool = False
+    # drop_crowded: samples that may be crowded this step (another cube's perceived line of sight within the
+    # critical spacing, baselines/crowding.py; Bouma 1970) are not fused: a pooled sample carries a
+    # neighbour's position (modelling choice, as the walker baselines).
+    drop_crowded: bool = False
+    ray_plane_m: float = 0.7
+    # ... and the chosen cube is looked at on its mean line of sight at that plane until its belief's best
+    # sample weight reaches cut_until_w (1/m^2: a depth std of 1/sqrt(w), 400 = 5 cm; modelling choice)
+    cut_until_w: float = 400.0
+    hand_on_cut: bool = False  # ... and the hand aims there too until then (modelling choice)
+    # verge_on_ray: the vergence distance of a look at a cube is its line of sight's cut with that plane, not
+    # the belief's distance (a belief from peripheral samples is wrong mostly along the line of sight, and a
+    # fixation verged at the wrong distance keeps the depth coarse: the depth pedestal; modelling choice).
+    verge_on_ray: bool = False
     verge_on_sample: bool = False
     verge_ecc_deg: float = 5.0
     hand_ready: tuple = (0.1, -0.4, 0.27)  # stance frame: the hand waits beside the hip, toward the wall (modelling choice)
@@ -115,6 +140,15 @@ class EomBraceParams:
     # A negative value switches the yield off (the arm pushes as a strut throughout).
     yield_speed_m_s: float = 0.0
     yield_brace: float = 0.0  # the brace command while the arm yields (-1 relaxed .. 1 braced; modelling choice)
+    # The active hold (off at 0): once the hand is on the cube, it pushes along the fall's direction by
+    # hold_lean_gain m per rad of the trunk's lean toward the wall beyond hold_lean_ref, plus hold_lean_damp m
+    # per rad/s of the lean's rate (the vestibular tilt and rates), clipped to [-hold_retract_m, hold_push_m]:
+    # the arm is a balance controller, not a fixed strut (modelling choice).
+    hold_lean_gain: float = 0.0
+    hold_lean_ref: float = 0.0
+    hold_lean_damp: float = 0.0
+    hold_push_m: float = 0.15
+    hold_retract_m: float = 0.05
     still_rad_s: float = 0.15  # trunk still: every vestibular rate below this (modelling choice)
     still_s: float = 0.5  # ... for this long before looking away (modelling choice)
     head_dead_zone_deg: float = 20.0  # Eyecatch Sec. 4.2 Eq. 17
@@ -125,7 +159,9 @@ class EomBraceParams:
     def __post_init__(self) -> None:
         for f in fields(self):
             v = getattr(self, f.name)
-            if f.name in ("foveated", "gaze_blind", "use_hand", "verge_on_sample", "fall_direction"):
+            if f.name in ("foveated", "gaze_blind", "use_hand", "verge_on_sample", "fall_direction", "wall_normal",
+                          "choose_by_ray", "drop_crowded", "verge_on_ray",
+                          "hand_on_cut"):
                 if not isinstance(v, bool):
                     raise ValueError(f"EomBraceParams.{f.name} must be true or false, got {v!r}")
             elif f.name == "scan_blocks":
@@ -135,7 +171,8 @@ class EomBraceParams:
                 if len(v) < 1 or not all(isinstance(x, (int, float)) and math.isfinite(x) for x in v):
                     raise ValueError(f"EomBraceParams.{f.name} must be finite numbers, got {v!r}")
             elif isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) \
-                    or (v < 0 and f.name not in ("scan_y_m", "scan_z_m", "yield_speed_m_s", "yield_brace")):
+                    or (v < 0 and f.name not in ("scan_y_m", "scan_z_m", "yield_speed_m_s", "yield_brace",
+                                           "hold_lean_ref")):
                 raise ValueError(f"EomBraceParams.{f.name} must be a finite number >= 0, got {v!r}")
 
 
@@ -187,11 +224,15 @@ class EomBraceAgent:
         self.w = np.zeros(N)
         self.sum = np.zeros((N, 3))
         self.best_w = np.zeros(N)
+        self.dir_sum = np.zeros((N, 3))  # sum of the fused samples' unit lines of sight (stance frame)
+        self.dir_eye = np.zeros((N, 3))  # ... and of the eye positions they were seen from
+        self.dir_n = np.zeros(N)
         self.poses: deque = deque(maxlen=self.delay_steps + 1)
         self.home: np.ndarray | None = None
         self.detected_at: float | None = None
         self.normal = np.array([0.0, -1.0, 0.0])
         self._scan_order = None
+        self._look_normal = np.array([0.0, -1.0, 0.0])
         self._scan_k = -1
         self._scan_target = 0
         self.chosen: int | None = None
@@ -234,6 +275,9 @@ class EomBraceAgent:
         self.best_w[i] = max(self.best_w[i], w)
         self.w[i] += w
         self.sum[i] += w * (eye + rot @ pos_eye)
+        self.dir_sum[i] += rot @ (pos_eye / dist)
+        self.dir_eye[i] += eye
+        self.dir_n[i] += 1.0
 
     # --- policy -----------------------------------------------------------------------------------
     def predict(self, observation, state=None, episode_start=None, deterministic=True):
@@ -259,8 +303,12 @@ class EomBraceAgent:
             r0, e0, f0 = self.poses[0]
             pos = obs[_S["block_pos"]].reshape(N, 3)
             vis = obs[_S["block_visible"]]
-            for i in range(N):
-                if vis[i] > 0.5:
+            seen = [i for i in range(N) if vis[i] > 0.5 and pos[i][0] > 0.0]
+            skip = set()
+            if self.params.drop_crowded and len(seen) > 1:
+                skip = {seen[k] for k in crowded([pos[i] for i in seen], seen, self.vision)}
+            for i in seen:
+                if i not in skip:
                     self._fuse(i, pos[i].copy(), r0, e0, f0)
 
         # --- detection: the CoP at the support polygon's edge (or a foot unloaded) ---------------------
@@ -308,6 +356,9 @@ class EomBraceAgent:
                 # go): a fixated cube is localised by the fovea, laterally and, verged on, in depth.
                 if self._scan_order is None or k != self._scan_k:
                     faces = np.array([self.estimate(i) for i in known]) - SHOULDER
+                    if p.wall_normal:
+                        n = self._wall_normal(faces, n)
+                        self._look_normal = n
                     lateral = faces - np.outer(faces @ n, n)
                     order = [known[j] for j in np.argsort(np.linalg.norm(lateral, axis=1))][:p.scan_blocks]
                     self._scan_order = order
@@ -320,9 +371,13 @@ class EomBraceAgent:
             if self.hold is None:
                 # The nearest believed face to the line of the fall through the right shoulder.
                 faces = np.array([self.estimate(i) for i in known]) - SHOULDER
+                if p.choose_by_ray:
+                    faces = np.array([self._direction_cut(i, n) for i in known]) - SHOULDER
                 lateral = faces - np.outer(faces @ n, n)
                 self.chosen = known[int(np.argmin(np.linalg.norm(lateral, axis=1)))]
                 face = self.estimate(self.chosen)
+                if p.hand_on_cut and self.best_w[self.chosen] < p.cut_until_w:
+                    face = self._direction_cut(self.chosen, n)  # not yet fixated: the direction at the plane
                 if self.approach_since is None:
                     # Align first: in front of the face, then toward it (a hand that sweeps along the wall
                     # catches an edge); move in anyway once align_timeout_s has passed.
@@ -345,6 +400,12 @@ class EomBraceAgent:
                 # The braced arm as a strut along the fall's direction: the hand keeps its distance from
                 # the head as the body leans (a hand held fixed in the room would let the arm fold).
                 target = self.hold + n * float((eye - self.hold_eye) @ n)
+                if p.hold_lean_gain > 0:
+                    ves = obs[_S["vestibular"]]
+                    lean = float(ves[1]) * n[0] - float(ves[0]) * n[1]  # trunk tilt toward the wall (rad)
+                    lean_rate = float(ves[3]) * n[0] - float(ves[2]) * n[1]
+                    push = p.hold_lean_gain * (lean - p.hold_lean_ref) + p.hold_lean_damp * lean_rate
+                    target = self.hold + n * min(max(push, -p.hold_retract_m), p.hold_push_m)
             if p.yield_speed_m_s >= 0 and -float(vel @ n) > p.yield_speed_m_s:
                 target = hand.copy()  # the body moves back over its feet: the arm yields
                 brace = p.yield_brace
@@ -352,6 +413,8 @@ class EomBraceAgent:
                     self.hold = hand.copy()
                     self.hold_eye = eye.copy()
             look_at = self.estimate(self.chosen)
+            if p.choose_by_ray and self.hold is None and self.best_w[self.chosen] < p.cut_until_w:
+                look_at = self._direction_cut(self.chosen, n)  # the cube's direction, at the plane's distance
             look_block = self.chosen
             rates = obs[_S["vestibular"]][2:5]
             if self.hold is not None and float(np.max(np.abs(rates))) < p.still_rad_s:
@@ -375,6 +438,9 @@ class EomBraceAgent:
             az, el = math.atan2(d[1], d[0]), math.atan2(d[2], math.hypot(d[0], d[1]))
             head = (self._beyond_dead_zone(az, 0), self._beyond_dead_zone(el, 1))
             fixation = float(np.linalg.norm(d))
+            if p.verge_on_ray and look_block is not None:
+                nl = n if self.detected_at is not None else self._look_normal
+                fixation = float(np.linalg.norm(self._ray_cuts(look_at[None, :], eye, nl)[0] - eye))
             if p.verge_on_sample and look_block is not None and obs[_S["block_visible"]][look_block] > 0.5:
                 # Vergence follows the fixated cube's own disparity: its latest sample's distance when it is
                 # near the fovea (the vergence loop closes on the fixated target, not on the belief).
@@ -382,6 +448,41 @@ class EomBraceAgent:
                 if sample[0] > 0 and foveation.eccentricity(sample) < p.verge_ecc_deg * DEG:
                     fixation = float(np.linalg.norm(sample))
         return encode(target, brace, gaze, fixation, head, self.gaze_range)
+
+    def _direction_cut(self, i: int, n: np.ndarray) -> np.ndarray:
+        """Cube ``i``'s mean line of sight (the mean direction of its fused samples, from the mean eye
+        position they were seen from) cut with the plane ``x . n = ray_plane_m``: where the cube is if the wall
+        is where expected. A sample's direction is precise even where its depth is not (the vision model)."""
+        k = max(self.dir_n[i], 1.0)
+        origin = self.dir_eye[i] / k
+        u = self.dir_sum[i] / max(float(np.linalg.norm(self.dir_sum[i])), 1e-9)
+        return self._ray_cuts((origin + u)[None, :], origin, n)[0]
+
+    def _ray_cuts(self, faces: np.ndarray, eye: np.ndarray, n: np.ndarray) -> np.ndarray:
+        """Each believed face's line of sight from ``eye`` cut with the plane ``x . n = ray_plane_m``
+        (stance frame); a line of sight that does not reach the plane keeps the belief."""
+        out = faces.copy()
+        for j, f in enumerate(faces):
+            r = f - eye
+            r = r / max(float(np.linalg.norm(r)), 1e-9)
+            rn = float(r @ n)
+            if rn > 0.2:
+                out[j] = eye + r * ((self.params.ray_plane_m - float(eye @ n)) / rn)
+        return out
+
+    @staticmethod
+    def _wall_normal(faces: np.ndarray, fallback: np.ndarray) -> np.ndarray:
+        """The unit normal (from the body toward the wall) of the line fitted through the believed faces
+        (shoulder-relative) on the floor plane; ``fallback`` with fewer than two faces."""
+        if len(faces) < 2:
+            return fallback
+        xy = faces[:, :2] - faces[:, :2].mean(axis=0)
+        _u, _s, vt = np.linalg.svd(xy, full_matrices=False)
+        along = vt[0]
+        nrm = np.array([-along[1], along[0], 0.0])
+        if float(nrm[:2] @ faces[:, :2].mean(axis=0)) < 0:
+            nrm = -nrm
+        return nrm
 
     def _beyond_dead_zone(self, angle: float, k: int) -> float:
         dz = self.params.head_dead_zone_deg * DEG

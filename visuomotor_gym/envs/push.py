@@ -21,7 +21,6 @@ from visuomotor_gym.core.eye import EYE_BLOCKS
 from visuomotor_gym.core.head import HEAD_BLOCKS
 from visuomotor_gym.core.observation import ObservationLayout
 from visuomotor_gym.tasks import push_recovery as pr
-from visuomotor_gym.vision.foveation import human_periphery
 from visuomotor_gym.tasks.push_recovery import (
     BLOCK_PERCEPT_BLOCKS,
     REWARD_TERMS,
@@ -30,6 +29,7 @@ from visuomotor_gym.tasks.push_recovery import (
     TIME_BLOCK,
     PushRecoveryTask,
 )
+from visuomotor_gym.vision.foveation import human_periphery
 
 __all__ = ["PushRecoveryEnv", "push_observation"]
 
