@@ -88,12 +88,12 @@ class EomBraceParams:
     # normal as the believed faces give it (a line fitted through them on the floor plane; the push comes
     # toward the wall), not along the body's right (modelling choice; for a wall turned per episode).
     wall_normal: bool = False
-    # choose_by_ray: after the detection, choose the cube by the DIRECTION of its believed face from the eye,
-    # not by its believed position: each belief's line of sight is cut with the plane ray_plane_m from the
-    # stance origin along the fall's direction (the wall's expected distance: modelling choice, the middle of
-    # the task's 0.60-0.80 m), and the cube whose cut lies nearest the fall line through the shoulder is
-    # chosen. A peripheral sample's direction is precise and its depth coarse (the vision model), so a far
-    # cube believed near is not chosen; the hand still goes to the belief (modelling choice).
+    # choose_by_ray: after the detection, choose the cube by the DIRECTION of its samples, not by its believed
+    # position: the mean line of sight of its fused samples (from the mean eye position they were seen from)
+    # is cut with the plane ray_plane_m from the stance origin along the fall's direction (the wall's expected
+    # distance: modelling choice, the middle of the task's 0.60-0.80 m), and the cube whose cut lies nearest
+    # the fall line through the shoulder is chosen. A peripheral sample's direction is precise and its depth
+    # coarse (the vision model), so a far cube believed near is not chosen (modelling choice).
     choose_by_ray: bool = False
     # drop_crowded: samples that may be crowded this step (another cube's perceived line of sight within the
     # critical spacing, baselines/crowding.py; Bouma 1970) are not fused: a pooled sample carries a
