@@ -8,7 +8,10 @@ Each row sets the task's and body's module constants in this process only (as ``
     OPENBLAS_CORETYPE=Haswell MUJOCO_GL=egl python docs/reproductions/data/push/explore_fourth.py \
         --out docs/reproductions/data/push/explore_fourth.json
 
-About 10 minutes on one shared core.
+About 10 minutes on one shared core. The agent specs are those of the commit that added this script: the
+rows named ``eom_brace`` (and the options not named) use eom_brace's defaults of the third pass; the
+redefinition that followed made this pass's options the defaults (``tests/test_push_recovery.py``'s
+``THIRD_PASS`` spells the former ones out).
 """
 
 from __future__ import annotations
