@@ -518,10 +518,10 @@ def test_fajen_warren_takes_every_constant_of_the_envs_eye():
     from visuomotor_gym.vision.foveation import human_periphery
 
     agent = FajenWarrenAgent.for_env("ObstacleDodge-v0")  # the default eye: DODGE_VISION
-    assert agent.vision == human_periphery(position_disarray=0.8) and not agent._search
+    assert agent.vision == human_periphery() and agent.vision.position_disarray == 0.8 and not agent._search
     with _registered(vision_params={"position_disarray": 0.0}):  # fields over the family's defaults
         agent = FajenWarrenAgent.for_env("ObstacleDodge-v0")
-    assert agent.vision == human_periphery()
+    assert agent.vision == human_periphery(position_disarray=0.0)
 
 
 @pytest.mark.parametrize("vision", ["foveated", "oracle"])
@@ -576,7 +576,7 @@ def test_fajen_warren_fuses_a_crowded_sample_with_its_crowding_zone():
     lateral = d * (1.0 + 40.0 / 0.7) * math.radians(1.0 / 60.0)  # 0.10 m
     for crowding in (True, False):
         agent = FajenWarrenAgent.for_env("ObstacleDodge-v0")
-        agent.vision = human_periphery(crowding=crowding, depth_pedestal_arcmin=None)
+        agent.vision = human_periphery(crowding=crowding, depth_pedestal_arcmin=None, position_disarray=0.0)
         still = (0.0, 0.0, 0.0)  # no retinal slip: the slip factor is 1
         obs = _synthetic_obs({0: (a, still), 1: (b, still), 2: (lone, still)})
         ol = obs.tolist()

@@ -1,7 +1,7 @@
 """Tests of the opt-in human peripheral vision (visuomotor_gym.vision.periphery): the human
 field of view, the position law, crowding and the depth law, each against a case computed by hand
-here, and their wiring into the retina of a real environment (pure-Python path when on, today's eye,
-compiled kernel included, when off).
+here, and their wiring into the retina of a real environment (on either path: the compiled retina
+mirrors the Python one bit for bit, tests/test_native.py).
 
 Oracles: the closed forms of the module docstring written out independently (1 arcmin lateral, 5 %
 depth, E2 = 2 deg for the acuity law), fields of view 60 up / 75 down / 100 to the side (Spector 1990),
@@ -10,6 +10,7 @@ Bouma's b = 0.5.
 
 from __future__ import annotations
 
+import contextlib
 import math
 
 import gymnasium as gym
@@ -227,12 +228,12 @@ def _placed(u, eye, dist, name, group=None):
     return t
 
 
-def test_env_defaults_keep_the_compiled_retina_and_options_take_the_python_path():
+def test_env_defaults_and_options_both_take_the_compiled_retina_when_built():
     env, u = _env_eye()
     assert u.retina._native == _native.enabled()
     env.close()
-    env, u = _env_eye(ALL_ON)
-    assert u.retina._native is False and u.vision_params.crowding and u.vision_params.position_e2_deg == 0.7
+    env, u = _env_eye(ALL_ON)  # the periphery's retina is compiled too (tests/test_native.py: bit for bit)
+    assert u.retina._native == _native.enabled() and u.vision_params.crowding and u.vision_params.position_e2_deg == 0.7
     obs = None
     for _ in range(20):
         obs, *_ = env.step(env.action_space.sample() * 0.0)
@@ -305,11 +306,12 @@ def test_walk_env_with_the_human_periphery_runs_and_groups_obstacle_points():
 
 @pytest.mark.parametrize("env_id", ["EyeCatchTwoBalls-v0", "SteppingStones-v0", "ObstacleDodge-v0", "ShelfReach-v0"])
 def test_every_family_runs_with_the_human_periphery(env_id):
-    # distinct objects everywhere (two balls, stones, pedestrians, the shelf object): the Python path
-    # runs, the percepts are finite, and seeded runs repeat exactly
-    def run():
-        env = gym.make(env_id, vision_params=ALL_ON)
-        assert env.unwrapped.retina._native is False
+    # distinct objects everywhere (two balls, stones, pedestrians, the shelf object): the percepts are
+    # finite, and seeded runs repeat exactly, the Python path's as the compiled one's (when built)
+    def run(native=True):
+        with contextlib.nullcontext() if native else _native.disabled():
+            env = gym.make(env_id, vision_params=ALL_ON)
+        assert env.unwrapped.retina._native is (native and _native.enabled())
         obs, _ = env.reset(seed=1)
         rng = np.random.default_rng(5)
         out = [obs]
@@ -321,7 +323,7 @@ def test_every_family_runs_with_the_human_periphery(env_id):
         env.close()
         return np.array(out)
 
-    a, b = run(), run()
+    a, b = run(), run(native=False)
     assert np.all(np.isfinite(a))
     np.testing.assert_array_equal(a, b)
 

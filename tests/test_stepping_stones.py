@@ -209,10 +209,12 @@ def test_lookahead_turns_the_walker_along_a_curving_course():
 
 @pytest.mark.slow
 def test_lookahead_crosses_more_courses_than_its_gaze_blind_twin():
-    seeds = range(300, 306)
+    # Development seeds (outside the pinned 0-199). Under the human periphery with the disarray lookahead
+    # crosses 97.5 % of the pinned courses: 10 of these 12 (300 and 302 not); neither held twin crosses one.
+    seeds = range(300, 312)
     looking = _successes("lookahead", seeds)
     blind, generic = _successes("lookahead:gaze_blind=true", seeds), _successes("gaze_blind:lookahead", seeds)
-    assert looking >= 5 and blind <= 2 and generic <= 2, (looking, blind, generic)
+    assert looking >= 9 and blind <= 3 and generic <= 3, (looking, blind, generic)
 
 
 def test_stones_realism_measures_on_a_synthetic_trace():

@@ -16,7 +16,7 @@ static PyObject *math_hypot;  /* math.hypot */
 /* attribute names, interned once */
 static PyObject *s_time, *s_suppressed, *s_prev_request, *s_last_sample, *s_drive_queue, *s_drive, *s_goal,
     *s_pursuit_omega, *s_saccade, *s_omega, *s_onset, *s_duration, *s_amplitude, *s_arc, *s_axis, *s_gaze,
-    *s_hidden, *s_state, *s_last_onset, *s_standard_normal;
+    *s_hidden, *s_state, *s_last_onset, *s_standard_normal, *s_kind, *s_group, *s_name, *s_values;
 static PyObject *np_empty, *np_ndarray, *np_float32, *int_three; /* numpy.empty, .ndarray, .float32, 3 */
 static PyObject *np_float64_dtype, *s_dtype, *float_zero; /* numpy.dtype("float64"), "dtype" */
 
@@ -982,6 +982,619 @@ fail:
     return NULL;
 }
 
+/* ---- the human periphery (visuomotor_gym/vision/periphery.py, Retina._see_all_periphery) -------- */
+
+/* The periphery's constants, packed by retina.periphery_constants (see there for the order). Angles
+ * are already in radians, computed there as the Python computes them (``field_side_deg * DEG`` ...). */
+typedef struct {
+    double foveated, human, fov, side, up, down, crowding, crowd_fovea, bouma, pos_e2_on, pos_e2, e2,
+        noise_scale, pos_std_arcmin, arcmin, knee, weber, floor, depth, depth_rate, pedestal_on, pedestal,
+        interocular, disarray;
+} PeripheryConsts;
+
+static int periphery_consts(PyObject *packed, PeripheryConsts *c)
+{
+    if (!PyBytes_Check(packed) || PyBytes_GET_SIZE(packed) != sizeof(PeripheryConsts)) {
+        PyErr_SetString(PyExc_TypeError, "periphery constants: expected retina.periphery_constants(params)");
+        return -1;
+    }
+    memcpy(c, PyBytes_AS_STRING(packed), sizeof(PeripheryConsts));
+    return 0;
+}
+
+/* periphery.human_field_limit */
+static double human_field_limit(const PeripheryConsts *c, double uy, double uz)
+{
+    double s = c->side;
+    double v = uz >= 0.0 ? c->up : c->down;
+    double rho2 = uy * uy + uz * uz;
+    if (rho2 <= 0.0)
+        return s;
+    return 1.0 / sqrt((uy * uy / rho2) / (s * s) + (uz * uz / rho2) / (v * v));
+}
+
+/* periphery.in_field */
+static int in_field(const PeripheryConsts *c, double x, double y, double z)
+{
+    if (!c->foveated)
+        return 1;
+    double d = sqrt(x * x + y * y + z * z);
+    if (d <= 0.0)
+        return 1;
+    double ecc = acos(py_max(-1.0, py_min(1.0, x / d)));
+    if (c->human)
+        return ecc <= human_field_limit(c, y / d, z / d);
+    return ecc <= c->fov;
+}
+
+/* periphery.position_factor */
+static double position_factor(const PeripheryConsts *c, double ecc)
+{
+    if (!c->foveated)
+        return 1.0;
+    return 1.0 + ecc / c->pos_e2;
+}
+
+/* periphery.depth_factor; ``has_fixation`` false: fixation is None. */
+static double depth_factor(const PeripheryConsts *c, double distance, int has_fixation, double fixation)
+{
+    if (!c->pedestal_on || !c->foveated || !has_fixation || distance <= 0.0)
+        return 1.0;
+    double eta = c->interocular * fabs(1.0 / distance - 1.0 / fixation);
+    return 1.0 + eta / c->pedestal;
+}
+
+/* foveation._sigmas with params.periphery_on (acuity, slip_factor, the position and depth laws) */
+static void periphery_sigmas(const PeripheryConsts *c, double distance, double ecc, double speed, int has_fixation,
+                             double fixation, double *s)
+{
+    double alpha = c->foveated ? c->e2 / (c->e2 + ecc) : 1.0;                /* acuity */
+    double slip = c->foveated ? py_max(1.0, fabs(speed) / c->knee) : 1.0;    /* slip_factor */
+    double k = distance * c->noise_scale / alpha;
+    double lateral = k * c->pos_std_arcmin * c->arcmin * slip;
+    double lateral_rate = k * (c->weber * fabs(speed) + c->floor);
+    if (c->pos_e2_on)
+        lateral = distance * c->noise_scale * position_factor(c, ecc) * c->pos_std_arcmin * c->arcmin * slip;
+    double g = depth_factor(c, distance, has_fixation, fixation);
+    s[0] = k * c->depth * g;
+    s[1] = lateral;
+    s[2] = lateral;
+    s[3] = k * c->depth_rate * g;
+    s[4] = lateral_rate;
+    s[5] = lateral_rate;
+}
+
+/* periphery.angular_separation */
+static double angular_separation(const double *u, const double *v)
+{
+    double cx = u[1] * v[2] - u[2] * v[1];
+    double cy = u[2] * v[0] - u[0] * v[2];
+    double cz = u[0] * v[1] - u[1] * v[0];
+    return atan2(sqrt(cx * cx + cy * cy + cz * cz), u[0] * v[0] + u[1] * v[1] + u[2] * v[2]);
+}
+
+/* Class labels of ``items`` by equality: label[k] = the first k' <= k with items[k'] == items[k], found
+ * through a dict (a kind or an object is a str: hash and == agree, as in crowding_groups' dict). */
+static int labels_of(PyObject *const *items, Py_ssize_t n, Py_ssize_t *label)
+{
+    PyObject *first = PyDict_New();
+    if (first == NULL)
+        return -1;
+    for (Py_ssize_t k = 0; k < n; k++) {
+        PyObject *index = PyLong_FromSsize_t(k);
+        PyObject *got = index == NULL ? NULL : PyDict_SetDefault(first, items[k], index);
+        Py_XDECREF(index);
+        if (got == NULL) {
+            Py_DECREF(first);
+            return -1;
+        }
+        label[k] = PyLong_AsSsize_t(got); /* borrowed, held by the dict */
+    }
+    Py_DECREF(first);
+    return 0;
+}
+
+/* periphery.crowding_groups for target i, on C arrays: ``dirs`` n x 3, ``eccs`` n, ``kind`` and ``obj``
+ * the labels (labels_of) of the targets' kinds and objects. Writes elem[j] = the element of i's group
+ * that holds j (1, 2, ...: the flanking objects in order of first appearance), 0 for none (i's own
+ * element [i] is element 0), and returns the number of elements (1: i alone). ``slot`` (n entries,
+ * all -1 on entry and on return): an object label's element. */
+static Py_ssize_t crowd_one(const PeripheryConsts *c, Py_ssize_t n, Py_ssize_t i, const double *dirs,
+                            const double *eccs, const Py_ssize_t *kind, const Py_ssize_t *obj, Py_ssize_t *elem,
+                            Py_ssize_t *slot)
+{
+    memset(elem, 0, (size_t)n * sizeof(Py_ssize_t));
+    if (!(c->crowding && c->foveated))
+        return 1;
+    double theta = eccs[i];
+    if (theta <= c->crowd_fovea)
+        return 1;
+    double spacing = c->bouma * theta;
+    Py_ssize_t m = 1;
+    for (Py_ssize_t j = 0; j < n; j++) {
+        if (j != i && kind[j] == kind[i] && obj[j] != obj[i]
+            && angular_separation(dirs + 3 * i, dirs + 3 * j) < spacing) {
+            if (slot[obj[j]] < 0)
+                slot[obj[j]] = m++;
+            elem[j] = slot[obj[j]];
+        }
+    }
+    for (Py_ssize_t j = 0; j < n; j++)
+        if (elem[j])
+            slot[obj[j]] = -1;
+    return m;
+}
+
+/* periphery.pooled over ``vecs`` (n x 3) of target i's group (crowd_one's elem and m) into out[3]: each
+ * element's sum runs over its points in index order from 0.0, as the Python's does. ``acc``: 4 m
+ * doubles of scratch. */
+static void pool_one(Py_ssize_t n, Py_ssize_t i, const Py_ssize_t *elem, Py_ssize_t m, const double *vecs,
+                     double *acc, double *out)
+{
+    if (m == 1) { /* a lone target is itself */
+        memcpy(out, vecs + 3 * i, 3 * sizeof(double));
+        return;
+    }
+    for (Py_ssize_t e = 0; e < 4 * m; e++)
+        acc[e] = 0.0;
+    acc[0] += vecs[3 * i], acc[1] += vecs[3 * i + 1], acc[2] += vecs[3 * i + 2], acc[3] = 1.0; /* [i] */
+    for (Py_ssize_t j = 0; j < n; j++) {
+        if (elem[j] == 0)
+            continue;
+        double *a = acc + 4 * elem[j];
+        const double *v = vecs + 3 * j;
+        a[0] += v[0];
+        a[1] += v[1];
+        a[2] += v[2];
+        a[3] += 1.0;
+    }
+    double sx = 0.0, sy = 0.0, sz = 0.0;
+    for (Py_ssize_t e = 0; e < m; e++) {
+        const double *a = acc + 4 * e;
+        sx += a[0] / a[3];
+        sy += a[1] / a[3];
+        sz += a[2] / a[3];
+    }
+    out[0] = sx / (double)m, out[1] = sy / (double)m, out[2] = sz / (double)m;
+}
+
+/* n x 3 doubles from a sequence of 3-sequences (lists, tuples or arrays) into a new buffer. */
+static double *rows3(PyObject *seq, Py_ssize_t n)
+{
+    double *out = PyMem_Malloc((size_t)(n > 0 ? 3 * n : 1) * sizeof(double));
+    if (out == NULL) {
+        PyErr_NoMemory();
+        return NULL;
+    }
+    for (Py_ssize_t k = 0; k < n; k++) {
+        if (vec3(PySequence_Fast_GET_ITEM(seq, k), out + 3 * k) < 0) {
+            PyMem_Free(out);
+            return NULL;
+        }
+    }
+    return out;
+}
+
+/* Scratch arrays of crowd_one and pool_one for n targets, in one allocation (slot all -1). */
+typedef struct {
+    Py_ssize_t *kind, *obj, *elem, *slot;
+    double *acc;
+} Crowd;
+
+static int crowd_alloc(Crowd *w, Py_ssize_t n)
+{
+    size_t m = (size_t)(n > 0 ? n : 1);
+    w->kind = PyMem_Malloc(4 * m * sizeof(Py_ssize_t) + 4 * m * sizeof(double));
+    if (w->kind == NULL) {
+        PyErr_NoMemory();
+        return -1;
+    }
+    w->obj = w->kind + m, w->elem = w->obj + m, w->slot = w->elem + m, w->acc = (double *)(w->slot + m);
+    for (size_t k = 0; k < m; k++)
+        w->slot[k] = -1;
+    return 0;
+}
+
+/* crowding_groups(directions, eccentricities, kinds, objects, constants) -> groups
+ *
+ * periphery.crowding_groups: the same groups (lists of lists of ints) for the same arguments, the
+ * params given as retina.periphery_constants(params). */
+static PyObject *crowding_groups(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    if (nargs != 5) {
+        PyErr_SetString(PyExc_TypeError, "crowding_groups(directions, eccentricities, kinds, objects, constants)");
+        return NULL;
+    }
+    PeripheryConsts c;
+    if (periphery_consts(args[4], &c) < 0)
+        return NULL;
+    PyObject *dseq = NULL, *eseq = NULL, *kseq = NULL, *oseq = NULL, *out = NULL;
+    double *dirs = NULL, *eccs = NULL;
+    Crowd w = {NULL};
+    dseq = PySequence_Fast(args[0], "directions must be a sequence");
+    eseq = dseq ? PySequence_Fast(args[1], "eccentricities must be a sequence") : NULL;
+    kseq = eseq ? PySequence_Fast(args[2], "kinds must be a sequence") : NULL;
+    oseq = kseq ? PySequence_Fast(args[3], "objects must be a sequence") : NULL;
+    if (oseq == NULL)
+        goto done;
+    Py_ssize_t n = PySequence_Fast_GET_SIZE(dseq);
+    if (PySequence_Fast_GET_SIZE(eseq) != n || PySequence_Fast_GET_SIZE(kseq) != n
+        || PySequence_Fast_GET_SIZE(oseq) != n) {
+        PyErr_SetString(PyExc_ValueError, "crowding_groups: directions, eccentricities, kinds and objects "
+                                          "must have the same length");
+        goto done;
+    }
+    if ((dirs = rows3(dseq, n)) == NULL || crowd_alloc(&w, n) < 0)
+        goto done;
+    eccs = PyMem_Malloc((size_t)(n > 0 ? n : 1) * sizeof(double));
+    if (eccs == NULL) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    for (Py_ssize_t k = 0; k < n; k++) {
+        eccs[k] = PyFloat_AsDouble(PySequence_Fast_GET_ITEM(eseq, k));
+        if (eccs[k] == -1.0 && PyErr_Occurred())
+            goto done;
+    }
+    if (labels_of(PySequence_Fast_ITEMS(kseq), n, w.kind) < 0
+        || labels_of(PySequence_Fast_ITEMS(oseq), n, w.obj) < 0)
+        goto done;
+    out = PyList_New(n);
+    for (Py_ssize_t i = 0; out != NULL && i < n; i++) {
+        Py_ssize_t m = crowd_one(&c, n, i, dirs, eccs, w.kind, w.obj, w.elem, w.slot);
+        PyObject *group = PyList_New(m);
+        int ok = group != NULL;
+        for (Py_ssize_t e = 0; ok && e < m; e++) {
+            PyObject *element = PyList_New(0);
+            ok = element != NULL;
+            if (ok)
+                PyList_SET_ITEM(group, e, element);
+        }
+        for (Py_ssize_t k = 0; ok && k < n; k++) { /* [i], then each flanking object's points in index order */
+            if (k != i && w.elem[k] == 0)
+                continue;
+            PyObject *index = PyLong_FromSsize_t(k);
+            ok = index != NULL && PyList_Append(PyList_GET_ITEM(group, k == i ? 0 : w.elem[k]), index) == 0;
+            Py_XDECREF(index);
+        }
+        if (!ok) {
+            Py_XDECREF(group);
+            Py_CLEAR(out);
+            break;
+        }
+        PyList_SET_ITEM(out, i, group);
+    }
+done:
+    PyMem_Free(dirs);
+    PyMem_Free(eccs);
+    PyMem_Free(w.kind);
+    Py_XDECREF(dseq);
+    Py_XDECREF(eseq);
+    Py_XDECREF(kseq);
+    Py_XDECREF(oseq);
+    return out;
+}
+
+/* pooled(vectors, group) -> [x, y, z]: periphery.pooled (a group as crowding_groups gives it). */
+static PyObject *pooled(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    if (nargs != 2) {
+        PyErr_SetString(PyExc_TypeError, "pooled(vectors, group)");
+        return NULL;
+    }
+    PyObject *group = PySequence_Fast(args[1], "group must be a sequence");
+    if (group == NULL)
+        return NULL;
+    PyObject *vectors = args[0], *out = NULL;
+    Py_ssize_t m = PySequence_Fast_GET_SIZE(group);
+    double sx = 0.0, sy = 0.0, sz = 0.0, v[3];
+    for (Py_ssize_t e = 0; e < m; e++) {
+        PyObject *element = PySequence_Fast(PySequence_Fast_GET_ITEM(group, e), "a group's element must be a sequence");
+        if (element == NULL)
+            goto done;
+        Py_ssize_t members = PySequence_Fast_GET_SIZE(element);
+        double ex = 0.0, ey = 0.0, ez = 0.0;
+        for (Py_ssize_t q = 0; q < members; q++) {
+            PyObject *vec = PyObject_GetItem(vectors, PySequence_Fast_GET_ITEM(element, q));
+            int rc = vec == NULL ? -1 : vec3(vec, v);
+            Py_XDECREF(vec);
+            if (rc < 0) {
+                Py_DECREF(element);
+                goto done;
+            }
+            if (m == 1 && members == 1) { /* a lone target is itself */
+                Py_DECREF(element);
+                out = list_of(v, 3);
+                goto done;
+            }
+            ex += v[0];
+            ey += v[1];
+            ez += v[2];
+        }
+        Py_DECREF(element);
+        if (members == 0) {
+            PyErr_SetString(PyExc_ZeroDivisionError, "pooled: an empty element");
+            goto done;
+        }
+        sx += ex / (double)members;
+        sy += ey / (double)members;
+        sz += ez / (double)members;
+    }
+    if (m == 0) {
+        PyErr_SetString(PyExc_ZeroDivisionError, "pooled: an empty group");
+        goto done;
+    }
+    v[0] = sx / (double)m, v[1] = sy / (double)m, v[2] = sz / (double)m;
+    out = list_of(v, 3);
+done:
+    Py_DECREF(group);
+    return out;
+}
+
+/* The per-seen-target state of retina_see_periphery. */
+typedef struct {
+    Py_ssize_t index;        /* the target's index */
+    double p[3], v[3];       /* position and velocity, eye frame (pooled once crowding is applied) */
+    double slip, d, ecc;     /* retinal speed; the look's distance and eccentricity */
+} Seen;
+
+/* A float64 array's element [row, col] of a 2-D strided buffer. */
+static double at2(const Py_buffer *view, Py_ssize_t row, Py_ssize_t col)
+{
+    return *(const double *)((const char *)view->buf + row * view->strides[0] + col * view->strides[1]);
+}
+
+/* retina_see_periphery(targets, data, eye, dt, constants, rng, fixation, disarray) -> [sample per target]
+ *
+ * Mirrors Retina._see_all_periphery (``constants`` = retina.periphery_constants(params); ``eye`` as for
+ * retina_see_all; ``fixation`` the eye's vergence distance or None; ``disarray`` the retina's
+ * DisarrayField or None): every target's position, velocity and retinal slip in the eye frame when it
+ * is shown and in the field (periphery.in_field), crowding and pooling (crowding_groups, pooled), each
+ * look's distance and eccentricity, the disarray field's values at every look in one call of
+ * ``disarray.values`` (numpy's own arithmetic), then foveation._draw_at. The Python draws
+ * rng.standard_normal(6) per look at a point off the eye's centre, in target order; this draws them in
+ * one rng.standard_normal(6 k) (the same stream, tests/test_native.py). */
+static PyObject *retina_see_periphery(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    if (nargs != 8) {
+        PyErr_SetString(PyExc_TypeError,
+                        "retina_see_periphery(targets, data, eye, dt, constants, rng, fixation, disarray)");
+        return NULL;
+    }
+    PyObject *targets = args[0], *data = args[1], *rng = args[5], *disarray = args[7];
+    double eye[18], fixation = 0.0;
+    int has_fixation = args[6] != Py_None;
+    double dt = PyFloat_AsDouble(args[3]);
+    if (dt == -1.0 && PyErr_Occurred())
+        return NULL;
+    if (has_fixation) {
+        fixation = PyFloat_AsDouble(args[6]);
+        if (fixation == -1.0 && PyErr_Occurred())
+            return NULL;
+    }
+    if (seq_doubles(args[2], eye, 18) < 0)
+        return NULL;
+    PeripheryConsts c;
+    if (periphery_consts(args[4], &c) < 0)
+        return NULL;
+    const double *r = eye + 9;
+    PyObject *seq = PySequence_Fast(targets, "targets must be a sequence");
+    if (seq == NULL)
+        return NULL;
+    Py_ssize_t n = PySequence_Fast_GET_SIZE(seq), m = 0, draws = 0;
+    PyObject *out = NULL, *draw = NULL, *fixed = NULL, **labels = NULL;
+    Py_buffer normals = {.buf = NULL}, fixed_view = {.buf = NULL};
+    double *dirs = NULL, *pooled_v = NULL;
+    Crowd w = {NULL};
+    Seen *seen = PyMem_Malloc((size_t)(n > 0 ? n : 1) * sizeof(Seen));
+    if (seen == NULL) {
+        PyErr_NoMemory();
+        goto fail;
+    }
+    for (Py_ssize_t i = 0; i < n; i++) { /* every shown target in the field */
+        PyObject *target = PySequence_Fast_GET_ITEM(seq, i);
+        PyObject *hidden = PyObject_GetAttr(target, s_hidden);
+        if (hidden == NULL)
+            goto fail;
+        int is_hidden = PyObject_IsTrue(hidden);
+        Py_DECREF(hidden);
+        if (is_hidden < 0)
+            goto fail;
+        if (is_hidden)
+            continue;
+        double b[3], v[3];
+        PyObject *state = PyObject_CallMethodOneArg(target, s_state, data);
+        if (state == NULL)
+            goto fail;
+        int rc = -1;
+        if (PyTuple_Check(state) && PyTuple_GET_SIZE(state) == 2)
+            rc = (vec3(PyTuple_GET_ITEM(state, 0), b) < 0 || vec3(PyTuple_GET_ITEM(state, 1), v) < 0) ? -1 : 0;
+        else
+            PyErr_SetString(PyExc_TypeError, "VisualTarget.state must return (position, velocity)");
+        Py_DECREF(state);
+        if (rc < 0)
+            goto fail;
+        double rx = b[0] - eye[0], ry = b[1] - eye[1], rz = b[2] - eye[2];
+        double pe[3] = {r[0] * rx + r[3] * ry + r[6] * rz, r[1] * rx + r[4] * ry + r[7] * rz,
+                        r[2] * rx + r[5] * ry + r[8] * rz};
+        if (!in_field(&c, pe[0], pe[1], pe[2]))
+            continue;
+        Seen *s = &seen[m++];
+        s->index = i;
+        memcpy(s->p, pe, sizeof(pe));
+        s->v[0] = r[0] * v[0] + r[3] * v[1] + r[6] * v[2];
+        s->v[1] = r[1] * v[0] + r[4] * v[1] + r[7] * v[2];
+        s->v[2] = r[2] * v[0] + r[5] * v[1] + r[8] * v[2];
+        /* pos_eye[0] ** 2 + ...: Python's float ** 2 is libm's pow (of |x|: float_pow) */
+        s->d = sqrt(pow(fabs(pe[0]), 2.0) + pow(fabs(pe[1]), 2.0) + pow(fabs(pe[2]), 2.0));
+        if (rx * rx + ry * ry + rz * rz == 0.0) { /* Eye.retinal_speed divides by it */
+            PyErr_SetString(PyExc_ZeroDivisionError, "float division by zero");
+            goto fail;
+        }
+        s->slip = retinal_speed(eye, rx, ry, rz, v[0], v[1], v[2], dt);
+    }
+    if (c.crowding && m > 1) { /* crowding: each seen target at the mean of its group */
+        dirs = PyMem_Malloc((size_t)(16 * m) * sizeof(double)); /* dirs, eccs, pooled p and v, unpooled */
+        labels = PyMem_Malloc((size_t)(2 * m) * sizeof(PyObject *));
+        if (dirs == NULL || labels == NULL) {
+            PyErr_NoMemory();
+            goto fail;
+        }
+        memset(labels, 0, (size_t)(2 * m) * sizeof(PyObject *));
+        double *eccs = dirs + 3 * m;
+        pooled_v = eccs + m;
+        if (crowd_alloc(&w, m) < 0)
+            goto fail;
+        for (Py_ssize_t k = 0; k < m; k++) {
+            const Seen *s = &seen[k];
+            double *u = dirs + 3 * k;
+            if (s->d > 0.0)
+                u[0] = s->p[0] / s->d, u[1] = s->p[1] / s->d, u[2] = s->p[2] / s->d;
+            else
+                u[0] = 1.0, u[1] = 0.0, u[2] = 0.0;
+            eccs[k] = acos(py_max(-1.0, py_min(1.0, u[0])));
+            PyObject *target = PySequence_Fast_GET_ITEM(seq, s->index);
+            if ((labels[k] = PyObject_GetAttr(target, s_kind)) == NULL)
+                goto fail;
+            PyObject *group = PyObject_GetAttr(target, s_group);
+            if (group == NULL)
+                goto fail;
+            if (group == Py_None) {
+                Py_DECREF(group);
+                if ((group = PyObject_GetAttr(target, s_name)) == NULL)
+                    goto fail;
+            }
+            labels[m + k] = group;
+        }
+        if (labels_of(labels, m, w.kind) < 0 || labels_of(labels + m, m, w.obj) < 0)
+            goto fail;
+        double *pv = pooled_v; /* m pooled positions, then m pooled velocities */
+        double *src = dirs + 4 * m + 6 * m; /* the unpooled positions, then velocities */
+        for (Py_ssize_t k = 0; k < m; k++) {
+            memcpy(src + 3 * k, seen[k].p, 3 * sizeof(double));
+            memcpy(src + 3 * (m + k), seen[k].v, 3 * sizeof(double));
+        }
+        for (Py_ssize_t k = 0; k < m; k++) {
+            Py_ssize_t count = crowd_one(&c, m, k, dirs, eccs, w.kind, w.obj, w.elem, w.slot);
+            pool_one(m, k, w.elem, count, src, w.acc, pv + 3 * k);
+            pool_one(m, k, w.elem, count, src + 3 * m, w.acc, pv + 3 * (m + k));
+        }
+        for (Py_ssize_t k = 0; k < m; k++) {
+            memcpy(seen[k].p, pv + 3 * k, 3 * sizeof(double));
+            memcpy(seen[k].v, pv + 3 * (m + k), 3 * sizeof(double));
+        }
+    }
+    for (Py_ssize_t k = 0; k < m; k++) { /* the looks */
+        Seen *s = &seen[k];
+        double x = s->p[0], y = s->p[1], z = s->p[2];
+        s->d = sqrt(x * x + y * y + z * z);
+        s->ecc = s->d > 0.0 ? acos(py_max(-1.0, py_min(1.0, x / s->d))) : 0.0;
+        draws += s->d > 0.0;
+    }
+    if (disarray != Py_None && m > 0) { /* disarray.values(eccentricities, polar angles) */
+        PyObject *eccs = PyList_New(m), *phis = PyList_New(m);
+        for (Py_ssize_t k = 0; eccs != NULL && phis != NULL && k < m; k++) {
+            PyObject *e = PyFloat_FromDouble(seen[k].ecc), *a = PyFloat_FromDouble(atan2(seen[k].p[2], seen[k].p[1]));
+            if (e == NULL || a == NULL) {
+                Py_XDECREF(e);
+                Py_XDECREF(a);
+                Py_CLEAR(eccs);
+                break;
+            }
+            PyList_SET_ITEM(eccs, k, e);
+            PyList_SET_ITEM(phis, k, a);
+        }
+        if (eccs != NULL && phis != NULL)
+            fixed = PyObject_CallMethodObjArgs(disarray, s_values, eccs, phis, NULL);
+        Py_XDECREF(eccs);
+        Py_XDECREF(phis);
+        if (fixed == NULL)
+            goto fail;
+        if (!is_f64_array(fixed) || PyObject_GetBuffer(fixed, &fixed_view, PyBUF_STRIDES | PyBUF_FORMAT) < 0) {
+            fixed_view.buf = NULL;
+            if (!PyErr_Occurred())
+                PyErr_SetString(PyExc_TypeError, "disarray.values must return a float64 array");
+            goto fail;
+        }
+        if (fixed_view.ndim != 2 || fixed_view.shape[0] != 2 || fixed_view.shape[1] != m) {
+            PyBuffer_Release(&fixed_view);
+            fixed_view.buf = NULL;
+            PyErr_SetString(PyExc_ValueError, "disarray.values must return an array of shape (2, n)");
+            goto fail;
+        }
+    }
+    const double *e = NULL;
+    if (draws > 0) { /* rng.standard_normal(6 * draws) */
+        PyObject *size = PyLong_FromSsize_t(6 * draws);
+        if (size == NULL)
+            goto fail;
+        PyObject *call[2] = {rng, size};
+        draw = PyObject_VectorcallMethod(s_standard_normal, call, 2 | PY_VECTORCALL_ARGUMENTS_OFFSET, NULL);
+        Py_DECREF(size);
+        if (draw == NULL || f64_buffer(draw, &normals, 0) < 0)
+            goto fail;
+        if (normals.len != 48 * draws) {
+            PyErr_SetString(PyExc_ValueError, "rng.standard_normal gave the wrong size");
+            goto fail;
+        }
+        e = (const double *)normals.buf;
+    }
+    out = PyList_New(n);
+    if (out == NULL)
+        goto fail;
+    for (Py_ssize_t k = 0, i = 0; i < n; i++) {
+        PyObject *sample;
+        if (k < m && seen[k].index == i) {
+            const Seen *s = &seen[k];
+            if (s->d <= 0.0) { /* at the eye's centre: the (pooled) state itself */
+                sample = sample_of(s->p, s->v, 1);
+            } else { /* foveation._draw_at */
+                Look lk = {.kind = 2};
+                double eps[6];
+                memcpy(eps, e, sizeof(eps));
+                e += 6;
+                if (fixed != NULL) {
+                    double f = position_factor(&c, s->ecc);
+                    double wgt = c.disarray * (1.0 - 1.0 / (f * f)); /* periphery.disarray_weight */
+                    double a = sqrt(wgt), b = sqrt(1.0 - wgt);
+                    double f0 = at2(&fixed_view, 0, k), f1 = at2(&fixed_view, 1, k);
+                    eps[1] = a * f0 + b * eps[1];
+                    eps[2] = a * f1 + b * eps[2];
+                }
+                memcpy(lk.p, s->p, sizeof(lk.p));
+                memcpy(lk.v, s->v, sizeof(lk.v));
+                periphery_sigmas(&c, s->d, s->ecc, s->slip, has_fixation, fixation, lk.s);
+                los_rows(s->p[0] / s->d, s->p[1] / s->d, s->p[2] / s->d, lk.r);
+                sample = look_sample(&lk, eps);
+            }
+            k++;
+        } else {
+            sample = nothing();
+        }
+        if (sample == NULL) {
+            Py_CLEAR(out);
+            goto fail;
+        }
+        PyList_SET_ITEM(out, i, sample);
+    }
+fail:
+    if (normals.buf != NULL)
+        PyBuffer_Release(&normals);
+    if (fixed_view.buf != NULL)
+        PyBuffer_Release(&fixed_view);
+    Py_XDECREF(fixed);
+    Py_XDECREF(draw);
+    if (labels != NULL)
+        for (Py_ssize_t k = 0; k < 2 * m; k++)
+            Py_XDECREF(labels[k]);
+    PyMem_Free(labels);
+    PyMem_Free(dirs);
+    PyMem_Free(w.kind);
+    PyMem_Free(seen);
+    Py_DECREF(seq);
+    return out;
+}
+
 /* ---- the hand (visuomotor_gym/control/hand.py) ---------------------------------------------------
  * HandController.setpoints keeps its three matrix products (numpy's BLAS, whose summation order C
  * cannot reproduce); these kernels do the element-wise work around them, into arrays the controller
@@ -1330,6 +1943,11 @@ static PyMethodDef kernel_methods[] = {
     {"float32_array", (PyCFunction)float32_array, METH_O, "np.array(values, dtype=np.float32)."},
     {"retina_see_all", (PyCFunction)(void (*)(void))retina_see_all, METH_FASTCALL,
      "Retina._see_all (see _kernels.c)."},
+    {"retina_see_periphery", (PyCFunction)(void (*)(void))retina_see_periphery, METH_FASTCALL,
+     "Retina._see_all_periphery (see _kernels.c)."},
+    {"crowding_groups", (PyCFunction)(void (*)(void))crowding_groups, METH_FASTCALL,
+     "periphery.crowding_groups (see _kernels.c)."},
+    {"pooled", (PyCFunction)(void (*)(void))pooled, METH_FASTCALL, "periphery.pooled (see _kernels.c)."},
     {NULL, NULL, 0, NULL},
 };
 
@@ -1383,6 +2001,10 @@ PyMODINIT_FUNC PyInit__kernels(void)
     INTERN(s_state, "state")
     INTERN(s_last_onset, "last_onset")
     INTERN(s_standard_normal, "standard_normal")
+    INTERN(s_kind, "kind")
+    INTERN(s_group, "group")
+    INTERN(s_name, "name")
+    INTERN(s_values, "values")
 
 #undef INTERN
     return PyModule_Create(&kernel_module);

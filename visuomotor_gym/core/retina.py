@@ -28,6 +28,25 @@ def nothing() -> tuple[list, list, bool]:
     return [0.0, 0.0, 0.0], [0.0, 0.0, 0.0], False
 
 
+def periphery_constants(params: VisionParams) -> bytes:
+    """The constants of the compiled periphery (``_kernels.c``: ``PeripheryConsts``, in its order):
+    each angle in radians computed as :mod:`visuomotor_gym.vision.periphery` and
+    :func:`visuomotor_gym.vision.foveation._sigmas` compute it, so both paths use the same doubles."""
+    deg, p = periphery.DEG, params
+    return np.array([
+        1.0 if p.foveated else 0.0, 1.0 if p.field_shape == "human" else 0.0, p.field_of_view_deg * foveation.DEG,
+        p.field_side_deg * deg, p.field_up_deg * deg, p.field_down_deg * deg,
+        1.0 if p.crowding else 0.0, p.crowding_fovea_deg * deg, p.crowding_bouma,
+        0.0 if p.position_e2_deg is None else 1.0, periphery.position_e2_deg(p) * deg,
+        p.fovea_e2_deg * foveation.DEG, p.noise_scale, p.retinal_position_std_arcmin, foveation.ARCMIN,
+        p.position_slip_knee_deg_s * foveation.DEG, p.retinal_velocity_weber,
+        p.retinal_velocity_floor_deg_s * foveation.DEG, p.depth_std_fraction, p.depth_rate_std_fraction,
+        0.0 if p.depth_pedestal_arcmin is None else 1.0,
+        0.0 if p.depth_pedestal_arcmin is None else p.depth_pedestal_arcmin * periphery.ARCMIN,
+        p.interocular_m, p.position_disarray,
+    ], dtype=np.float64).tobytes()
+
+
 class VisualTarget:
     """Something the eye can see. Subclasses give its world position and velocity as arrays
     (:meth:`state`) and say when the scene hides it (``hidden``: behind its thrower, out of play, not
@@ -110,8 +129,9 @@ class Retina:
         self._cos_fov = math.cos(min(params.field_of_view_deg * foveation.DEG + 1e-9, math.pi))
         # The compiled _see_all (visuomotor_gym._native, _kernels.c: retina_see_all), when built; its
         # constants in the order of its VisionConsts struct.
-        # The periphery's mechanisms (params.periphery_on) run on the pure-Python path only.
-        self._native = _native.enabled() and not params.periphery_on
+        # With the periphery's mechanisms (params.periphery_on) the compiled _see_all_periphery
+        # (_kernels.c: retina_see_periphery) and its constants (periphery_constants).
+        self._native = _native.enabled()
         deg = foveation.DEG
         self._native_constants = np.array([
             1.0 if params.foveated else 0.0, self._cos_fov, params.field_of_view_deg * deg, params.noise_scale,
@@ -119,12 +139,15 @@ class Retina:
             params.retinal_velocity_floor_deg_s * deg, params.depth_std_fraction, params.depth_rate_std_fraction,
             params.fovea_e2_deg * deg, params.position_slip_knee_deg_s * deg,
         ], dtype=np.float64).tobytes()
+        self._periphery_constants = periphery_constants(params)
         self.reset()
 
     def __setstate__(self, state: dict) -> None:
         self.__dict__.update(state)
         self.__dict__.setdefault("_disarray", None)  # pickled before the positional disarray existed
         self._native = self._native and _native.enabled()  # unpickled where the extension is missing
+        if "_periphery_constants" not in state:  # pickled before the compiled periphery existed
+            self._periphery_constants = periphery_constants(self.params)
 
     def reset(self) -> None:
         self._delay: deque = deque(maxlen=self.delay_steps + 1)
@@ -198,6 +221,10 @@ class Retina:
         target's own retinal slip); the position law and the depth law (the eye's
         vergence distance ``eye.fixation``) inside :func:`~visuomotor_gym.vision.foveation.perceive`.
         One ``rng.standard_normal(6)`` per seen target, in target order, as without them."""
+        if self._native:  # this method, compiled
+            return _native.kernels.retina_see_periphery(targets, data, eye.pos_list + eye.prev_pos + eye.prev_gaze
+                                                        + eye.rot_flat, self.dt, self._periphery_constants, rng,
+                                                        eye.fixation, self._disarray)
         vp = self.params
         ex, ey, ez = eye.pos_list
         r0, r1, r2, r3, r4, r5, r6, r7, r8 = eye.rot_flat

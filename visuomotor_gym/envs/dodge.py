@@ -32,11 +32,10 @@ from visuomotor_gym.vision.foveation import human_periphery
 
 __all__ = ["DODGE_LAYOUT", "DODGE_SCENE", "DODGE_VISION", "ObstacleDodgeEnv"]
 
-# The human periphery (vision.foveation.HUMAN_PERIPHERY: the human field of Spector 1990, the position law
-# E2 0.7 deg, crowding b 0.5 after Bouma 1970, the depth pedestal of 10 arcmin) and the positional disarray
-# (periphery.DisarrayField, Hess & Field 1993; the share 0.8 a modelling choice, swept 0 / 0.5 / 0.8 / 1.0
-# in docs/reproductions/gaze_default.md (g)).
-DODGE_VISION = human_periphery(position_disarray=0.8)
+# The human periphery, every family's eye (vision.foveation.HUMAN_PERIPHERY: the human field of Spector 1990,
+# the position law E2 0.7 deg, crowding b 0.5 after Bouma 1970, the depth pedestal of 10 arcmin and the
+# positional disarray 0.8 of Hess & Field 1993, swept in docs/reproductions/gaze_default.md (g)).
+DODGE_VISION = human_periphery()
 
 DODGE_SCENE = "dodge.xml"
 DODGE_TOP_CAMERA = "dodge_top"
@@ -56,7 +55,7 @@ class ObstacleDodgeEnv(WalkerEnv):
     (Jovancevic, Sullivan & Hayhoe), one member of a group alone. Coming closer to a pedestrian than the two bodies' radii is a **collision** and
     ends the episode. The pedestrians are seen **only through the eye**: the same oculomotor plant,
     foveated noise (Eyecatch Eq. 1-3), saccadic suppression and VOR as every family, with the **human
-    periphery** (``DODGE_VISION``: ``vision.foveation.human_periphery(position_disarray=0.8)``): the human
+    periphery** (``DODGE_VISION``: ``vision.foveation.human_periphery()``): the human
     field (Spector 1990), position precision falling with eccentricity (E2 0.7 deg), crowding (Bouma
     1970: a group's members pool in the periphery), depth precise only near the vergence distance, and
     the positional disarray (Hess & Field 1993: a still eye cannot average a pedestrian's peripheral

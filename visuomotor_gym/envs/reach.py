@@ -37,8 +37,9 @@ from visuomotor_gym.vision.foveation import human_periphery
 
 __all__ = ["REACH_VISION", "ShelfReachEnv", "reach_observation"]
 
-# The human periphery (vision.foveation.HUMAN_PERIPHERY: the human field of Spector 1990, the position law
-# E2 0.7 deg, crowding b = 0.5 after Bouma 1970, the depth pedestal 10 arcmin), in place of the catch
+# The human periphery, every family's eye (vision.foveation.HUMAN_PERIPHERY: the human field of Spector 1990,
+# the position law E2 0.7 deg, crowding b = 0.5 after Bouma 1970, the depth pedestal 10 arcmin, the positional
+# disarray 0.8 of Hess & Field 1993), in place of the catch
 # family's +-60 deg field with the acuity law alone.
 REACH_VISION = human_periphery()
 # Full shelves: every other target holds a distractor of the object's kind (modelling choice: a stocked shelf,
@@ -170,7 +171,8 @@ class ShelfReachEnv(VisuomotorEnv):
         "arrival_speed_m_s": ("the hand must be slower than this (m/s) to count as arrived (modelling choice: "
                               "arriving, not sweeping past)"),
         "vision_params": ("``VisionParams`` or a dict of its fields; the default is the human periphery "
-                          "(``vision.foveation.human_periphery()``: human field, position law, crowding, depth law)"),
+                          "(``vision.foveation.human_periphery()``: human field, position law, crowding, depth law, "
+                          "positional disarray)"),
         "shelf_clutter": ("how many of the other 29 targets hold a distractor (a cylinder of the object's size, seen "
                           "as a target of its kind: crowding pools it with the object), drawn per episode; 0 gives "
                           "the former scene with the object alone"),

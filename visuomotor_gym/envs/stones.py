@@ -36,8 +36,9 @@ from visuomotor_gym.vision.foveation import human_periphery
 __all__ = ["STONES_LAYOUT", "STONES_VISION", "SteppingStonesEnv"]
 
 RENDER_CAMERAS = ("both", "side", "follow", "scene", "eye")
-# The human periphery (vision.foveation.HUMAN_PERIPHERY: the human field of Spector 1990, the position law
-# E2 0.7 deg, crowding b = 0.5 after Bouma 1970, the depth pedestal 10 arcmin), in place of the walk
+# The human periphery, every family's eye (vision.foveation.HUMAN_PERIPHERY: the human field of Spector 1990,
+# the position law E2 0.7 deg, crowding b = 0.5 after Bouma 1970, the depth pedestal 10 arcmin, the positional
+# disarray 0.8 of Hess & Field 1993), in place of the walk
 # family's all-round 20 deg cone (Iwao's downward view angle, which no source gives as a cone).
 STONES_VISION = human_periphery()
 STONES_LAYOUT = ObservationLayout(PERCEPT_BLOCKS + EYE_BLOCKS + HEAD_BLOCKS + TURNING_WALKER_BLOCKS + TRAILING_BLOCKS)
@@ -162,7 +163,8 @@ class SteppingStonesEnv(WalkerEnv):
                                 'course: ALLSTEPS\' 0.25 m stones, no hazards); ``COURSE_PRESETS`` in '
                                 '``visuomotor_gym.tasks.stepping_stones``'),
         "vision_params": ("``VisionParams`` or a dict of its fields; the default is the human periphery "
-                          "(``vision.foveation.human_periphery()``: human field, position law, crowding, depth law)"),
+                          "(``vision.foveation.human_periphery()``: human field, position law, crowding, depth law, "
+                          "positional disarray)"),
         "vision": ('``"foveated"``, ``"full_view"`` (foveal noise everywhere, no field-of-view limit, no saccadic '
                    'blindness) or ``"oracle"`` (true stone centres)'),
         "render_camera": '``"both"`` (side view beside the eye view), ``"side"``, ``"follow"``, ``"scene"``, ``"eye"``',

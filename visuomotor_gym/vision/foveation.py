@@ -146,11 +146,14 @@ class VisionParams:
         return replace(self, noise_scale=self.noise_scale * factor)
 
 
-#: The four human-periphery mechanisms together (``"all four"`` in docs/reproductions/gaze_default.md):
-#: the human field (Spector 1990), the position law with E2 = 0.7 deg (modelling choice, swept 0.35-1.4),
-#: crowding with Bouma's b = 0.5 (Bouma 1970; Parkes et al. 2001) and the depth pedestal of 10 arcmin
-#: (modelling choice, swept 10 / 60 / off). The fields of :class:`VisionParams` they set.
-HUMAN_PERIPHERY = {"field_shape": "human", "position_e2_deg": 0.7, "crowding": True, "depth_pedestal_arcmin": 10.0}
+#: The human periphery, one eye for every family: the four mechanisms of docs/reproductions/gaze_default.md
+#: (``"all four"``) -- the human field (Spector 1990), the position law with E2 = 0.7 deg (modelling choice,
+#: swept 0.35-1.4), crowding with Bouma's b = 0.5 (Bouma 1970; Parkes et al. 2001) and the depth pedestal of
+#: 10 arcmin (modelling choice, swept 10 / 60 / off) -- and the positional disarray (Hess & Field 1993) with
+#: the share 0.8 of the added lateral variance fixed in retinal coordinates (modelling choice, swept
+#: 0 / 0.5 / 0.8 / 1.0 in gaze_default.md (g)). The fields of :class:`VisionParams` they set.
+HUMAN_PERIPHERY = {"field_shape": "human", "position_e2_deg": 0.7, "crowding": True, "depth_pedestal_arcmin": 10.0,
+                   "position_disarray": 0.8}
 
 
 def human_periphery(base: VisionParams | None = None, **overrides) -> VisionParams:

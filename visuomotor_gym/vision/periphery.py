@@ -3,7 +3,8 @@
 Each is switched on by a :class:`~visuomotor_gym.vision.foveation.VisionParams` field and is off by
 default (today's eye, bit for bit); all of them act only on a foveated eye (``foveated=False``, the
 FullView rung, sees with the fovea everywhere). The retina (:mod:`visuomotor_gym.core.retina`) applies
-them on its pure-Python path.
+them; its compiled path (``_kernels.c``: ``retina_see_periphery``, ``crowding_groups``, ``pooled``) mirrors
+the functions here, which stay the reference, bit for bit (``tests/test_native.py``).
 
 1. **Field of view, human shape** (``field_shape="human"``): instead of an all-round cone of half-angle
    ``field_of_view_deg``, the field reaches ``field_up_deg`` = 60 deg above the fixation point,
