@@ -161,11 +161,12 @@ def test_eom_brace_keeps_the_body_upright_on_a_few_seeds():
 
 
 def test_a_brace_that_keeps_pushing_throws_the_body_over_its_other_foot():
-    """Seed 5: the hand strikes the cube; an arm that keeps pushing as the body moves back (yield off)
-    throws it away from the wall, over its left foot; the arm that yields keeps it upright."""
-    _env, _agent, info = _play("eom_brace", 5)
+    """Seed 8 (seed 5 before the eye carried the positional disarray): the hand strikes the cube; an arm that
+    keeps pushing as the body moves back (yield off) throws it away from the wall, over its left foot; the arm
+    that yields keeps it upright."""
+    _env, _agent, info = _play("eom_brace", 8)
     assert info["is_success"], info
-    _env, _agent, info = _play("eom_brace:yield_speed_m_s=-1", 5)
+    _env, _agent, info = _play("eom_brace:yield_speed_m_s=-1", 8)
     assert info["fallen"] and info["first_contact_time"] > 0, info  # it touched a cube, then fell ...
     assert info["pelvis_pos"][1] > 0.2, info["pelvis_pos"]  # ... away from the wall (the wall is at -y)
 
