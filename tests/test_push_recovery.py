@@ -258,6 +258,23 @@ def test_a_turned_wall_is_a_plane_at_its_yaw_and_the_push_goes_toward_it(monkeyp
     np.testing.assert_allclose(q, (math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)), atol=1e-12)
 
 
+def test_a_crowded_row_keeps_every_cube_near_the_first_one_s_height_and_the_other_draws(monkeypatch):
+    """ROW_HEIGHT_JITTER_M (fifth pass, opt-in): the cubes after the first within +-jitter of its height; the
+    sizes, the along-wall positions and the push are the definition's draws (their order is unchanged)."""
+    env = gym.make(ENV)
+    env.reset(seed=7)
+    task = env.unwrapped.task
+    faces, sizes, push = task.block_faces.copy(), task.block_half_sizes.copy(), task.push_time
+    monkeypatch.setattr(pr, "ROW_HEIGHT_JITTER_M", 0.02)
+    env.reset(seed=7)
+    z = task.block_faces[:, 2]
+    assert np.ptp(faces[:, 2]) > 0.1  # the definition's cubes at independent heights (seed 7)
+    assert np.all(np.abs(z[1:] - z[0]) <= 0.02 + 1e-12) and z[0] == faces[0, 2]
+    np.testing.assert_array_equal(task.block_half_sizes, sizes)
+    np.testing.assert_array_equal(task.block_faces[:, :2], faces[:, :2])
+    assert task.push_time == push
+
+
 def test_eom_brace_braces_along_the_fall_toward_a_turned_wall(monkeypatch):
     """fall_direction=true: the push is detected from the vestibular fall direction, which points at the
     turned wall, and the hand braces on a cube there (Oracle rung: the brace, not the eye)."""
@@ -339,3 +356,50 @@ def test_choose_by_ray_cuts_each_belief_s_line_of_sight_with_the_expected_wall_p
 def test_the_fourth_pass_options_refuse_bad_values(spec):
     with pytest.raises(ValueError, match="EomBraceParams"):
         make_agent(spec, ENV, 9)
+
+
+@pytest.mark.parametrize("spec", ["eom_brace:verify_reach=1", "eom_brace:reach_max_m=-0.5",
+                                  "eom_brace:verify_w=-1"])
+def test_the_fifth_pass_options_refuse_bad_values(spec):
+    with pytest.raises(ValueError, match="EomBraceParams"):
+        make_agent(spec, ENV, 9)
+
+
+def test_a_back_row_sets_the_odd_cubes_behind_the_wall_plane(monkeypatch):
+    """BACK_ROW_M (fifth pass, opt-in): the odd cubes this far behind their definition place along the wall's
+    normal, the even ones where they were."""
+    env = gym.make(ENV)
+    env.reset(seed=3)
+    task = env.unwrapped.task
+    faces = task.block_faces.copy()
+    monkeypatch.setattr(pr, "BACK_ROW_M", 0.4)
+    env.reset(seed=3)
+    moved = task.block_faces - faces
+    np.testing.assert_allclose(moved[0::2], 0.0, atol=1e-12)
+    np.testing.assert_allclose(moved[1::2], np.outer(np.ones(len(moved[1::2])), 0.4 * task.wall_normal), atol=1e-12)
+
+
+def test_reach_max_keeps_the_oracle_s_brace_off_a_back_cube(monkeypatch):
+    """On the fifth pass's crowded row with a back row (seed 5), the brace that picks the cube nearest the fall
+    line goes for back cube 1 and falls; with reach_max_m it holds on front cube 0."""
+    for name, value in (("BACK_ROW_M", 0.4), ("BLOCK_HALF_SIZE_M", (0.04, 0.05)), ("GAP_M", (0.05, 0.08)),
+                        ("WALL_YAW_DEG", (0.0, 30.0)), ("ROW_HEIGHT_JITTER_M", 0.02)):
+        monkeypatch.setattr(pr, name, value)
+    monkeypatch.setattr(sn, "ANKLE_STRATEGY_GAIN", 1.0)
+    brace = "eom_brace:fall_direction=true,hold_lean_gain=2,hold_lean_damp=0.1"
+    outcomes = {}
+    for spec in (brace, brace + ",reach_max_m=0.7"):
+        env = gym.make("PushRecoveryOracle-v0")
+        agent = make_agent(spec, "PushRecoveryOracle-v0", env.action_space.shape[0], seed=5)
+        obs, info = env.reset(seed=5)
+        touched = set()
+        while True:
+            action, _ = agent.predict(obs)
+            obs, _r, terminated, truncated, info = env.step(action)
+            if info["hand_block"] >= 0:
+                touched.add(info["hand_block"])
+            if terminated or truncated:
+                break
+        outcomes[spec] = (info["fallen"], touched)
+    assert outcomes[brace] == (True, {1})
+    assert outcomes[brace + ",reach_max_m=0.7"] == (False, {0})

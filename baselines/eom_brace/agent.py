@@ -126,6 +126,16 @@ class EomBraceParams:
     # cube nearest the fall line through the shoulder and brace along that direction, for a wall that is not
     # beside the body (task WALL_YAW_DEG). Off: the definition's wall on the right, as before (bit for bit).
     fall_direction: bool = False
+    # reach_max_m (fifth pass, opt-in; 0 = off): a cube whose believed face lies farther than this from the
+    # shoulder along the fall's direction is out of reach and not chosen while a nearer one is believed
+    # (modelling choice: the arm's ~0.6 m plus the lean; a back row of cubes, tasks.push_recovery.BACK_ROW_M).
+    reach_max_m: float = 0.0
+    # verify_reach: only a cube whose depth a fixation has measured (a sample of weight >= verify_w) is ruled out by reach_max_m; the others stay candidates, and the eye goes to the nearest of them;
+    # the choice is kept until that cube is ruled out, and the hand moves in only once a fixation has measured
+    # the chosen cube's depth (modelling choice: a depth seen only in the periphery,
+    # ~0.4 m std at 20 deg, cannot tell a cube within reach from one behind it).
+    verify_reach: bool = False
+    verify_w: float = 100.0  # a depth std under 10 cm: the rows 0.3-0.4 m apart are told apart (modelling choice)
     fall_speed_m_s: float = 0.15  # the pelvis moving faster than this: its direction is the fall's (modelling choice)
     approach_offset_m: float = 0.10  # align the palm 10 cm in front of the believed face first (modelling choice)
     align_m: float = 0.04  # ... to within 4 cm along the wall, then move in (modelling choice)
@@ -161,7 +171,7 @@ class EomBraceParams:
             v = getattr(self, f.name)
             if f.name in ("foveated", "gaze_blind", "use_hand", "verge_on_sample", "fall_direction", "wall_normal",
                           "choose_by_ray", "drop_crowded", "verge_on_ray",
-                          "hand_on_cut"):
+                          "hand_on_cut", "verify_reach"):
                 if not isinstance(v, bool):
                     raise ValueError(f"EomBraceParams.{f.name} must be true or false, got {v!r}")
             elif f.name == "scan_blocks":
@@ -371,10 +381,19 @@ class EomBraceAgent:
             if self.hold is None:
                 # The nearest believed face to the line of the fall through the right shoulder.
                 faces = np.array([self.estimate(i) for i in known]) - SHOULDER
+                depth = faces @ n
                 if p.choose_by_ray:
                     faces = np.array([self._direction_cut(i, n) for i in known]) - SHOULDER
-                lateral = faces - np.outer(faces @ n, n)
-                self.chosen = known[int(np.argmin(np.linalg.norm(lateral, axis=1)))]
+                lateral = np.linalg.norm(faces - np.outer(faces @ n, n), axis=1)
+                if p.reach_max_m > 0 and p.verify_reach:
+                    out = (depth > p.reach_max_m) & (self.best_w[known] >= p.verify_w)
+                    if not np.all(out):
+                        lateral = np.where(out, np.inf, lateral)
+                    if self.chosen in known and not out[known.index(self.chosen)]:
+                        lateral[known.index(self.chosen)] = -1.0  # keep the choice until it is ruled out
+                elif p.reach_max_m > 0 and np.any(depth <= p.reach_max_m):
+                    lateral = np.where(depth <= p.reach_max_m, lateral, np.inf)
+                self.chosen = known[int(np.argmin(lateral))]
                 face = self.estimate(self.chosen)
                 if p.hand_on_cut and self.best_w[self.chosen] < p.cut_until_w:
                     face = self._direction_cut(self.chosen, n)  # not yet fixated: the direction at the plane
@@ -384,7 +403,8 @@ class EomBraceAgent:
                     target = face - n * p.approach_offset_m
                     late = t - self.detected_at - p.reaction_latency_s >= p.align_timeout_s - 1e-9
                     off = hand - face
-                    if float(np.linalg.norm(off - n * float(off @ n))) < p.align_m or late:
+                    verified = not p.verify_reach or self.best_w[self.chosen] >= p.verify_w
+                    if verified and (float(np.linalg.norm(off - n * float(off @ n))) < p.align_m or late):
                         self.approach_since = t
                         self.events.append((t, "approach"))
                 if self.approach_since is not None:

@@ -46,6 +46,17 @@ BLOCK_HALF_SIZE_M = (0.07, 0.11)
 GAP_M = (0.12, 0.30)
 BLOCK_HEIGHT_M = (1.00, 1.35)
 BLOCK_OFFSET_M = (0.0, 0.10)
+# A crowded wall (issue 25's fifth pass, opt-in; None in the definition): every cube after the first at the
+# first cube's height plus up to +-ROW_HEIGHT_JITTER_M (its own height draw mapped onto that range, so the
+# draws and their order are unchanged): a straight row whose neighbours lie side by side in the visual field,
+# where crowding (Bouma 1970) can pool them. Modelling choice.
+ROW_HEIGHT_JITTER_M: float | None = None
+# A back row (fifth pass, opt-in; None in the definition): the odd cubes stand this far behind the wall plane,
+# out of the hand's reach, seen through the gaps of the front row. Same kind as the front cubes, so a
+# peripheral percept may pool a front cube with the back cube beside it (Bouma 1970), and a peripheral depth
+# (~0.4 m std at 20 deg) cannot tell the rows apart: a hand sent to a back cube goes through a gap.
+# Modelling choice.
+BACK_ROW_M: float | None = None
 FIRST_BLOCK_X_M = (-0.35, -0.05)  # the row starts beside the body and runs forward (modelling choice)
 PARKED = (-20.0, -20.0, -5.0)  # a parked block: 5 m under the floor, out of sight
 
@@ -147,6 +158,9 @@ class PushRecoveryTask(Task):
             off = float(rng.uniform(*BLOCK_OFFSET_M))
             if i > 0:
                 x += gap
+                if ROW_HEIGHT_JITTER_M is not None:
+                    lo, hi = BLOCK_HEIGHT_M
+                    z = rows[0][2] + ROW_HEIGHT_JITTER_M * (2.0 * (z - lo) / (hi - lo) - 1.0)
             x += h
             rows.append((x, h, z, off))
             x += h
@@ -170,6 +184,8 @@ class PushRecoveryTask(Task):
                 continue
             xa, h, z, off = row
             face = along * xa + normal * (wall - off) + np.array([0.0, 0.0, z])
+            if BACK_ROW_M is not None and i % 2 == 1:
+                face = face + normal * BACK_ROW_M
             centre = face + normal * h
             self._resize(i, h)
             data.mocap_pos[self._mocap[i]] = centre
