@@ -359,7 +359,7 @@ def test_the_fourth_pass_options_refuse_bad_values(spec):
 
 
 @pytest.mark.parametrize("spec", ["eom_brace:verify_reach=1", "eom_brace:reach_max_m=-0.5",
-                                  "eom_brace:verify_w=-1"])
+                                  "eom_brace:verify_w=-1", "eom_brace:verify_dwell_s=-0.1"])
 def test_the_fifth_pass_options_refuse_bad_values(spec):
     with pytest.raises(ValueError, match="EomBraceParams"):
         make_agent(spec, ENV, 9)

@@ -136,6 +136,7 @@ class EomBraceParams:
     # ~0.4 m std at 20 deg, cannot tell a cube within reach from one behind it).
     verify_reach: bool = False
     verify_w: float = 100.0  # a depth std under 10 cm: the rows 0.3-0.4 m apart are told apart (modelling choice)
+    verify_dwell_s: float = 0.15  # a candidate looked at this long without a measured depth is passed over (modelling choice)
     fall_speed_m_s: float = 0.15  # the pelvis moving faster than this: its direction is the fall's (modelling choice)
     approach_offset_m: float = 0.10  # align the palm 10 cm in front of the believed face first (modelling choice)
     align_m: float = 0.04  # ... to within 4 cm along the wall, then move in (modelling choice)
@@ -246,6 +247,8 @@ class EomBraceAgent:
         self._scan_k = -1
         self._scan_target = 0
         self.chosen: int | None = None
+        self._checked: set = set()  # verify_reach: cubes ruled out (measured beyond reach, or not seen well)
+        self._check_since: float | None = None
         self.hold: np.ndarray | None = None
         self.hold_eye: np.ndarray | None = None
         self.approach_since: float | None = None
@@ -375,6 +378,8 @@ class EomBraceAgent:
                     self._scan_k = k
                     self._scan_target = order[(k - len(p.scan_x_m)) % len(order)]
                 look_at = self.estimate(self._scan_target)
+                if p.verify_reach:  # verged at the expected wall: a front cube's depth is measured there
+                    look_at = self._direction_cut(self._scan_target, n)
                 look_block = self._scan_target
         if self.detected_at is not None and known and t >= self.detected_at + p.reaction_latency_s - 1e-9:
             hand_speed = float(np.linalg.norm(obs[_S["hand_vel"]]))
@@ -386,14 +391,31 @@ class EomBraceAgent:
                     faces = np.array([self._direction_cut(i, n) for i in known]) - SHOULDER
                 lateral = np.linalg.norm(faces - np.outer(faces @ n, n), axis=1)
                 if p.reach_max_m > 0 and p.verify_reach:
-                    out = (depth > p.reach_max_m) & (self.best_w[known] >= p.verify_w)
-                    if not np.all(out):
-                        lateral = np.where(out, np.inf, lateral)
-                    if self.chosen in known and not out[known.index(self.chosen)]:
-                        lateral[known.index(self.chosen)] = -1.0  # keep the choice until it is ruled out
+                    # A cube a fixation has measured within reach is chosen (the nearest such); until one is,
+                    # the eye checks the candidates nearest the fall line in turn, each for verify_dwell_s.
+                    sure = self.best_w[known] >= p.verify_w
+                    ok = sure & (depth <= p.reach_max_m)
+                    for j, i in enumerate(known):
+                        if sure[j] and not ok[j]:
+                            self._checked.add(i)
+                    if self.chosen in known and self.chosen in self._checked:
+                        self.chosen = None
+                    if np.any(ok):
+                        lateral = np.where(ok, lateral, np.inf)
+                    else:
+                        lateral = np.where([i in self._checked for i in known], lateral + 10.0, lateral)
+                        if self.chosen in known and self._check_since is not None \
+                                and t - self._check_since >= p.verify_dwell_s:
+                            self._checked.add(self.chosen)
+                            lateral[known.index(self.chosen)] += 10.0
+                        elif self.chosen in known:
+                            lateral[known.index(self.chosen)] = -1.0  # keep checking it
                 elif p.reach_max_m > 0 and np.any(depth <= p.reach_max_m):
                     lateral = np.where(depth <= p.reach_max_m, lateral, np.inf)
+                previous = self.chosen
                 self.chosen = known[int(np.argmin(lateral))]
+                if self.chosen != previous:
+                    self._check_since = t
                 face = self.estimate(self.chosen)
                 if p.hand_on_cut and self.best_w[self.chosen] < p.cut_until_w:
                     face = self._direction_cut(self.chosen, n)  # not yet fixated: the direction at the plane
