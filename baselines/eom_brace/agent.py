@@ -130,10 +130,11 @@ class EomBraceParams:
     # shoulder along the fall's direction is out of reach and not chosen while a nearer one is believed
     # (modelling choice: the arm's ~0.6 m plus the lean; a back row of cubes, tasks.push_recovery.BACK_ROW_M).
     reach_max_m: float = 0.0
-    # verify_reach: only a cube whose depth a fixation has measured (a sample of weight >= verify_w) is ruled out by reach_max_m; the others stay candidates, and the eye goes to the nearest of them;
-    # the choice is kept until that cube is ruled out, and the hand moves in only once a fixation has measured
-    # the chosen cube's depth (modelling choice: a depth seen only in the periphery,
-    # ~0.4 m std at 20 deg, cannot tell a cube within reach from one behind it).
+    # verify_reach (with reach_max_m): a cube is chosen only once a fixation has measured it within reach (a
+    # sample of weight >= verify_w); until then the eye checks the candidates nearest the fall line in turn,
+    # verify_dwell_s each, the hand does not move in, and the scan before the push looks at the cubes on the
+    # expected wall plane (modelling choice: a depth seen only in the periphery, ~0.4 m std at 20 deg, cannot
+    # tell a cube within reach from one behind it).
     verify_reach: bool = False
     verify_w: float = 100.0  # a depth std under 10 cm: the rows 0.3-0.4 m apart are told apart (modelling choice)
     verify_dwell_s: float = 0.15  # a candidate looked at this long without a measured depth is passed over (modelling choice)
