@@ -181,7 +181,9 @@ def test_first_saccade_waits_for_a_human_latency_and_the_criterion():
         assert 0.18 - 1e-6 <= first <= 0.24
         held = t.t <= 0.18 - 1e-9
         np.testing.assert_allclose(t.gaze_dir[held], np.repeat(t.gaze_dir[:1], held.sum(), axis=0), atol=1e-9)
-    never = make_agent("eyecatch:first_saccade_retinal_std_deg=1e-6,first_saccade_deadline_s=0.4", "EyeCatch-v0", 9)
+    # (the criterion is the paper agent's: under EyeCatch-v0's human periphery, periphery_model goes at the latency)
+    never = make_agent("eyecatch:first_saccade_retinal_std_deg=1e-6,first_saccade_deadline_s=0.4,periphery_model=False",
+                       "EyeCatch-v0", 9)
     t = run_episode(env, never, 0, "EyeCatch-v0", "eyecatch")
     assert t.t[t.saccade_onset][0] - t.dt == pytest.approx(0.4, abs=1e-6)
     env = gym.make("EyeCatchPaperPoorVision-v0")
@@ -278,8 +280,9 @@ def test_thrower_prior_on_the_line_of_sight():
 def test_noise_is_evaluated_at_the_expected_distance_on_the_retinal_direction():
     """Eq. 1-3 need the true distance and line of sight: the agent evaluates the sample's noise at
     sqrt(E[d^2]) of its prior (mean distance^2 + depth variance) along the sample's own direction
-    (mixed with the prior's by their angular variances); a sample behind the eye keeps its ray."""
-    agent = make_agent("eyecatch", "EyeCatch-v0", 9)
+    (mixed with the prior's by their angular variances); a sample behind the eye keeps its ray. (The paper
+    agent's rule: an eye without the human periphery.)"""
+    agent = make_agent("eyecatch", "EyeCatchPaper-v0", 9)
     rot, eye = np.eye(3), np.zeros(3)
     agent.filter.x = np.array([3.0, 0.0, 0.0, 0.0, 0.0, 0.0])
     agent.filter.P = np.diag([4.0, 1e-6, 1e-6, 1.0, 1.0, 1.0])  # depth std 2 m, lateral 1 mm

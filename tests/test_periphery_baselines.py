@@ -173,9 +173,9 @@ def test_crowded_flags_only_targets_within_the_critical_spacing():
     assert crowd_std(2.0, 10.0 * DEG, v) == pytest.approx(0.5 * 0.5 * 10.0 * DEG * 2.0)
 
 
-def _first_saccade_time(disarray: float, seed: int = 16) -> float:
+def _first_saccade_time(disarray: float, seed: int = 16, spec: str = "eyecatch") -> float:
     env = gym.make("EyeCatch-v0", vision_params={**HUMAN, "position_disarray": disarray})
-    policy = make_agent("eyecatch", "EyeCatch-v0", int(env.action_space.shape[0]), seed=seed)
+    policy = make_agent(spec, "EyeCatch-v0", int(env.action_space.shape[0]), seed=seed)
     match_vision(policy, env.unwrapped.vision_params)
     agent = _inner(policy)
     obs, _ = env.reset(seed=seed)
@@ -187,12 +187,93 @@ def _first_saccade_time(disarray: float, seed: int = 16) -> float:
     return next(t for t, e in agent.events if e == "first-saccade")
 
 
-def test_eyecatch_under_the_disarray_saccades_once_waiting_stops_paying(monkeypatch):
-    # seed 16, all four + disarray 0.8: the ball's believed retinal std never meets the 3 deg criterion;
-    # the agent goes as soon as it has stopped falling (0.1 s), not at the 0.5 s deadline
-    from visuomotor_gym.baselines.eyecatch import agent as eyecatch_agent
+def test_eyecatch_under_the_human_periphery_saccades_at_the_latency():
+    # seed 16, all four + disarray 0.8: the ball's believed retinal std never meets the 3 deg criterion
+    # (the old agent waited for its 0.5 s deadline); with the throw expected the first saccade goes at the
+    # saccadic latency (0.18 s), and the agent without its periphery model still waits
+    assert _first_saccade_time(0.8) == pytest.approx(0.18, abs=0.011)
+    assert _first_saccade_time(0.8, spec="eyecatch:periphery_model=False") == pytest.approx(0.5, abs=0.011)
 
-    assert _first_saccade_time(0.0) == pytest.approx(0.18, abs=0.011)  # the criterion met at once
-    assert 0.18 <= _first_saccade_time(0.8) < 0.4
-    monkeypatch.setattr(eyecatch_agent, "FIRST_SACCADE_PLATEAU", math.inf)  # the plateau rule off
-    assert _first_saccade_time(0.8) == pytest.approx(0.5, abs=0.011)
+# --- eyecatch's model of the human periphery (baselines/eyecatch/agent.py, 5-7) -------------------------
+def _eyecatch(vision_params=None, spec="eyecatch"):
+    agent = _inner(make_agent(spec, "EyeCatch-v0", 9))
+    if vision_params is not None:
+        agent.vision = VisionParams(**vision_params)
+    return agent
+
+
+def test_throw_prior_matches_its_monte_carlo():
+    """The closed-form moments of the expected throw against 400k draws of the same generative model."""
+    from visuomotor_gym.baselines.eyecatch.agent import throw_prior
+
+    from visuomotor_gym.scenarios.throws import GRAVITY, ThrowDistribution
+
+    mean0, cov0 = np.array([4.5, 0.3, 1.6]), np.diag([1.0, 0.09, 0.09])
+    mean, cov = throw_prior(mean0, cov0)
+    rng = np.random.default_rng(0)
+    n, d = 400_000, ThrowDistribution()
+    p0 = rng.multivariate_normal(mean0, cov0, n)
+    lo = np.array([d.arrival_x_m[0], d.arrival_y_m[0], d.arrival_z_m[0]])
+    hi = np.array([d.arrival_x_m[1], d.arrival_y_m[1], d.arrival_z_m[1]])
+    arrival = lo + (hi - lo) * rng.random((n, 3))
+    flight = d.flight_time_s[0] + (d.flight_time_s[1] - d.flight_time_s[0]) * rng.random((n, 1))
+    samples = np.hstack([p0, (arrival - p0) / flight - 0.5 * GRAVITY * flight])
+    np.testing.assert_allclose(mean, samples.mean(axis=0), atol=0.01)
+    np.testing.assert_allclose(cov, np.cov(samples.T), atol=0.02)
+    # by hand: the mean velocity of a throw from 4.5 m to the region's centre (0.375, -0.25, 1.025)
+    inv_t = math.log(1.4 / 0.8) / 0.6
+    np.testing.assert_allclose(mean[3:], [(0.375 - 4.5) * inv_t, (-0.25 - 0.3) * inv_t,
+                                          (1.025 - 1.6) * inv_t + 0.5 * 9.81 * 1.1], atol=1e-9)
+    assert np.diag(cov)[3:].max() < 2.0  # far below the uninformative 100 m^2/s^2
+
+
+def test_eyecatch_expects_the_throw_only_under_the_human_periphery():
+    rot, eye = np.eye(3), np.array([0.1, -0.2, 1.2])
+    plain = _eyecatch({})  # an eye without the human periphery
+    plain._set_thrower_prior(rot, eye)
+    np.testing.assert_allclose(np.diag(plain.filter.P)[3:], [100.0] * 3)  # the paper agent: uninformative
+    for spec, expects in (("eyecatch", True), ("eyecatch:periphery_model=False", False)):
+        agent = _eyecatch({**HUMAN, "position_disarray": 0.8}, spec)
+        agent._set_thrower_prior(rot, eye)
+        np.testing.assert_allclose(agent.filter.x[:3], eye + [4.5, 0.0, 0.0])
+        assert (np.diag(agent.filter.P)[3:].max() < 2.0) == expects
+        assert (agent.filter.x[3] < -2.0) == expects  # toward the catcher
+
+
+def test_eyecatch_noise_point_at_the_rms_eccentricity_under_the_periphery():
+    """A sample on the fovea is not taken for a foveal ball: the noise is evaluated in the prior's polar
+    direction at sqrt(theta_p^2 + 2 sigma_theta^2), whatever the sample's own direction."""
+    agent = _eyecatch({**HUMAN, "position_disarray": 0.8})
+    rot, eye = np.eye(3), np.zeros(3)
+    theta = 5.0 * DEG
+    agent.filter.x = np.array([3.0 * math.cos(theta), 0.0, 3.0 * math.sin(theta), 0.0, 0.0, 0.0])
+    lat = (0.03 * 3.0) ** 2  # 1.72 deg of lateral std per axis at 3 m
+    u = agent.filter.x[:3] / 3.0
+    agent.filter.P = np.zeros((6, 6))
+    agent.filter.P[:3, :3] = 0.04 * np.outer(u, u) + lat * (np.eye(3) - np.outer(u, u))
+    agent.filter.initialised = True
+    point = agent._noise_point(np.array([2.0, 0.0, 0.0]), rot, eye)  # the sample: on the fovea, too near
+    d = math.sqrt(9.0 + 0.04)
+    assert np.linalg.norm(point) == pytest.approx(d)
+    var = lat / (9.0 + 0.04)
+    expected = math.sqrt(theta**2 + 2.0 * var)
+    assert math.acos(point[0] / d) == pytest.approx(expected, rel=1e-9)
+    assert point[1] == pytest.approx(0.0, abs=1e-12) and point[2] > 0  # the prior's polar direction
+
+
+def test_eyecatch_rms_pedestal_and_retinal_speed():
+    agent = _eyecatch({**HUMAN, "position_disarray": 0.8})
+    eye = np.zeros(3)
+    agent.filter.x = np.array([2.0, 0.0, 0.0, 0.0, 0.0, 0.0])
+    agent.filter.P = np.diag([0.1**2, 1e-4, 1e-4, 1.0, 0.25, 0.25])
+    agent.filter.initialised = True
+    # verged on the estimate (2 m): the gap is the depth std over d^2 alone, 0.1 / 4 diopters
+    fix = agent._pedestal_fixation(np.array([2.0, 0.0, 0.0]), 2.0, eye)
+    assert 1.0 / fix - 1.0 / 2.0 == pytest.approx(0.1 / 4.0)
+    # and it adds in quadrature to the vergence's own gap (verged at 4 m: 0.25 D)
+    fix = agent._pedestal_fixation(np.array([2.0, 0.0, 0.0]), 4.0, eye)
+    assert 1.0 / fix - 1.0 / 2.0 == pytest.approx(math.hypot(0.25, 0.025))
+    # RMS retinal speed: a still ball with 0.5 m/s of velocity std on each lateral axis at 2 m
+    speed = agent._expected_retinal_speed(np.array([2.0, 0.0, 0.0]), np.zeros(3), np.diag([1.0, 0.25, 0.25]),
+                                          np.zeros(3))
+    assert speed == pytest.approx(math.sqrt(0.5) / 2.0)

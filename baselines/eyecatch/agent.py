@@ -37,6 +37,29 @@ The agent sees observations only. Each 20 ms control step:
 Parameters are named in :class:`EyecatchParams` with their source; ``EyecatchAgent.for_env`` sets the
 vision assumptions (noise scale, foveation, latency) from the registered env id, as a brain is
 adapted to its own eye.
+
+**Under the human periphery** (``VisionParams.periphery_on``: the position law, the depth law, the
+positional disarray of ``vision/periphery.py``), a sample's noise depends steeply on where the ball is
+relative to the fovea and to the vergence distance, which the brain knows only through its estimate.
+The agent then (``periphery_model``, on by default; off: the agent above, unchanged) models its eye as
+follows (docs/reproductions/gaze_default.md, "EyeCatch-v0 under the one eye"):
+
+5. **The throw is expected** (:func:`throw_prior`): the catcher knows it is the target. The first prior's
+   velocity is the one that carries the ball from the thrower's hand to the catchable region in front of
+   the right shoulder in a flight time of the throw distribution (moments in closed form), instead of an
+   uninformative 10 m/s std.
+6. **The expected noise, not the noise at one guess**: a sample's eccentricity is taken as the RMS
+   eccentricity under the prior (``sqrt(theta_p^2 + 2 sigma_theta^2)``, not the sample's own direction,
+   whose noise would make a foveal-looking sample look precise); the disparity pedestal as the RMS inverse-
+   distance gap under the prior's depth variance; the retinal speed as the RMS under the prior's angular-
+   velocity variance.
+7. **The first saccade at the saccadic latency** (0.18 s): with the throw expected, the estimate where the
+   saccade would land is as good as a still eye can make it (the ball slips off the fovea at ~60 deg/s,
+   where the position law leaves each look worth little).
+8. **The head pursues the ball's believed motion**, not the eye's achieved one: the head's share of
+   pursuit (Eyecatch 4.2) is driven by the target motion that drives the eye's pursuit, so an eye held at
+   its orbital limit (+27.7 deg up: rising throws reach it) no longer stops the head, which then leaves
+   the ball 10-20 deg off the fovea (modelling choice).
 """
 
 from __future__ import annotations
@@ -51,6 +74,7 @@ from visuomotor_gym.envs.actions import NECK_RANGE_DEG, hand_action
 from visuomotor_gym.envs.observation import ObservationLayout
 from visuomotor_gym.oculomotor.plant import angles_from_direction, direction_from_angles, minimum_jerk
 from visuomotor_gym.registration import env_vision
+from visuomotor_gym.scenarios.throws import GRAVITY, ThrowDistribution
 from visuomotor_gym.vision import foveation
 from visuomotor_gym.vision.foveation import VisionParams
 
@@ -59,10 +83,44 @@ from .kalman import BallKalmanFilter, KalmanParams
 _S = ObservationLayout().slices
 DEG = math.pi / 180.0
 SHOULDER_WORLD = np.array([0.0, -0.2, 0.9])  # right shoulder at the reset posture
-# Under the positional disarray the first saccade also goes once the ball's retinal std has fallen by
-# less than 10 % over the last 0.1 s (five looks): modelling choices (see EyecatchAgent._first_saccade_due).
-FIRST_SACCADE_PLATEAU = 0.9
-FIRST_SACCADE_PLATEAU_S = 0.1
+
+
+def throw_prior(release_mean: np.ndarray, release_cov: np.ndarray,
+                throws: ThrowDistribution | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """The (position, velocity) prior at the release of a throw aimed at the catcher: mean (6,) and
+    covariance (6, 6), world frame.
+
+    The release point ``p0 ~ N(release_mean, release_cov)``, the arrival point ``a`` uniform in the
+    catchable region of ``throws`` (``arrival_*_m``), the flight time ``T`` uniform in
+    ``flight_time_s``, all independent; the launch velocity ``v = (a - p0) / T - g T / 2`` (ballistic).
+    Moments in closed form, with ``c = E[a] - E[p0]``, ``E[1/T] = ln(T1/T0) / (T1 - T0)`` and
+    ``E[1/T^2] = 1 / (T0 T1)``::
+
+        E[v] = c E[1/T] - g E[T] / 2
+        Cov(v) = (Cov(a) + Cov(p0) + c c^T) E[1/T^2] - c c^T E[1/T]^2 + g g^T Var(T) / 4
+                 - (c g^T + g c^T) (1 - E[1/T] E[T]) / 2
+        Cov(p0, v) = -Cov(p0) E[1/T]
+    """
+    throws = throws if throws is not None else ThrowDistribution()
+    lo = np.array([throws.arrival_x_m[0], throws.arrival_y_m[0], throws.arrival_z_m[0]])
+    hi = np.array([throws.arrival_x_m[1], throws.arrival_y_m[1], throws.arrival_z_m[1]])
+    t0, t1 = throws.flight_time_s
+    mean_t, var_t = 0.5 * (t0 + t1), (t1 - t0) ** 2 / 12.0
+    inv_t = math.log(t1 / t0) / (t1 - t0) if t1 > t0 else 1.0 / t0
+    inv_t2 = 1.0 / (t0 * t1)
+    c = 0.5 * (lo + hi) - release_mean
+    cov_a = np.diag((hi - lo) ** 2 / 12.0)
+    mean_v = c * inv_t - 0.5 * GRAVITY * mean_t
+    cc = np.outer(c, c)
+    cross = np.outer(c, GRAVITY) * 0.5 * (1.0 - inv_t * mean_t)
+    cov_v = (cov_a + release_cov + cc) * inv_t2 - cc * inv_t**2 + 0.25 * np.outer(GRAVITY, GRAVITY) * var_t \
+        - cross - cross.T
+    cov = np.zeros((6, 6))
+    cov[:3, :3] = release_cov
+    cov[:3, 3:] = -release_cov * inv_t
+    cov[3:, :3] = cov[:3, 3:].T
+    cov[3:, 3:] = 0.5 * (cov_v + cov_v.T)
+    return np.concatenate([release_mean, mean_v]), cov
 
 
 @dataclass(frozen=True)
@@ -84,6 +142,10 @@ class EyecatchParams:
     thrower_distance_m: float = 4.5  # modelling choice: middle of a 3-6 m throw (ThrowDistribution)
     thrower_distance_std_m: float = 1.0  # modelling choice: ~ the std of a 3-6 m uniform range (0.87)
     thrower_lateral_std_m: float = 0.3  # modelling choice: ~4 deg at 4.5 m (the reset gaze jitter is 2 deg)
+    periphery_model: bool = True  # under an eye with the human periphery (VisionParams.periphery_on), the
+    # adaptations 5-8 of the module docstring: the throw expected (throw_prior), the expected sample noise,
+    # the first saccade at the saccadic latency, the head pursuing the believed ball. No effect on other
+    # eyes. False: the agent as before them
     # Gaze (Eyecatch 4.1).
     first_saccade_min_latency_s: float = 0.18  # the first saccade's decision signal needs this long to
     # reach its criterion: human saccadic latency 180-200 ms (REFERENCES.md, Eyecatch's criterion is
@@ -172,6 +234,15 @@ def head_law(head_dest, gaze_dest, dead_zone_rad: float) -> tuple[float, float]:
     return az, el
 
 
+def _at_eccentricity(u: np.ndarray, theta: float) -> np.ndarray:
+    """The unit vector (eye frame, x the visual axis) at eccentricity ``theta`` (rad) in the polar
+    direction of ``u`` (along +y when ``u`` is on the axis)."""
+    r = math.hypot(float(u[1]), float(u[2]))
+    if r < 1e-12:
+        return np.array([math.cos(theta), math.sin(theta), 0.0])
+    return np.array([math.cos(theta), math.sin(theta) * u[1] / r, math.sin(theta) * u[2] / r])
+
+
 @dataclass
 class _Submovement:
     onset: float
@@ -238,7 +309,6 @@ class EyecatchAgent:
         self.t = 0.0
         self.started = False
         self.first_saccade_released = False
-        self._std_history: list[tuple[float, float]] = []  # (t, retinal std): the first saccade's plateau
         self.next_update = math.inf
         self.proactive = False
         self.grasp = False
@@ -307,7 +377,11 @@ class EyecatchAgent:
 
         # --- visuomotor update: every ~200 ms, re-synchronised to saccade onsets --------------
         if p.head_pursuit_gain > 0.0:
-            self._head_pursuit(rot[:, 0], in_saccade)
+            if self.periphery_adapted:  # the head follows the ball's believed motion (module docstring, 8)
+                to_ball = ball_now - eye
+                self._head_pursuit(to_ball / max(float(np.linalg.norm(to_ball)), 1e-9), in_saccade)
+            else:
+                self._head_pursuit(rot[:, 0], in_saccade)
         if in_saccade and since_onset < self.dt * 0.5 + 1e-9:
             self.next_update = t  # a saccade just started: update with it
         if math.isinf(self.next_update) and self.first_saccade_released:
@@ -325,6 +399,8 @@ class EyecatchAgent:
         The eye's pursuit over the last step is the change of its line of sight (world azimuth and
         elevation) when no saccade flew during it; the head's whole plan (its submovements' start and
         destination) is shifted by the same change, so pursuit does not use up the eye's orbital range.
+        Under the human periphery ``gaze_dir`` is the direction of the believed ball instead (module
+        docstring, 8).
         """
         p = self.params
         prev, pursued = self.prev_gaze_dir, not (in_saccade or self.prev_in_saccade)
@@ -345,27 +421,19 @@ class EyecatchAgent:
     def _first_saccade_due(self, t: float, delay: float) -> bool:
         """Eyecatch 4.1: the first saccade waits until the ball's position is significant [Carpenter &
         Williams 1995]: at least the human saccadic latency, then until the estimated retinal error
-        of the ball where the saccade would land is below the criterion (or the deadline passes)."""
+        of the ball where the saccade would land is below the criterion (or the deadline passes).
+        Under the human periphery with ``periphery_model`` it goes at the latency (module docstring, 7)."""
         p = self.params
         if t < p.first_saccade_min_latency_s - 1e-9:
             return False
-        if t >= p.first_saccade_deadline_s - 1e-9:
+        if t >= p.first_saccade_deadline_s - 1e-9 or self.periphery_adapted:
             return True
-        std = self._retinal_std(delay + p.saccade_lead_s)
-        if std < p.first_saccade_retinal_std_deg * DEG:
-            return True
-        if self.vision.position_disarray > 0.0 and math.isfinite(std):
-            # With the positional disarray more looks from the same retinal place reduce little of the
-            # error: release once the estimate has stopped improving (less than FIRST_SACCADE_PLATEAU in
-            # FIRST_SACCADE_PLATEAU_S; modelling choice: Eyecatch 4.1's "significance" is then reached
-            # as far as this place of the retina can give it).
-            self._std_history.append((t, std))
-            while self._std_history and self._std_history[0][0] < t - FIRST_SACCADE_PLATEAU_S - 0.25 * self.dt:
-                self._std_history.pop(0)
-            t0, s0 = self._std_history[0]
-            if t - t0 >= FIRST_SACCADE_PLATEAU_S - 0.25 * self.dt and std > FIRST_SACCADE_PLATEAU * s0:  # float32 times
-                return True
-        return False
+        return self._retinal_std(delay + p.saccade_lead_s) < p.first_saccade_retinal_std_deg * DEG
+
+    @property
+    def periphery_adapted(self) -> bool:
+        """Whether the agent models the human periphery of its eye (module docstring, 5-8)."""
+        return self.params.periphery_model and self.vision.periphery_on
 
     def _fuse(self, obs: np.ndarray) -> None:
         rot, eye = self.pose_history[0] if self.delay_steps else self.pose_history[-1]
@@ -387,12 +455,19 @@ class EyecatchAgent:
         # Retinal speed (Weber velocity noise, slip): the larger of the prior's and the sample's (an
         # underestimated noise locks in a wrong estimate; an overestimated one only slows learning).
         near = rot.T @ (self.filter.x[:3] - eye) if self.filter.initialised else z[:3]
-        speed = max(self._retinal_speed(near, vel, eye_turn), self._retinal_speed(near, z[3:], eye_turn))
+        adapted = self.periphery_adapted and self.filter.initialised
+        if adapted:  # the RMS retinal speed under the prior (module docstring, 6)
+            speed = self._expected_retinal_speed(near, vel, rot.T @ self.filter.P[3:, 3:] @ rot, eye_turn)
+        else:
+            speed = max(self._retinal_speed(near, vel, eye_turn), self._retinal_speed(near, z[3:], eye_turn))
         pos = self._noise_point(z[:3], rot, eye, speed)
         # fixation: the eye's vergence distance (proprioception), for the depth law of
         # VisionParams.depth_pedestal_arcmin (no effect without it)
         # dt: the positional disarray, if the eye has it, is sized for a stream of looks (no effect without)
-        R_meas = foveation.covariance(pos, speed, self.vision, float(obs[_S["fixation"]][0]), dt=self.dt)
+        fixation = float(obs[_S["fixation"]][0])
+        if adapted:
+            fixation = self._pedestal_fixation(pos, fixation, eye)
+        R_meas = foveation.covariance(pos, speed, self.vision, fixation, dt=self.dt)
         before = self.filter.resets
         self.filter.update(z, R_meas, rot, eye)
         if self.filter.resets != before:
@@ -411,6 +486,8 @@ class EyecatchAgent:
         P = np.zeros((6, 6))
         P[:3, :3] = np.outer(g, g) * p.thrower_distance_std_m**2 + lat * p.thrower_lateral_std_m**2
         P[3:, 3:] = np.eye(3) * self.kalman_params.initial_velocity_var_m2_s2
+        if self.periphery_adapted:  # the throw is expected (module docstring, 5)
+            x, P = throw_prior(x[:3], P[:3, :3])
         self.filter.x, self.filter.P, self.filter.initialised = x, P, True
         self.thrower_prior_used = True
 
@@ -436,15 +513,41 @@ class EyecatchAgent:
             u_p = mean / dm
             depth_var = float(u_p @ P @ u_p)
             d_noise = math.sqrt(dm * dm + depth_var)
-            lateral = foveation.standard_deviations(d_noise, foveation.eccentricity(u_s), speed, self.vision)[1]
-            var_s = (lateral / max(ds, 1e-9)) ** 2
             var_p = max(float(np.trace(P)) - depth_var, 0.0) / 2.0 / (dm * dm + depth_var)
-            w = u_s / max(var_s, 1e-18) + u_p / max(var_p, 1e-18)
-            direction = w / max(float(np.linalg.norm(w)), 1e-12)
-
+            if self.periphery_adapted:
+                # The RMS eccentricity under the prior, in the prior's polar direction (module docstring, 6).
+                direction = _at_eccentricity(u_p, math.sqrt(foveation.eccentricity(u_p) ** 2 + 2.0 * var_p))
+            else:
+                lateral = foveation.standard_deviations(d_noise, foveation.eccentricity(u_s), speed, self.vision)[1]
+                var_s = (lateral / max(ds, 1e-9)) ** 2
+                w = u_s / max(var_s, 1e-18) + u_p / max(var_p, 1e-18)
+                direction = w / max(float(np.linalg.norm(w)), 1e-12)
         else:
             d_noise = math.sqrt(dm * dm + float(u_s @ P @ u_s))
         return direction * d_noise
+
+    def _pedestal_fixation(self, pos: np.ndarray, fixation: float, eye: np.ndarray) -> float:
+        """The vergence distance at which the depth law, evaluated at the noise point ``pos`` (eye frame),
+        gives the RMS disparity pedestal under the prior (module docstring, 6): the inverse-distance gap
+        ``sqrt((1/d - 1/d_fix)^2 + sigma_d^2 / d_m^4)``, ``sigma_d`` the prior's depth std at its distance
+        ``d_m`` (the depth law reads only ``|1/d - 1/d_fix|``, so a fixation nearer by the gap gives it)."""
+        d = max(float(np.linalg.norm(pos)), 1e-9)
+        m = self.filter.x[:3] - eye
+        dm = max(float(np.linalg.norm(m)), 1e-9)
+        u = m / dm
+        sd = math.sqrt(max(float(u @ self.filter.P[:3, :3] @ u), 0.0))
+        gap = math.hypot(1.0 / d - 1.0 / fixation, sd / (dm * dm))
+        return 1.0 / (1.0 / d + gap)
+
+    @classmethod
+    def _expected_retinal_speed(cls, pos: np.ndarray, vel: np.ndarray, vel_cov: np.ndarray,
+                                eye_turn: np.ndarray) -> float:
+        """RMS retinal speed (rad/s) of a ball at ``pos`` with velocity ``vel ~ N(vel, vel_cov)`` (eye frame):
+        the mean's slip and the velocity variance across the line of sight over the distance squared."""
+        d2 = max(float(pos @ pos), 1e-9)
+        u = pos / math.sqrt(d2)
+        across = np.eye(3) - np.outer(u, u)
+        return math.sqrt(cls._retinal_speed(pos, vel, eye_turn) ** 2 + float(np.trace(across @ vel_cov @ across)) / d2)
 
     @staticmethod
     def _retinal_speed(pos: np.ndarray, vel: np.ndarray, eye_turn: np.ndarray) -> float:

@@ -48,6 +48,9 @@ _SLOTS = tuple(_S[f"obstacle_{k}"].start for k in range(K_SLOTS))
 # glimpse (its keep-out zone grown by 2 std would close the walkway) keeps a zone of its estimate's size plus
 # 2 caps; the gaze fixates it before a foothold near it is chosen (modelling choice).
 FOOTHOLDS_PLAN_MAX_SD_M = 0.1
+# With gaze_mode="footholds", when no foothold is clear of the 2-std zones, the planner tries 1 std, then
+# the estimates themselves (PlannerParams.fallback_sigmas; modelling choice), before the blind nominal step.
+FOOTHOLDS_FALLBACK_SIGMAS = (1.0, 0.0)
 NECK_PITCH_DOWN_DEG = 50.0  # the head action's -1 (envs_assets/common/head_eye.xml: neck_pitch -50 .. 40)
 
 
@@ -128,6 +131,8 @@ class IwaoAgent:
         self.params = p = params or IwaoParams()
         self.gaze_params = gaze or IwaoGazeParams()
         self.gait = gait or GaitParams()
+        if planner is None and p.gaze_mode == "footholds":
+            planner = PlannerParams(fallback_sigmas=FOOTHOLDS_FALLBACK_SIGMAS)
         self.planner = FootstepPlanner(self.gait, planner)
         self.memory = ObstacleMemory(vision or VisionParams(noise_scale=p.vision_noise_scale, foveated=p.foveated,
                                                            position_slip_knee_deg_s=p.position_slip_knee_deg_s),

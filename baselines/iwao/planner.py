@@ -52,6 +52,12 @@ class PlannerParams:
     w_length: float = 1.0
     w_corridor: float = 2.0
     w_lateral: float = 0.3
+    # When no foothold is clear: the extents grown by these fewer estimate stds instead of ``sigmas``, in
+    # turn, before the nominal step is taken blind (empty: no relaxation, iwao v0 and the walkway's golden
+    # digests). On dense hazards the 2-std zones of several uncertain neighbours close every foothold of a
+    # step although the best estimates leave room (modelling choice: a walker who must step somewhere
+    # steps where the hazards are least likely to be; IwaoAgent sets (1, 0) with gaze_mode="footholds").
+    fallback_sigmas: tuple[float, ...] = ()
 
 
 class FootstepPlanner:
@@ -79,11 +85,13 @@ class FootstepPlanner:
         sign = 1.0 if side == 0 else -1.0
         return v_prev + sign * np.maximum(self.g.step_width_m + sign * lateral, self.g.min_step_width_m)
 
-    def _zones(self, obstacles):
-        """(x0, x1, y0, y1, height) of every keep-out zone as arrays (before the foot box is added)."""
+    def _zones(self, obstacles, sigmas: float | None = None):
+        """(x0, x1, y0, y1, height) of every keep-out zone as arrays (before the foot box is added), the
+        extents grown by ``sigmas`` estimate stds (default ``PlannerParams.sigmas``)."""
         p = self.p
-        arr = np.array([(o.x0 - p.sigmas * o.sx, o.x1 + p.sigmas * o.sx, o.y0 - p.sigmas * o.sy - p.lateral_margin_m,
-                         o.y1 + p.sigmas * o.sy + p.lateral_margin_m, o.height + p.sigmas * o.sz)
+        k = p.sigmas if sigmas is None else sigmas
+        arr = np.array([(o.x0 - k * o.sx, o.x1 + k * o.sx, o.y0 - k * o.sy - p.lateral_margin_m,
+                         o.y1 + k * o.sy + p.lateral_margin_m, o.height + k * o.sz)
                         for o in obstacles], dtype=float).reshape(-1, 5)
         front = p.gap_front_m + p.gap_front_per_height * arr[:, 4]  # obstacle ahead of the foot
         back = p.gap_back_m + p.gap_back_per_height * arr[:, 4]  # obstacle behind the foot
@@ -142,16 +150,19 @@ class FootstepPlanner:
         (u_a, v_a, _), (u_b, v_b, side_b) = footholds[-2], footholds[-1]
         u_from, v_from = u_a, v_a  # the new foothold's foot swings from the one before the last
         side = 1 - int(side_b)
-        arr, gap = self._zones(obstacles)
-        y_goal = self.corridor(u_b, 0.5 * (v_a + v_b), obstacles, arr, gap)
         L, A = self._L, self._A
         u1 = u_b + self.lengths  # U[i, j] = u1[i]
         v1 = self._next_v(v_b, self.laterals, side)  # V[i, j] = v1[j]
-        ok = self._ok_first(u_b, u1, v1, arr, gap) & (np.abs(v1) <= self._v_limit)[None, :]
-        # One step of look-ahead: the other foot must find a clear foothold after this one.
-        best2 = self._best_next(u1, v1, arr, gap, side, y_goal)
-        cost = (self._cost_length + p.w_corridor * np.abs(0.5 * (v1 + v_b) - y_goal) + self._cost_lateral + best2)
-        cost = np.where(ok & np.isfinite(best2), cost, np.inf)
+        for sigmas in (None, *p.fallback_sigmas):  # PlannerParams.fallback_sigmas: fewer stds when nothing is clear
+            arr, gap = self._zones(obstacles, sigmas)
+            y_goal = self.corridor(u_b, 0.5 * (v_a + v_b), obstacles, arr, gap)
+            ok = self._ok_first(u_b, u1, v1, arr, gap) & (np.abs(v1) <= self._v_limit)[None, :]
+            # One step of look-ahead: the other foot must find a clear foothold after this one.
+            best2 = self._best_next(u1, v1, arr, gap, side, y_goal)
+            cost = (self._cost_length + p.w_corridor * np.abs(0.5 * (v1 + v_b) - y_goal) + self._cost_lateral + best2)
+            cost = np.where(ok & np.isfinite(best2), cost, np.inf)
+            if np.isfinite(cost).any():
+                break
         if not np.isfinite(cost).any():  # nothing is clear: the footholds that are clear now, else nominal
             cost = np.where(ok, self._cost_length, np.inf)
             if not np.isfinite(cost).any():

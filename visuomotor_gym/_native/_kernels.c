@@ -850,6 +850,52 @@ static void perceive_prepare(const VisionConsts *c, const double *pe, const doub
 }
 
 /* The sample of a look (foveation._draw_at with the six standard normals ``e``). */
+/* rng.standard_normal(6 n) (one six-vector per look, in look order) into *draw (a new reference) and
+ * *normals (its buffer, held): 0; -1 with an exception set and *normals not held (buf NULL). */
+static int draw_normals(PyObject *rng, Py_ssize_t n, PyObject **draw, Py_buffer *normals)
+{
+    PyObject *size = PyLong_FromSsize_t(6 * n);
+    if (size == NULL)
+        return -1;
+    PyObject *call[2] = {rng, size};
+    *draw = PyObject_VectorcallMethod(s_standard_normal, call, 2 | PY_VECTORCALL_ARGUMENTS_OFFSET, NULL);
+    Py_DECREF(size);
+    if (*draw == NULL || f64_buffer(*draw, normals, 0) < 0) {
+        normals->buf = NULL;
+        return -1;
+    }
+    if (normals->len != 48 * n) {
+        PyBuffer_Release(normals);
+        normals->buf = NULL;
+        PyErr_SetString(PyExc_ValueError, "rng.standard_normal gave the wrong size");
+        return -1;
+    }
+    return 0;
+}
+
+/* A VisualTarget's world position b and velocity v (its ``state(data)``): 1 when shown, 0 when hidden
+ * (b, v untouched), -1 with an exception set. */
+static int target_state(PyObject *target, PyObject *data, double *b, double *v)
+{
+    PyObject *hidden = PyObject_GetAttr(target, s_hidden);
+    if (hidden == NULL)
+        return -1;
+    int is_hidden = PyObject_IsTrue(hidden);
+    Py_DECREF(hidden);
+    if (is_hidden != 0)
+        return is_hidden < 0 ? -1 : 0;
+    PyObject *state = PyObject_CallMethodOneArg(target, s_state, data);
+    if (state == NULL)
+        return -1;
+    int rc = -1;
+    if (PyTuple_Check(state) && PyTuple_GET_SIZE(state) == 2)
+        rc = (vec3(PyTuple_GET_ITEM(state, 0), b) < 0 || vec3(PyTuple_GET_ITEM(state, 1), v) < 0) ? -1 : 0;
+    else
+        PyErr_SetString(PyExc_TypeError, "VisualTarget.state must return (position, velocity)");
+    Py_DECREF(state);
+    return rc < 0 ? -1 : 1;
+}
+
 static PyObject *look_sample(const Look *lk, const double *e)
 {
     if (lk->kind == 0)
@@ -907,27 +953,12 @@ static PyObject *retina_see_all(PyObject *self, PyObject *const *args, Py_ssize_
         PyObject *target = PySequence_Fast_GET_ITEM(seq, i);
         Look *lk = &looks[i];
         lk->kind = 0;
-        PyObject *hidden = PyObject_GetAttr(target, s_hidden);
-        if (hidden == NULL)
-            goto fail;
-        int is_hidden = PyObject_IsTrue(hidden);
-        Py_DECREF(hidden);
-        if (is_hidden < 0)
-            goto fail;
-        if (is_hidden)
-            continue;
         double b[3], v[3];
-        PyObject *state = PyObject_CallMethodOneArg(target, s_state, data);
-        if (state == NULL)
+        int shown = target_state(target, data, b, v);
+        if (shown < 0)
             goto fail;
-        int rc = -1;
-        if (PyTuple_Check(state) && PyTuple_GET_SIZE(state) == 2)
-            rc = (vec3(PyTuple_GET_ITEM(state, 0), b) < 0 || vec3(PyTuple_GET_ITEM(state, 1), v) < 0) ? -1 : 0;
-        else
-            PyErr_SetString(PyExc_TypeError, "VisualTarget.state must return (position, velocity)");
-        Py_DECREF(state);
-        if (rc < 0)
-            goto fail;
+        if (!shown)
+            continue;
         double rx = b[0] - eye[0], ry = b[1] - eye[1], rz = b[2] - eye[2];
         double px = r[0] * rx + r[3] * ry + r[6] * rz;
         if (c.foveated && px < c.cos_fov * sqrt(rx * rx + ry * ry + rz * rz))
@@ -940,20 +971,9 @@ static PyObject *retina_see_all(PyObject *self, PyObject *const *args, Py_ssize_
     }
     const double *e = NULL;
     Py_buffer normals = {.buf = NULL};
-    if (seen > 0) { /* rng.standard_normal(6 * seen) */
-        PyObject *size = PyLong_FromSsize_t(6 * seen);
-        if (size == NULL)
+    if (seen > 0) {
+        if (draw_normals(rng, seen, &draw, &normals) < 0)
             goto fail;
-        PyObject *call[2] = {rng, size};
-        draw = PyObject_VectorcallMethod(s_standard_normal, call, 2 | PY_VECTORCALL_ARGUMENTS_OFFSET, NULL);
-        Py_DECREF(size);
-        if (draw == NULL || f64_buffer(draw, &normals, 0) < 0)
-            goto fail;
-        if (normals.len != 48 * seen) {
-            PyBuffer_Release(&normals);
-            PyErr_SetString(PyExc_ValueError, "rng.standard_normal gave the wrong size");
-            goto fail;
-        }
         e = (const double *)normals.buf;
     }
     out = PyList_New(n);
@@ -1393,27 +1413,12 @@ static PyObject *retina_see_periphery(PyObject *self, PyObject *const *args, Py_
     }
     for (Py_ssize_t i = 0; i < n; i++) { /* every shown target in the field */
         PyObject *target = PySequence_Fast_GET_ITEM(seq, i);
-        PyObject *hidden = PyObject_GetAttr(target, s_hidden);
-        if (hidden == NULL)
-            goto fail;
-        int is_hidden = PyObject_IsTrue(hidden);
-        Py_DECREF(hidden);
-        if (is_hidden < 0)
-            goto fail;
-        if (is_hidden)
-            continue;
         double b[3], v[3];
-        PyObject *state = PyObject_CallMethodOneArg(target, s_state, data);
-        if (state == NULL)
+        int shown = target_state(target, data, b, v);
+        if (shown < 0)
             goto fail;
-        int rc = -1;
-        if (PyTuple_Check(state) && PyTuple_GET_SIZE(state) == 2)
-            rc = (vec3(PyTuple_GET_ITEM(state, 0), b) < 0 || vec3(PyTuple_GET_ITEM(state, 1), v) < 0) ? -1 : 0;
-        else
-            PyErr_SetString(PyExc_TypeError, "VisualTarget.state must return (position, velocity)");
-        Py_DECREF(state);
-        if (rc < 0)
-            goto fail;
+        if (!shown)
+            continue;
         double rx = b[0] - eye[0], ry = b[1] - eye[1], rz = b[2] - eye[2];
         double pe[3] = {r[0] * rx + r[3] * ry + r[6] * rz, r[1] * rx + r[4] * ry + r[7] * rz,
                         r[2] * rx + r[5] * ry + r[8] * rz};
@@ -1524,19 +1529,9 @@ static PyObject *retina_see_periphery(PyObject *self, PyObject *const *args, Py_
         }
     }
     const double *e = NULL;
-    if (draws > 0) { /* rng.standard_normal(6 * draws) */
-        PyObject *size = PyLong_FromSsize_t(6 * draws);
-        if (size == NULL)
+    if (draws > 0) {
+        if (draw_normals(rng, draws, &draw, &normals) < 0)
             goto fail;
-        PyObject *call[2] = {rng, size};
-        draw = PyObject_VectorcallMethod(s_standard_normal, call, 2 | PY_VECTORCALL_ARGUMENTS_OFFSET, NULL);
-        Py_DECREF(size);
-        if (draw == NULL || f64_buffer(draw, &normals, 0) < 0)
-            goto fail;
-        if (normals.len != 48 * draws) {
-            PyErr_SetString(PyExc_ValueError, "rng.standard_normal gave the wrong size");
-            goto fail;
-        }
         e = (const double *)normals.buf;
     }
     out = PyList_New(n);

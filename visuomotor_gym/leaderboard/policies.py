@@ -174,11 +174,20 @@ def _eyecatch_load(data: bytes, env_id: str) -> Policy:
     from visuomotor_gym.baselines.eyecatch import EyecatchAgent, EyecatchParams
 
     obj = _read_json_policy(data, EYECATCH_FORMAT, env_id)
-    params = _typed_params(obj["params"], EyecatchParams, "EyecatchParams")
+    params = _typed_params(obj["params"], EyecatchParams, "EyecatchParams", fill_defaults=True)
     return EyecatchAgent(EyecatchParams(**params))
 
 
-register_policy_format(PolicyFormat(EYECATCH_FORMAT, "eyecatch", ".json", _eyecatch_export, _eyecatch_load))
+def _eyecatch_same(committed: bytes, fresh: bytes, env_id: str) -> bool:
+    """A committed Eyecatch file written before some parameters existed (``periphery_model``) is the same
+    policy when the fresh export adds only fields at their default (:func:`_same_but_defaults`)."""
+    from visuomotor_gym.baselines.eyecatch import EyecatchParams
+
+    return _same_but_defaults(committed, fresh, EyecatchParams)
+
+
+register_policy_format(PolicyFormat(EYECATCH_FORMAT, "eyecatch", ".json", _eyecatch_export, _eyecatch_load,
+                                    same_policy=_eyecatch_same))
 
 
 # ------------------------------------------------------------------ belief-mpc-params
@@ -242,6 +251,13 @@ def _belief_mpc_same(committed: bytes, fresh: bytes, env_id: str) -> bool:
     that sit at the params dataclass's default: :func:`_belief_mpc_load` fills a missing field with
     that default, so loading the committed file builds the agent the spec builds today. (A field added
     with a default that changes behaviour is still caught: the re-score replays the committed file.)"""
+    _, params_cls, _ = _belief_mpc_classes(env_id)
+    return _same_but_defaults(committed, fresh, params_cls)
+
+
+def _same_but_defaults(committed: bytes, fresh: bytes, params_cls: type) -> bool:
+    """The rule of :func:`_belief_mpc_same` for any params dataclass: the fresh export is the committed file
+    plus fields at ``params_cls``'s defaults (the loader fills a missing field with its default)."""
     from dataclasses import MISSING, fields
 
     old, new = json.loads(committed), json.loads(fresh)
@@ -250,7 +266,6 @@ def _belief_mpc_same(committed: bytes, fresh: bytes, env_id: str) -> bool:
     added = set(new["params"]) - set(old["params"])
     if not added or set(old["params"]) - set(new["params"]):
         return False
-    _, params_cls, _ = _belief_mpc_classes(env_id)
     defaults = {}
     for f in fields(params_cls):
         if f.default is not MISSING:
