@@ -138,6 +138,25 @@ class EomBraceParams:
     verify_reach: bool = False
     verify_w: float = 100.0  # a depth std under 10 cm: the rows 0.3-0.4 m apart are told apart (modelling choice)
     verify_dwell_s: float = 0.15  # a candidate looked at this long without a measured depth is passed over (modelling choice)
+    # depth_search (sixth pass, opt-in; with reach_max_m): a VERGENCE SEARCH before the push. Each cube's distance
+    # along its mean line of sight is believed on a grid (depth_grid_m, every depth_grid_step_m) by the likelihood
+    # of its fused samples' distances under the vision model's depth law at each hypothesised distance (the
+    # std d x depth_std_fraction / acuity, x (1 + eta / eta_2) with eta the disparity pedestal from the vergence of
+    # that sample's time; Blakemore 1970): a scatter of samples is itself evidence that the cube is not at the
+    # vergence distance. Before the push the eye fixates the search_blocks cubes nearest the expected fall line
+    # in turn, each verged at its most probable distance (vergence follows the fixated object's depth: Erkelens
+    # et al. 1989; Collewijn et al. 1995), until it is known within reach or beyond (posterior probability
+    # search_sure, or search_max_s on one cube); after the push the brace chooses among the cubes believed within
+    # reach (probability >= 0.5) and aims at the believed face given that it is within reach (modelling choices).
+    depth_search: bool = False
+    depth_grid_m: tuple = (0.3, 2.0)
+    depth_grid_step_m: float = 0.02
+    search_blocks: int = 3
+    search_sure: float = 0.9
+    search_max_s: float = 0.3
+    # the expected fall direction before the push: the wall's normal turned forward by this (deg; the middle of
+    # the task's 0..30 deg: modelling choice, a person standing by a wall knows roughly how it runs)
+    search_yaw_deg: float = 15.0
     fall_speed_m_s: float = 0.15  # the pelvis moving faster than this: its direction is the fall's (modelling choice)
     approach_offset_m: float = 0.10  # align the palm 10 cm in front of the believed face first (modelling choice)
     align_m: float = 0.04  # ... to within 4 cm along the wall, then move in (modelling choice)
@@ -173,12 +192,19 @@ class EomBraceParams:
             v = getattr(self, f.name)
             if f.name in ("foveated", "gaze_blind", "use_hand", "verge_on_sample", "fall_direction", "wall_normal",
                           "choose_by_ray", "drop_crowded", "verge_on_ray",
-                          "hand_on_cut", "verify_reach"):
+                          "hand_on_cut", "verify_reach", "depth_search"):
                 if not isinstance(v, bool):
                     raise ValueError(f"EomBraceParams.{f.name} must be true or false, got {v!r}")
-            elif f.name == "scan_blocks":
+            elif f.name == "depth_grid_m":
+                if not (isinstance(v, tuple) and len(v) == 2 and all(isinstance(x, (int, float)) for x in v)
+                        and 0.0 < v[0] < v[1] and math.isfinite(v[1])):
+                    raise ValueError(f"EomBraceParams.depth_grid_m must be (lo, hi) with 0 < lo < hi, got {v!r}")
+            elif f.name == "search_yaw_deg":
+                if isinstance(v, bool) or not isinstance(v, (int, float)) or not -90.0 <= v <= 90.0:
+                    raise ValueError(f"EomBraceParams.search_yaw_deg must be a number in [-90, 90], got {v!r}")
+            elif f.name in ("scan_blocks", "search_blocks"):
                 if isinstance(v, bool) or not isinstance(v, int) or v < 0:
-                    raise ValueError(f"EomBraceParams.scan_blocks must be an integer >= 0, got {v!r}")
+                    raise ValueError(f"EomBraceParams.{f.name} must be an integer >= 0, got {v!r}")
             elif isinstance(v, tuple):
                 if len(v) < 1 or not all(isinstance(x, (int, float)) and math.isfinite(x) for x in v):
                     raise ValueError(f"EomBraceParams.{f.name} must be finite numbers, got {v!r}")
@@ -239,7 +265,15 @@ class EomBraceAgent:
         self.dir_sum = np.zeros((N, 3))  # sum of the fused samples' unit lines of sight (stance frame)
         self.dir_eye = np.zeros((N, 3))  # ... and of the eye positions they were seen from
         self.dir_n = np.zeros(N)
+        # depth_search: every fused sample of each cube as (eye position, unit line of sight (stance frame),
+        # distance, eccentricity, vergence distance of its time)
+        self.samples: list[list] = [[] for _ in range(N)]
+        self._post: dict = {}  # this step's posteriors, by cube
+        self._search_target: int | None = None
+        self._search_since: float | None = None
         self.poses: deque = deque(maxlen=self.delay_steps + 1)
+        self._pose_pairs: deque = deque(maxlen=self.delay_steps + 2)  # depth_search: the pose before a sample's
+        self._slip_pose = None
         self.home: np.ndarray | None = None
         self.detected_at: float | None = None
         self.normal = np.array([0.0, -1.0, 0.0])
@@ -267,6 +301,8 @@ class EomBraceAgent:
         vision has it). The noise is taken at the sample's own distance. A sample ``reset_ratio`` times
         more precise than the best one so far restarts the mean: the earlier, coarse samples are dropped
         (a cube first seen in the periphery, then fixated)."""
+        if self.params.depth_search:
+            self._record(i, pos_eye, rot, eye, fixation)
         if pos_eye[0] <= 0.0:
             return
         dist = float(np.linalg.norm(pos_eye))
@@ -289,9 +325,145 @@ class EomBraceAgent:
         self.best_w[i] = max(self.best_w[i], w)
         self.w[i] += w
         self.sum[i] += w * (eye + rot @ pos_eye)
-        self.dir_sum[i] += rot @ (pos_eye / dist)
-        self.dir_eye[i] += eye
-        self.dir_n[i] += 1.0
+        if not self.params.depth_search:
+            self.dir_sum[i] += rot @ (pos_eye / dist)
+            self.dir_eye[i] += eye
+            self.dir_n[i] += 1.0
+
+    def _crowded_by_belief(self, seen: list, los: list, rot: np.ndarray, eye: np.ndarray) -> set:
+        """depth_search: the samples that may be crowded judged by where the cubes are BELIEVED to be (their
+        mean lines of sight cut with the expected wall plane, in the eye frame of the sample), not only by where
+        this step's samples put them: a pooled percept lies between its cube and the flankers, at a smaller
+        eccentricity than its cube, so its own critical spacing understates the crowding zone (Bouma 1970;
+        the env pools flankers within crowding_bouma x the target's eccentricity)."""
+        v = self.vision
+        if not (v.crowding and v.foveated):
+            return set()
+        yaw = self.params.search_yaw_deg * DEG
+        n0 = self.normal if self.detected_at is not None else np.array([math.sin(yaw), -math.cos(yaw), 0.0])
+        believed = {}
+        for j in range(N):
+            if self.dir_n[j] > 0.0:
+                d = rot.T @ (self._direction_cut(j, n0) - eye)
+                nd = float(np.linalg.norm(d))
+                if nd > 0.0 and d[0] > 0.0:
+                    believed[j] = d / nd
+        out = set()
+        fovea = v.crowding_fovea_deg * DEG
+        for i, p in zip(seen, los):
+            u = p / max(float(np.linalg.norm(p)), 1e-12)
+            own = believed.get(i, u)
+            theta = max(foveation.eccentricity(own), foveation.eccentricity(u))
+            if theta <= fovea:
+                continue
+            for j, b in believed.items():
+                if j != i and min(math.acos(min(1.0, float(own @ b))), math.acos(min(1.0, float(u @ b)))) \
+                        < v.crowding_bouma * theta:
+                    out.add(i)
+                    break
+        return out
+
+    def _record(self, i: int, pos_eye: np.ndarray, rot: np.ndarray, eye: np.ndarray, fixation: float) -> None:
+        """depth_search: keep a sample for the depth likelihood (its signed distance: negative for a sample
+        that the depth error put behind the eye) and add its line of sight to the cube's mean direction,
+        weighted by its lateral precision (the vision model's position law at its eccentricity: a foveal
+        direction outweighs a peripheral one)."""
+        dist = float(np.linalg.norm(pos_eye))
+        if dist <= 0.0:
+            return
+        u = pos_eye / dist if pos_eye[0] > 0.0 else -pos_eye / dist
+        signed = dist if pos_eye[0] > 0.0 else -dist
+        ecc = foveation.eccentricity(u)
+        v = self.vision
+        if v.foveated and ecc > self.params.fuse_max_ecc_deg * DEG:
+            return
+        # The image's retinal slip (it blurs the direction: the vision model's slip factor), taken as the
+        # believed cube's angular speed in the eye frame between the previous pose and the sample's.
+        slip = 0.0
+        if self._slip_pose is not None and self.dir_n[i] > 0.0:
+            x = self._direction_cut(i, self.normal)
+            a, b = rot.T @ (x - eye), self._slip_pose[0].T @ (x - self._slip_pose[1])
+            c = float(a @ b) / max(float(np.linalg.norm(a) * np.linalg.norm(b)), 1e-12)
+            slip = math.acos(max(-1.0, min(1.0, c))) / self.dt
+        lat = float(foveation.standard_deviations(1.0, ecc, slip, v)[1])  # rad per m of distance
+        wd = 1.0 / max(lat, 1e-6) ** 2
+        self.samples[i].append((eye.copy(), rot @ u, signed, ecc, fixation, wd))
+        self.dir_sum[i] += wd * (rot @ u)
+        self.dir_eye[i] += wd * eye
+        self.dir_n[i] += wd
+
+    def posterior(self, i: int, n: np.ndarray):
+        """depth_search: cube ``i``'s belief along its mean line of sight, ``(points, probabilities,
+        p_reach)``: the grid's points (stance frame), their posterior probabilities (flat prior on the grid)
+        and the probability that the face lies within ``reach_max_m`` of the shoulder along ``n``. The
+        likelihood of each sample's distance ``s`` at a hypothesised distance ``D`` is N(s; D, sigma(D)) with
+        the vision model's depth std at ``D``, the sample's eccentricity and its vergence distance (the env's
+        depth law), so a fixation verged far from a cube, whose samples scatter, still says where it is not."""
+        key = (i, float(n[0]), float(n[1]))
+        if key in self._post:
+            return self._post[key]
+        p, v = self.params, self.vision
+        rows = self.samples[i]
+        eyes = np.array([r[0] for r in rows])
+        dist = np.array([r[2] for r in rows])
+        ecc = np.array([r[3] for r in rows])
+        verg = np.maximum(np.array([r[4] for r in rows]), 0.1)
+        origin = self.dir_eye[i] / max(self.dir_n[i], 1e-12)
+        u = self.dir_sum[i] / max(float(np.linalg.norm(self.dir_sum[i])), 1e-12)
+        grid = np.arange(p.depth_grid_m[0], p.depth_grid_m[1] + 1e-9, max(p.depth_grid_step_m, 1e-3))
+        points = origin + np.outer(grid, u)
+        d = np.linalg.norm(points[None, :, :] - eyes[:, None, :], axis=2)  # samples x grid
+        sig = d * v.depth_std_fraction * v.noise_scale
+        if v.foveated:
+            e2 = v.fovea_e2_deg * DEG
+            sig = sig * ((e2 + ecc) / e2)[:, None]  # / acuity
+            if v.depth_pedestal_arcmin is not None:
+                eta = v.interocular_m * np.abs(1.0 / d - 1.0 / verg[:, None]) / foveation.ARCMIN
+                sig = sig * (1.0 + eta / v.depth_pedestal_arcmin)
+        sig = np.maximum(sig, 1e-3)
+        ll = np.sum(-0.5 * ((dist[:, None] - d) / sig) ** 2 - np.log(sig), axis=0)
+        prob = np.exp(ll - ll.max())
+        prob /= prob.sum()
+        reach = float(prob[(points - SHOULDER) @ n <= p.reach_max_m].sum()) if p.reach_max_m > 0 else 1.0
+        out = (points, prob, reach)
+        self._post[key] = out
+        return out
+
+    def _depth_point(self, i: int, n: np.ndarray, within_reach: bool = False) -> np.ndarray:
+        """depth_search: the believed face of cube ``i`` (the posterior mean of its grid points; given that it
+        lies within reach along ``n`` when ``within_reach`` and that has any probability)."""
+        points, prob, _ = self.posterior(i, n)
+        if within_reach and self.params.reach_max_m > 0:
+            m = prob * (((points - SHOULDER) @ n) <= self.params.reach_max_m)
+            if m.sum() > 1e-12:
+                prob = m / m.sum()
+        x = prob @ points
+        # The grid lies on the samples' mean line of sight, which is not a line of sight of any one eye position
+        # once the body has moved (parallax): the face is then the lateral-precision-weighted mean of each
+        # sample's own line of sight at its eye's distance to that point, iterated with Huber weights (a sample
+        # whose line of sight misses the point by more than twice its lateral std counts less: a pooled, crowded
+        # percept the crowding test missed; modelling choice).
+        rows = self.samples[i]
+        eyes = np.array([r[0] for r in rows])
+        dirs = np.array([r[1] for r in rows])
+        wd = np.array([r[5] for r in rows])
+        sd = 1.0 / np.sqrt(wd)
+        w = wd
+        for _ in range(4):
+            rel = x - eyes
+            dist = np.linalg.norm(rel, axis=1)
+            q = eyes + dirs * dist[:, None]
+            x = w @ q / w.sum()
+            rel = x - eyes
+            cosang = np.sum(rel * dirs, axis=1) / np.maximum(np.linalg.norm(rel, axis=1), 1e-12)
+            miss = np.arccos(np.clip(cosang, -1.0, 1.0))
+            w = wd / np.maximum(1.0, miss / (2.0 * sd))
+        return x
+
+    def _depth_mode(self, i: int, n: np.ndarray) -> np.ndarray:
+        """depth_search: cube ``i``'s most probable face point (where the search verges next)."""
+        points, prob, _ = self.posterior(i, n)
+        return points[int(np.argmax(prob))]
 
     # --- policy -----------------------------------------------------------------------------------
     def predict(self, observation, state=None, episode_start=None, deterministic=True):
@@ -313,17 +485,29 @@ class EomBraceAgent:
             self.started = True
             self.home = np.array(p.hand_ready)
         self.poses.append((rot.copy(), eye.copy(), float(obs[_S["fixation"]][0])))
+        self._pose_pairs.append((rot.copy(), eye.copy()))
         if len(self.poses) == self.delay_steps + 1:
             r0, e0, f0 = self.poses[0]
+            self._slip_pose = self._pose_pairs[0] if len(self._pose_pairs) == self.delay_steps + 2 else None
             pos = obs[_S["block_pos"]].reshape(N, 3)
             vis = obs[_S["block_visible"]]
-            seen = [i for i in range(N) if vis[i] > 0.5 and pos[i][0] > 0.0]
+            if self.params.depth_search:
+                # A sample whose depth error put it behind the eye is still a sample (of the line of sight,
+                # reversed; its distance negative): the scatter is the evidence the search uses.
+                seen = [i for i in range(N) if vis[i] > 0.5 and float(pos[i] @ pos[i]) > 0.0]
+                los = [pos[i] if pos[i][0] > 0.0 else -pos[i] for i in seen]
+            else:
+                seen = [i for i in range(N) if vis[i] > 0.5 and pos[i][0] > 0.0]
+                los = [pos[i] for i in seen]
             skip = set()
             if self.params.drop_crowded and len(seen) > 1:
-                skip = {seen[k] for k in crowded([pos[i] for i in seen], seen, self.vision)}
+                skip = {seen[k] for k in crowded(los, seen, self.vision)}
+            if self.params.depth_search and self.params.drop_crowded:
+                skip |= self._crowded_by_belief(seen, los, r0, e0)
             for i in seen:
                 if i not in skip:
                     self._fuse(i, pos[i].copy(), r0, e0, f0)
+        self._post = {}
 
         # --- detection: the CoP at the support polygon's edge (or a foot unloaded) ---------------------
         cop = obs[_S["foot_pressure"]]
@@ -358,9 +542,13 @@ class EomBraceAgent:
         look_at = None
         look_block = None
         known = [i for i in range(N) if self.w[i] > 0]
+        search_look = False
         if t >= p.look_latency_s - 1e-9:
             k = int((t - p.look_latency_s + 1e-9) // p.scan_dwell_s)
-            if p.scan_blocks <= 0:
+            if p.depth_search and known and k >= len(p.scan_x_m) and self.detected_at is None:
+                look_at, look_block = self._search_look(known, t)
+                search_look = True
+            elif p.scan_blocks <= 0:
                 look_at = np.array([p.scan_x_m[k % len(p.scan_x_m)], p.scan_y_m, p.scan_z_m])
             elif k < len(p.scan_x_m) or not known:
                 k = min(k, len(p.scan_x_m) - 1)
@@ -391,7 +579,14 @@ class EomBraceAgent:
                 if p.choose_by_ray:
                     faces = np.array([self._direction_cut(i, n) for i in known]) - SHOULDER
                 lateral = np.linalg.norm(faces - np.outer(faces @ n, n), axis=1)
-                if p.reach_max_m > 0 and p.verify_reach:
+                if p.depth_search and p.reach_max_m > 0:
+                    # The cubes believed within reach (the vergence search's posterior), the nearest to the
+                    # fall line by the face believed given reach; none: the likeliest to be within reach.
+                    faces = np.array([self._depth_point(i, n, True) for i in known]) - SHOULDER
+                    lateral = np.linalg.norm(faces - np.outer(faces @ n, n), axis=1)
+                    pr = np.array([self.posterior(i, n)[2] for i in known])
+                    lateral = np.where(pr >= 0.5, lateral, np.inf) if np.any(pr >= 0.5) else lateral + 10.0 * (1 - pr)
+                elif p.reach_max_m > 0 and p.verify_reach:
                     # A cube a fixation has measured within reach is chosen (the nearest such); until one is,
                     # the eye checks the candidates nearest the fall line in turn, each for verify_dwell_s.
                     sure = self.best_w[known] >= p.verify_w
@@ -418,7 +613,9 @@ class EomBraceAgent:
                 if self.chosen != previous:
                     self._check_since = t
                 face = self.estimate(self.chosen)
-                if p.hand_on_cut and self.best_w[self.chosen] < p.cut_until_w:
+                if p.depth_search:
+                    face = self._depth_point(self.chosen, n, True)
+                elif p.hand_on_cut and self.best_w[self.chosen] < p.cut_until_w:
                     face = self._direction_cut(self.chosen, n)  # not yet fixated: the direction at the plane
                 if self.approach_since is None:
                     # Align first: in front of the face, then toward it (a hand that sweeps along the wall
@@ -456,7 +653,10 @@ class EomBraceAgent:
                     self.hold = hand.copy()
                     self.hold_eye = eye.copy()
             look_at = self.estimate(self.chosen)
-            if p.choose_by_ray and self.hold is None and self.best_w[self.chosen] < p.cut_until_w:
+            if p.depth_search:
+                look_at = self._depth_point(self.chosen, n, True)
+                search_look = True
+            elif p.choose_by_ray and self.hold is None and self.best_w[self.chosen] < p.cut_until_w:
                 look_at = self._direction_cut(self.chosen, n)  # the cube's direction, at the plane's distance
             look_block = self.chosen
             rates = obs[_S["vestibular"]][2:5]
@@ -470,6 +670,7 @@ class EomBraceAgent:
             if self.looked_away:
                 look_at = eye + np.array([3.0, 0.0, 0.0])
                 look_block = None
+                search_look = False
 
         if not p.use_hand:
             target = self.home
@@ -481,10 +682,10 @@ class EomBraceAgent:
             az, el = math.atan2(d[1], d[0]), math.atan2(d[2], math.hypot(d[0], d[1]))
             head = (self._beyond_dead_zone(az, 0), self._beyond_dead_zone(el, 1))
             fixation = float(np.linalg.norm(d))
-            if p.verge_on_ray and look_block is not None:
+            if p.verge_on_ray and look_block is not None and not search_look:
                 nl = n if self.detected_at is not None else self._look_normal
                 fixation = float(np.linalg.norm(self._ray_cuts(look_at[None, :], eye, nl)[0] - eye))
-            if p.verge_on_sample and look_block is not None and obs[_S["block_visible"]][look_block] > 0.5:
+            if p.verge_on_sample and look_block is not None and not search_look and obs[_S["block_visible"]][look_block] > 0.5:
                 # Vergence follows the fixated cube's own disparity: its latest sample's distance when it is
                 # near the fovea (the vergence loop closes on the fixated target, not on the belief).
                 sample = obs[_S["block_pos"]].reshape(N, 3)[look_block]
@@ -492,11 +693,42 @@ class EomBraceAgent:
                     fixation = float(np.linalg.norm(sample))
         return encode(target, brace, gaze, fixation, head, self.gaze_range)
 
+    def _search_look(self, known: list, t: float):
+        """depth_search before the push: the cube to fixate and where (its most probable face: the gaze goes along
+        its line of sight and the vergence to that distance). The search_blocks cubes nearest the expected fall
+        line through the shoulder (by their directions, cut with the expected wall plane) are fixated in turn
+        until each is known within reach or beyond; then the nearest believed within reach is kept."""
+        p = self.params
+        yaw = p.search_yaw_deg * DEG
+        n0 = np.array([math.sin(yaw), -math.cos(yaw), 0.0])
+        cuts = np.array([self._direction_cut(i, n0) for i in known]) - SHOULDER
+        lateral = np.linalg.norm(cuts - np.outer(cuts @ n0, n0), axis=1)
+        order = [known[j] for j in np.argsort(lateral)][:max(p.search_blocks, 1)]
+        reach = {i: self.posterior(i, n0)[2] for i in order}
+        undecided = [i for i in order if 1.0 - p.search_sure < reach[i] < p.search_sure]
+        tgt = self._search_target
+        timed_out = self._search_since is not None and t - self._search_since >= p.search_max_s - 1e-9
+        if tgt not in undecided or timed_out:
+            if undecided:
+                # the next undecided candidate after the current one (in the order nearest the fall line)
+                k = order.index(tgt) + 1 if tgt in order and timed_out else 0
+                nxt = next((order[(k + j) % len(order)] for j in range(len(order))
+                            if order[(k + j) % len(order)] in undecided), undecided[0])
+            else:
+                front = [i for i in order if reach[i] >= 0.5]
+                nxt = front[0] if front else order[0]
+            if nxt != tgt:
+                self._search_target, self._search_since = nxt, t
+                self.events.append((t, f"search {nxt}"))
+            elif timed_out:
+                self._search_since = t
+        return self._depth_mode(self._search_target, n0), self._search_target
+
     def _direction_cut(self, i: int, n: np.ndarray) -> np.ndarray:
         """Cube ``i``'s mean line of sight (the mean direction of its fused samples, from the mean eye
         position they were seen from) cut with the plane ``x . n = ray_plane_m``: where the cube is if the wall
         is where expected. A sample's direction is precise even where its depth is not (the vision model)."""
-        k = max(self.dir_n[i], 1.0)
+        k = self.dir_n[i] if self.dir_n[i] > 0.0 else 1.0
         origin = self.dir_eye[i] / k
         u = self.dir_sum[i] / max(float(np.linalg.norm(self.dir_sum[i])), 1e-9)
         return self._ray_cuts((origin + u)[None, :], origin, n)[0]
