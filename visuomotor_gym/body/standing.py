@@ -194,6 +194,7 @@ class StandingBody(Body):
         self._ws = (ws_lo, ws_half)
         self._force = np.zeros(6)
         self.brace_level = 1.0
+        self._brace_set = False  # whether the model's braced gains hold brace_level (see _set_brace)
         self._hand_prev = (0.0, 0.0, 0.0)
         self._cop = (0.0, 0.0, 0.0, 0.0)
         self._com_prev: float | None = None
@@ -212,6 +213,7 @@ class StandingBody(Body):
         self._com_prev = None
         self._xcom.clear()
         data.qpos[self._leg_q] = STANCE_RAD
+        self._brace_set = False
         self._set_brace(1.0)
 
     def start(self, data: mujoco.MjData) -> None:
@@ -222,6 +224,9 @@ class StandingBody(Body):
 
     # --- control ------------------------------------------------------------------------------
     def _set_brace(self, level: float) -> None:
+        if level == self.brace_level and self._brace_set:
+            return  # the gains already hold this level (the model arrays are written only on a change)
+        self._brace_set = True
         self.brace_level = level
         kp = self._gain * (RELAXED_STIFFNESS + (1.0 - RELAXED_STIFFNESS) * level)
         self.model.actuator_gainprm[self._braced, 0] = kp
@@ -288,9 +293,11 @@ class StandingBody(Body):
         fl = fr = sx = sy = 0.0
         left, right = self.feet_geoms
         floor = self.floor_geom
-        for i in range(d.ncon):
-            c = d.contact[i]
-            g1, g2 = c.geom1, c.geom2
+        if not d.ncon:
+            return 0.0, 0.0, 0.0, 0.0
+        contacts = d.contact
+        positions = contacts.pos
+        for i, (g1, g2) in enumerate(contacts.geom.tolist()):  # (a contact object per contact costs more)
             if g1 == floor:
                 g1, g2 = g2, g1
             elif g2 != floor:
@@ -305,7 +312,7 @@ class StandingBody(Body):
                 fl += fn
             else:
                 fr += fn
-            px, py, _pz = c.pos.tolist()
+            px, py = float(positions[i, 0]), float(positions[i, 1])
             sx += fn * px
             sy += fn * py
         total = fl + fr

@@ -125,6 +125,13 @@ class PushRecoveryTask(Task):
         self._allowed = set(body.feet_geoms) | set(body.hand_geoms)
         self._hand = set(body.hand_geoms)
         self._scene = {body.floor_geom} | self._block_geoms
+        # Which geom pairs in contact are a fall (check_substep's rule as a set, looked up once per substep):
+        # a body geom other than the feet and the palm on the floor or a cube, or the palm on the floor.
+        self._fall_pairs = set()
+        for s_ in self._scene:
+            for b in range(model.ngeom):
+                if b not in self._scene and (b not in self._allowed or (b in self._hand and s_ not in self._block_geoms)):
+                    self._fall_pairs.update(((s_, b), (b, s_)))
         self.targets = [PointTarget(f"block_{i}") for i in range(sn.N_BLOCKS)]
         for t in self.targets:
             t.kind = "block"
@@ -243,24 +250,17 @@ class PushRecoveryTask(Task):
         if self.fallen:
             return True
         d = data
-        allowed, scene, hand = self._allowed, self._scene, self._hand
-        for i in range(d.ncon):
-            c = d.contact[i]
-            g1, g2 = c.geom1, c.geom2
-            if g1 in scene:
-                g1, g2 = g2, g1
-            elif g2 not in scene:
-                continue
-            if g1 in scene:
-                continue
-            if g1 in hand and g2 in self._block_geoms:
-                continue
-            if g1 not in allowed or (g1 in hand and g2 not in self._block_geoms):
-                self.fallen = True
-                m = self.model
-                self.fall_geoms = (mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_GEOM, g1),
-                                   mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_GEOM, g2))
-                return True
+        if d.ncon:
+            fall = self._fall_pairs
+            for g1, g2 in d.contact.geom.tolist():
+                if (g1, g2) in fall:  # the first such contact, named body geom first
+                    if g1 in self._scene:
+                        g1, g2 = g2, g1
+                    self.fallen = True
+                    m = self.model
+                    self.fall_geoms = (mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_GEOM, g1),
+                                       mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_GEOM, g2))
+                    return True
         if self.body.head_height(d) < FALL_HEAD_HEIGHT_M:
             self.fallen = True
             self.fall_geoms = ("head", "height")
