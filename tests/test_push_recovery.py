@@ -403,3 +403,81 @@ def test_reach_max_keeps_the_oracle_s_brace_off_a_back_cube(monkeypatch):
         outcomes[spec] = (info["fallen"], touched)
     assert outcomes[brace] == (True, {1})
     assert outcomes[brace + ",reach_max_m=0.7"] == (False, {0})
+
+
+# --- the sixth pass: the vergence search (depth_search, opt-in) ----------------------------------------------
+
+
+def _samples_along_minus_y(agent, distance: float, vergence: float, n: int, rng) -> None:
+    """``n`` samples of cube 0 straight ahead of an eye that looks along the stance frame's -y (toward the
+    wall), drawn with the env's own depth law (``foveation.perceive``) at ``distance`` with the eye verged at
+    ``vergence``, recorded through the agent's depth_search path."""
+    from visuomotor_gym.vision import foveation
+
+    rot = np.array([[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])  # eye x (line of sight) -> stance -y
+    eye = np.array([0.0, 0.0, 0.5])
+    for _ in range(n):
+        pos, _vel, seen = foveation.perceive([distance, 0.0, 0.0], [0.0, 0.0, 0.0], 0.0, agent.vision, rng,
+                                             fixation=vergence)
+        assert seen
+        agent._fuse(0, np.array(pos), rot, eye, vergence)
+
+
+@pytest.mark.parametrize("distance, within", [(0.75, True), (1.15, False)])
+def test_depth_search_tells_a_cube_within_reach_from_one_behind_by_its_samples_scatter(distance, within):
+    """An eye verged at 0.7 m: a cube 0.75 m away gives tight samples, one 1.15 m away (a back-row cube) samples
+    scattered ~0.7 m by the disparity pedestal. The posterior over the cube's distance under the depth law says
+    which (reach along -y from the shoulder: distance - 0.2 m <= 0.7 m), where the plain precision-weighted mean
+    of the same samples (``estimate``: each weighted at its own distance) is pulled toward the vergence distance."""
+    agent = make_agent("eom_brace:depth_search=true,reach_max_m=0.7", ENV, 9)
+    _samples_along_minus_y(agent, distance, 0.7, 20, np.random.default_rng(4))
+    points, prob, reach = agent.posterior(0, np.array([0.0, -1.0, 0.0]))
+    assert prob.sum() == pytest.approx(1.0)
+    if within:
+        assert reach > 0.95
+    else:
+        assert reach < 0.05
+        assert -float(agent.estimate(0)[1]) < 0.9  # the plain weighted mean: within reach (the fifth pass's failure)
+    believed = -float(prob @ points[:, 1])
+    assert believed == pytest.approx(distance, abs=0.15)
+
+
+def test_a_sample_put_behind_the_eye_is_kept_as_a_negative_distance():
+    agent = make_agent("eom_brace:depth_search=true,reach_max_m=0.7", ENV, 9)
+    rot = np.eye(3)
+    agent._record(2, np.array([-0.4, 0.0, 0.0]), rot, np.zeros(3), 0.7)
+    _eye, u, signed, ecc, _verg, _w = agent.samples[2][0]
+    np.testing.assert_allclose(u, [1.0, 0.0, 0.0])
+    assert signed == pytest.approx(-0.4) and ecc == pytest.approx(0.0)
+
+
+SEED_BACK = 3
+
+
+def test_the_vergence_search_holds_on_a_back_row_where_the_fifth_pass_agent_falls(monkeypatch):
+    """The fifth pass's back row (odd cubes 0.4 m behind the wall plane, crowded row, wall 0..30 deg), seed
+    SEED_BACK: the agent whose fixations are verged at the expected wall falls; with the vergence search it
+    fixates the cubes nearest the fall line before the push, knows which are out of reach, and stands."""
+    for name, value in (("BACK_ROW_M", 0.4), ("BLOCK_HALF_SIZE_M", (0.04, 0.05)), ("GAP_M", (0.05, 0.08)),
+                        ("WALL_YAW_DEG", (0.0, 30.0)), ("ROW_HEIGHT_JITTER_M", 0.02)):
+        monkeypatch.setattr(pr, name, value)
+    monkeypatch.setattr(sn, "ANKLE_STRATEGY_GAIN", 1.0)
+    _env, _agent, info = _play("eom_brace:reach_max_m=0.7", SEED_BACK)
+    assert info["fallen"]
+    _env, agent, info = _play("eom_brace:reach_max_m=0.7,depth_search=true", SEED_BACK)
+    assert not info["fallen"]
+    assert any(name.startswith("search") for _t, name in agent.events)
+    n = agent.normal
+    for i in range(sn.N_BLOCKS):
+        if agent.samples[i] and agent.w[i] > 0:
+            _p, _q, reach = agent.posterior(i, n)
+            if i == agent.chosen:
+                assert i % 2 == 0 and reach > 0.5  # a front cube, believed within reach
+
+
+@pytest.mark.parametrize("spec", ["eom_brace:depth_search=1", "eom_brace:search_sure=0.4",
+                                  "eom_brace:search_sure=1", "eom_brace:depth_grid_step_m=0",
+                                  "eom_brace:search_blocks=-1", "eom_brace:search_yaw_deg=120"])
+def test_the_sixth_pass_options_refuse_bad_values(spec):
+    with pytest.raises(ValueError, match="EomBraceParams"):
+        make_agent(spec, ENV, 9)

@@ -199,6 +199,12 @@ class EomBraceParams:
                 if not (isinstance(v, tuple) and len(v) == 2 and all(isinstance(x, (int, float)) for x in v)
                         and 0.0 < v[0] < v[1] and math.isfinite(v[1])):
                     raise ValueError(f"EomBraceParams.depth_grid_m must be (lo, hi) with 0 < lo < hi, got {v!r}")
+            elif f.name == "search_sure":
+                if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0.5 < v < 1.0:
+                    raise ValueError(f"EomBraceParams.search_sure must be a probability in (0.5, 1), got {v!r}")
+            elif f.name == "depth_grid_step_m":
+                if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0.0 < v <= 0.5:
+                    raise ValueError(f"EomBraceParams.depth_grid_step_m must be in (0, 0.5] m, got {v!r}")
             elif f.name == "search_yaw_deg":
                 if isinstance(v, bool) or not isinstance(v, (int, float)) or not -90.0 <= v <= 90.0:
                     raise ValueError(f"EomBraceParams.search_yaw_deg must be a number in [-90, 90], got {v!r}")
@@ -410,7 +416,7 @@ class EomBraceAgent:
         verg = np.maximum(np.array([r[4] for r in rows]), 0.1)
         origin = self.dir_eye[i] / max(self.dir_n[i], 1e-12)
         u = self.dir_sum[i] / max(float(np.linalg.norm(self.dir_sum[i])), 1e-12)
-        grid = np.arange(p.depth_grid_m[0], p.depth_grid_m[1] + 1e-9, max(p.depth_grid_step_m, 1e-3))
+        grid = np.arange(p.depth_grid_m[0], p.depth_grid_m[1] + 1e-9, p.depth_grid_step_m)
         points = origin + np.outer(grid, u)
         d = np.linalg.norm(points[None, :, :] - eyes[:, None, :], axis=2)  # samples x grid
         sig = d * v.depth_std_fraction * v.noise_scale
