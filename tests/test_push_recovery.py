@@ -481,3 +481,54 @@ def test_the_vergence_search_holds_on_a_back_row_where_the_fifth_pass_agent_fall
 def test_the_sixth_pass_options_refuse_bad_values(spec):
     with pytest.raises(ValueError, match="EomBraceParams"):
         make_agent(spec, ENV, 9)
+
+
+# --- the seventh pass: visual-only clutter of the cubes' kind ---------------------------------------------
+def test_visual_only_clutter_is_placed_behind_the_wall_beside_the_cubes_and_leaves_the_rest_alone(monkeypatch):
+    """CLUTTER_PER_CUBE (seventh pass, opt-in): retina targets of the cubes' kind, CLUTTER_BEHIND_M behind the wall
+    plane, never over a cube's silhouette on the wall, each within the cube's half-size + CLUTTER_SPREAD_M of it
+    along the wall and on one side of it; the cubes, the push and the observation's size are the definition's."""
+    env = gym.make(ENV)
+    obs0, _ = env.reset(seed=4)
+    task = env.unwrapped.task
+    faces, push = task.block_faces.copy(), (task.push_time, task.push_force)
+    monkeypatch.setattr(pr, "CLUTTER_PER_CUBE", 4)
+    env = gym.make(ENV)
+    obs, _ = env.reset(seed=4)
+    task = env.unwrapped.task
+    np.testing.assert_array_equal(task.block_faces, faces)
+    assert (task.push_time, task.push_force) == push and obs.shape == obs0.shape
+    clutter = task.clutter_faces
+    assert len(clutter) >= 3 * sn.N_BLOCKS and all(t.kind == "block" for t in task.targets)
+    assert sum(not t.hidden for t in task.clutter) == len(clutter)
+    n = task.wall_normal
+    along = np.array([-n[1], n[0], 0.0])
+    behind = clutter @ n - task.wall_distance
+    assert np.all(behind >= pr.CLUTTER_BEHIND_M[0] - 1e-9) and np.all(behind <= pr.CLUTTER_BEHIND_M[1] + 1e-9)
+    for f, h in zip(task.block_faces, task.block_half_sizes):
+        du, dz = np.abs((clutter - f) @ along), np.abs(clutter[:, 2] - f[2])
+        assert np.all((du >= h + pr.CLUTTER_HALF_SIZE_M[0] - 1e-9) | (dz >= h + pr.CLUTTER_HALF_SIZE_M[0] - 1e-9))
+    # no geom of the model is a clutter cube: nothing to touch
+    assert all("clutter" not in (mujoco.mj_id2name(task.model, mujoco.mjtObj.mjOBJ_GEOM, g) or "")
+               for g in range(task.model.ngeom))
+
+
+def test_trust_ecc_restarts_a_cube_s_belief_at_its_first_trusted_sample_and_then_ignores_the_periphery():
+    """trust_ecc_deg (seventh pass, opt-in): a peripheral sample places a cube until one within trust_ecc_deg
+    comes; that one restarts the belief, and later peripheral samples (possibly pooled with the clutter) are
+    not fused."""
+    agent = make_agent("eom_brace:trust_ecc_deg=8", ENV, 9)
+    agent.reset()
+    rot, eye = np.eye(3), np.zeros(3)
+    a = math.radians(20.0)
+    agent._fuse(0, np.array([0.7 * math.cos(a), -0.7 * math.sin(a), 0.0]), rot, eye, 0.7)
+    assert agent.w[0] > 0 and not agent.trusted[0]
+    agent._fuse(0, np.array([0.7, 0.01, 0.0]), rot, eye, 0.7)
+    assert agent.trusted[0]
+    np.testing.assert_allclose(agent.estimate(0), (0.7, 0.01, 0.0))
+    w = agent.w[0]
+    agent._fuse(0, np.array([0.7 * math.cos(a), 0.7 * math.sin(a), 0.0]), rot, eye, 0.7)
+    assert agent.w[0] == w
+    np.testing.assert_allclose(agent.estimate(0), (0.7, 0.01, 0.0))
+    with pytest.raises(ValueError, match="EomBraceParams.trust_ecc_deg"):
+        make_agent("eom_brace:trust_ecc_deg=-1", ENV, 9)

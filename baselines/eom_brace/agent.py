@@ -157,6 +157,15 @@ class EomBraceParams:
     # the expected fall direction before the push: the wall's normal turned forward by this (deg; the middle of
     # the task's 0..30 deg: modelling choice, a person standing by a wall knows roughly how it runs)
     search_yaw_deg: float = 15.0
+    # trust_ecc_deg (seventh pass, opt-in; 0 = off): a wall with visual-only clutter of the cubes' own kind
+    # (tasks.push_recovery.CLUTTER_PER_CUBE) crowds every peripheral sample of a cube (Bouma 1970: flankers within
+    # 0.5 x eccentricity pool; the clutter itself is never seen as a cube, so baselines/crowding.py cannot flag
+    # it): a sample beyond this eccentricity is taken as possibly pooled. It still places the cube coarsely (the
+    # looks and the choice use it) until the cube's first sample within trust_ecc_deg, which restarts its belief
+    # (position and direction) from the trusted samples only; the look at a cube without one goes to its latest
+    # sample (a corrective saccade: a pooled percept nearer the fovea has fewer flankers), and the hand moves in
+    # only once the chosen cube has a trusted sample, or align_timeout_s after the reaction (modelling choices).
+    trust_ecc_deg: float = 0.0
     fall_speed_m_s: float = 0.15  # the pelvis moving faster than this: its direction is the fall's (modelling choice)
     approach_offset_m: float = 0.10  # align the palm 10 cm in front of the believed face first (modelling choice)
     align_m: float = 0.04  # ... to within 4 cm along the wall, then move in (modelling choice)
@@ -271,6 +280,8 @@ class EomBraceAgent:
         self.dir_sum = np.zeros((N, 3))  # sum of the fused samples' unit lines of sight (stance frame)
         self.dir_eye = np.zeros((N, 3))  # ... and of the eye positions they were seen from
         self.dir_n = np.zeros(N)
+        self.trusted = np.zeros(N, dtype=bool)  # trust_ecc_deg: a sample within it has come
+        self.last_seen = np.zeros((N, 3))  # trust_ecc_deg: the latest sample (stance frame)
         # depth_search: every fused sample of each cube as (eye position, unit line of sight (stance frame),
         # distance, eccentricity, vergence distance of its time)
         self.samples: list[list] = [[] for _ in range(N)]
@@ -316,6 +327,18 @@ class EomBraceAgent:
             return
         v = self.vision
         ecc = foveation.eccentricity(pos_eye)
+        if self.params.trust_ecc_deg > 0 and v.foveated:
+            self.last_seen[i] = eye + rot @ pos_eye
+            if ecc <= self.params.trust_ecc_deg * DEG:
+                if not self.trusted[i]:  # the first trusted sample: forget the pooled ones
+                    self.trusted[i] = True
+                    self.w[i] = self.best_w[i] = 0.0
+                    self.sum[i] = 0.0
+                    self.dir_sum[i] = 0.0
+                    self.dir_eye[i] = 0.0
+                    self.dir_n[i] = 0.0
+            elif self.trusted[i]:
+                return  # possibly pooled with the clutter: a trusted belief keeps to trusted samples
         if v.foveated and ecc > self.params.fuse_max_ecc_deg * DEG:
             return  # far periphery: crowded and coarse, not fused (a full view has no periphery)
         depth_std = dist * v.depth_std_fraction * v.noise_scale / foveation.acuity(ecc, v)
@@ -573,6 +596,8 @@ class EomBraceAgent:
                     self._scan_k = k
                     self._scan_target = order[(k - len(p.scan_x_m)) % len(order)]
                 look_at = self.estimate(self._scan_target)
+                if p.trust_ecc_deg > 0 and self.vision.foveated and not self.trusted[self._scan_target]:
+                    look_at = self.last_seen[self._scan_target].copy()  # its latest percept (corrective)
                 if p.verify_reach:  # verged at the expected wall: a front cube's depth is measured there
                     look_at = self._direction_cut(self._scan_target, n)
                 look_block = self._scan_target
@@ -630,7 +655,10 @@ class EomBraceAgent:
                     late = t - self.detected_at - p.reaction_latency_s >= p.align_timeout_s - 1e-9
                     off = hand - face
                     verified = not p.verify_reach or self.best_w[self.chosen] >= p.verify_w
-                    if verified and (float(np.linalg.norm(off - n * float(off @ n))) < p.align_m or late):
+                    aligned = float(np.linalg.norm(off - n * float(off @ n))) < p.align_m
+                    if p.trust_ecc_deg > 0 and self.vision.foveated:
+                        aligned = aligned and bool(self.trusted[self.chosen])
+                    if verified and (aligned or late):
                         self.approach_since = t
                         self.events.append((t, "approach"))
                 if self.approach_since is not None:
@@ -664,6 +692,9 @@ class EomBraceAgent:
                 search_look = True
             elif p.choose_by_ray and self.hold is None and self.best_w[self.chosen] < p.cut_until_w:
                 look_at = self._direction_cut(self.chosen, n)  # the cube's direction, at the plane's distance
+            if p.trust_ecc_deg > 0 and self.vision.foveated and not self.trusted[self.chosen] \
+                    and self.hold is None:
+                look_at = self.last_seen[self.chosen].copy()  # a corrective saccade to its latest percept
             look_block = self.chosen
             rates = obs[_S["vestibular"]][2:5]
             if self.hold is not None and float(np.max(np.abs(rates))) < p.still_rad_s:

@@ -57,6 +57,20 @@ ROW_HEIGHT_JITTER_M: float | None = None
 # (~0.4 m std at 20 deg) cannot tell the rows apart: a hand sent to a back cube goes through a gap.
 # Modelling choice.
 BACK_ROW_M: float | None = None
+# Visual-only clutter (seventh pass, opt-in; None in the definition): CLUTTER_PER_CUBE small cubes of the SAME
+# kind as the wall's ("block" targets of the retina), drawn but not touchable and not in the observation, placed
+# around each reachable cube, irregularly, in the gaps and above and below it, CLUTTER_BEHIND_M behind the wall
+# plane (never overlapping a real cube's silhouette on the wall, so nothing is hidden behind one). Crowding
+# (Bouma 1970: same-kind flankers within 0.5 x eccentricity pool, the percept is the group's mean) then pools a
+# peripheral sample of a cube with its clutter, to one side (each cube's clutter keeps to one side of it, drawn
+# per cube, so the pooled mean lands off the cube) and behind; only a fixated cube is seen where it is. As
+# ShelfReach's shelf clutter (envs/reach.py). Modelling choices: counts, sizes, spread and depths below.
+CLUTTER_PER_CUBE: int | None = None
+CLUTTER_HALF_SIZE_M = (0.02, 0.03)
+CLUTTER_BEHIND_M = (0.05, 0.15)
+CLUTTER_SPREAD_M = 0.06  # a clutter cube's face centre within the cube's half-size + this of the cube's centre
+CLUTTER_TRIES = 40  # rejection draws per clutter cube (one that finds no free place stays parked)
+N_CLUTTER = 36  # the pool of clutter targets (6 per cube of the pool)
 FIRST_BLOCK_X_M = (-0.35, -0.05)  # the row starts beside the body and runs forward (modelling choice)
 PARKED = (-20.0, -20.0, -5.0)  # a parked block: 5 m under the floor, out of sight
 
@@ -133,6 +147,10 @@ class PushRecoveryTask(Task):
                 if b not in self._scene and (b not in self._allowed or (b in self._hand and s_ not in self._block_geoms)):
                     self._fall_pairs.update(((s_, b), (b, s_)))
         self.targets = [PointTarget(f"block_{i}") for i in range(sn.N_BLOCKS)]
+        # The visual-only clutter follows the cubes in the retina's target list (the observation reads only
+        # the cubes' samples); none without CLUTTER_PER_CUBE (the definition's target list).
+        self.clutter = [PointTarget(f"clutter_{k}") for k in range(N_CLUTTER)] if CLUTTER_PER_CUBE else []
+        self.targets += self.clutter
         for t in self.targets:
             t.kind = "block"
         self.leading_blocks = BLOCK_PERCEPT_BLOCKS
@@ -206,9 +224,43 @@ class PushRecoveryTask(Task):
         self.block_centres = np.array(centres)
         self.block_faces = np.array(faces)
         self.block_half_sizes = np.array(sizes)
+        self.clutter_faces = self._place_clutter(rng, rows, wall, along, normal) if self.clutter else np.zeros((0, 3))
         c, sn_ = math.cos(az), math.sin(az)
         self.push_dir = np.array([c * normal[0] - sn_ * normal[1], sn_ * normal[0] + c * normal[1], 0.0])
         data.xfrc_applied[:] = 0.0
+
+    def _place_clutter(self, rng: np.random.Generator, rows: list, wall: float, along: np.ndarray,
+                       normal: np.ndarray) -> np.ndarray:
+        """Place the visual-only clutter (:data:`CLUTTER_PER_CUBE` around each cube within reach; one
+        ``rng.integers`` seeds a generator of its own, after every other draw) and return its faces."""
+        g = np.random.default_rng(int(rng.integers(2**31)))
+        for t in self.clutter:
+            t.hidden = True
+        # silhouettes on the wall (along, z, half-size) that a clutter cube may not overlap
+        boxes = [(r[0], r[2], r[1]) for r in rows if r is not None]
+        faces, k = [], 0
+        for i, row in enumerate(rows):
+            if row is None or (BACK_ROW_M is not None and i % 2 == 1):
+                continue
+            xa, h, z, _off = row
+            side = 1.0 if g.random() < 0.5 else -1.0
+            for _ in range(CLUTTER_PER_CUBE):
+                if k >= len(self.clutter):
+                    break
+                for _try in range(CLUTTER_TRIES):
+                    hd = float(g.uniform(*CLUTTER_HALF_SIZE_M))
+                    u = xa + side * float(g.uniform(0.0, h + CLUTTER_SPREAD_M))
+                    v = z + float(g.uniform(-(h + CLUTTER_SPREAD_M), h + CLUTTER_SPREAD_M))
+                    if all(abs(u - bx) >= bh + hd or abs(v - bz) >= bh + hd for bx, bz, bh in boxes):
+                        break
+                else:
+                    continue
+                boxes.append((u, v, hd))
+                face = along * u + normal * (wall + float(g.uniform(*CLUTTER_BEHIND_M))) + np.array([0.0, 0.0, v])
+                self.clutter[k].place(float(face[0]), float(face[1]), float(face[2]))
+                faces.append(face)
+                k += 1
+        return np.array(faces).reshape(-1, 3)
 
     def _resize(self, i: int, h: float) -> None:
         """Cube ``i`` of half-size ``h``, with the bounding volumes MuJoCo's collision broad- and mid-phase
@@ -282,7 +334,7 @@ class PushRecoveryTask(Task):
     # --- observation --------------------------------------------------------------------------
     def observe_leading(self, values: list, samples: list) -> None:
         vis = []
-        for pos, _vel, visible in samples:
+        for pos, _vel, visible in samples[: sn.N_BLOCKS]:  # the cubes' samples (not the clutter's)
             values += pos
             vis.append(1.0 if visible else 0.0)
         self.visible = [v > 0.5 for v in vis]

@@ -8,7 +8,9 @@ gap range m [0.05,0.08], ``PUSH_ROW_JITTER`` per-cube height jitter m [0.02; "no
 ``PUSH_YAW`` wall yaw range deg [0,30], ``PUSH_FIRST_X`` first cube's x range m [-0.35,-0.05], ``PUSH_HEIGHT`` the
 cube (row) height range m [1.00,1.35], ``PUSH_AZ`` the push's azimuth
 half-range about the wall's normal deg [10]; ``PUSH_BACK`` the odd cubes set back by
-this many m, out of reach [none]; ``PUSH_CROWDING=0`` the same eye
+this many m, out of reach [none]; ``PUSH_CLUTTER`` visual-only clutter cubes per cube (seventh
+pass, ``tasks.push_recovery.CLUTTER_PER_CUBE``) [none], ``PUSH_CLUTTER_BEHIND`` their depth behind the wall
+plane, m [0.05,0.15], ``PUSH_CLUTTER_SPREAD`` m [0.06]; ``PUSH_CROWDING=0`` the same eye
 without crowding (a diagnostic). E.g.:
 
     OPENBLAS_CORETYPE=Haswell MUJOCO_GL=egl python docs/reproductions/data/push/variant_crowded.py bench \
@@ -43,6 +45,10 @@ if __name__ == "__main__":
     pr.ROW_HEIGHT_JITTER_M = None if jitter == "none" else float(jitter)
     back = os.environ.get("PUSH_BACK", "none")
     pr.BACK_ROW_M = None if back == "none" else float(back)
+    clutter = os.environ.get("PUSH_CLUTTER", "none")
+    pr.CLUTTER_PER_CUBE = None if clutter == "none" else int(clutter)
+    pr.CLUTTER_BEHIND_M = _pair("PUSH_CLUTTER_BEHIND", "0.05,0.15")
+    pr.CLUTTER_SPREAD_M = float(os.environ.get("PUSH_CLUTTER_SPREAD", "0.06"))
     sn.ANKLE_STRATEGY_GAIN = 1.0
     if os.environ.get("PUSH_CROWDING", "1") == "0":  # diagnostic: the same eye without crowding
         for prefix in ("PushRecovery", "PushRecoveryDelayed", "PushRecoveryPoorVision"):
