@@ -530,5 +530,5 @@ def test_trust_ecc_restarts_a_cube_s_belief_at_its_first_trusted_sample_and_then
     agent._fuse(0, np.array([0.7 * math.cos(a), 0.7 * math.sin(a), 0.0]), rot, eye, 0.7)
     assert agent.w[0] == w
     np.testing.assert_allclose(agent.estimate(0), (0.7, 0.01, 0.0))
-    with pytest.raises(ValueError, match="EomBraceParams.trust_ecc_deg"):
+    with pytest.raises(ValueError, match=r"EomBraceParams\.trust_ecc_deg"):
         make_agent("eom_brace:trust_ecc_deg=-1", ENV, 9)
