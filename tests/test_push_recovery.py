@@ -517,7 +517,7 @@ def test_trust_ecc_restarts_a_cube_s_belief_at_its_first_trusted_sample_and_then
     """trust_ecc_deg (seventh pass, opt-in): a peripheral sample places a cube until one within trust_ecc_deg
     comes; that one restarts the belief, and later peripheral samples (possibly pooled with the clutter) are
     not fused."""
-    agent = make_agent("eom_brace:trust_ecc_deg=8", ENV, 9)
+    agent = make_agent("eom_brace:trust_ecc_deg=8,fuse_max_ecc_deg=40", ENV, 9)
     agent.reset()
     rot, eye = np.eye(3), np.zeros(3)
     a = math.radians(20.0)
