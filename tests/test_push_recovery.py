@@ -293,7 +293,7 @@ def test_the_new_options_refuse_bad_values(spec):
         make_agent(spec, ENV, 9)
 
 
-# --- fourth pass (issue 25): the active hold, crowded samples, choosing by the line of sight ----------
+# --- fourth pass: the active hold, crowded samples, choosing by the line of sight ----------
 def test_the_active_hold_keeps_a_body_upright_that_the_strut_lets_lean_over():
     """Oracle rung, seed 6: with the plain strut the hand rests on the cube's edge while the body leans on
     its right foot's outer edge and slowly tips into the wall (upper arm on a cube); the arm that pushes with

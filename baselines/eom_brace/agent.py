@@ -78,7 +78,7 @@ class EomBraceParams:
     scan_y_m: float = -0.75
     scan_z_m: float = 0.35
     scan_dwell_s: float = 0.3
-    # Options tried in the third pass of issue 25 (off by default; docs/reproductions/eom.md, "Tried in the
+    # Options tried in PushRecovery's third pass (off by default; docs/reproductions/eom.md, "Tried in the
     # third pass"): after the scan_x_m looks, fixate the scan_blocks believed cubes nearest the fall line in
     # turn, scan_dwell_s each (0: keep looking at the wall's middle); verge on the fixated cube's latest
     # sample distance when it lies within verge_ecc_deg of the fovea instead of on the belief's distance

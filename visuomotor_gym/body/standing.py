@@ -58,7 +58,7 @@ STANCE_ANKLE_PITCH_RAD = 0.03
 STANCE_RAD = (STANCE_HIP_ROLL_RAD, 0.0, 0.0, STANCE_ANKLE_PITCH_RAD, -STANCE_HIP_ROLL_RAD,
               -STANCE_HIP_ROLL_RAD, 0.0, 0.0, STANCE_ANKLE_PITCH_RAD, STANCE_HIP_ROLL_RAD)
 # The automatic postural response of the legs: OFF in the definition (every gain 0; the third pass of
-# issue 25 measured it, docs/reproductions/eom.md, "Tried in the third pass"). When on, each control step the
+# PushRecovery's passes measured it, docs/reproductions/eom.md, "Tried in the third pass"). When on, each control step the
 # leg servos' setpoints are the stance plus offsets driven by the extrapolated centre of mass
 # (XCoM = x + v / omega0, Hof, Gazendam & Sinke 2005, J Biomech 38:1) seen POSTURAL_LATENCY_S earlier:
 # sagittally an ankle strategy (ankle pitch) and a hip strategy (hip pitch: the trunk bends to move the

@@ -46,7 +46,7 @@ BLOCK_HALF_SIZE_M = (0.07, 0.11)
 GAP_M = (0.12, 0.30)
 BLOCK_HEIGHT_M = (1.00, 1.35)
 BLOCK_OFFSET_M = (0.0, 0.10)
-# A crowded wall (issue 25's fifth pass, opt-in; None in the definition): every cube after the first at the
+# A crowded wall (PushRecovery's fifth pass, opt-in; None in the definition): every cube after the first at the
 # first cube's height plus up to +-ROW_HEIGHT_JITTER_M (its own height draw mapped onto that range, so the
 # draws and their order are unchanged): a straight row whose neighbours lie side by side in the visual field,
 # where crowding (Bouma 1970) can pool them. Modelling choice.
@@ -89,7 +89,7 @@ PUSH_FORCE_N = (300.0, 350.0)
 # sagittal margin, 10 cm behind the centre of mass to the heels, is the body's weak direction once braced).
 PUSH_AZIMUTH_DEG = 10.0
 # The wall's yaw, drawn per episode (deg; its normal turned forward from the body's right; the push follows
-# the normal): (0, 0) in the definition, no draw. The third pass of issue 25 tried 0..30, 30..60, -30..0 and
+# the normal): (0, 0) in the definition, no draw. PushRecovery's third pass tried 0..30, 30..60, -30..0 and
 # -10..35 so that the cube the hand needs is not always beside the shoulder (docs/reproductions/eom.md,
 # "Tried in the third pass"): the braced stance falls on forward and backward components (modelling choice).
 WALL_YAW_DEG = (0.0, 0.0)

@@ -1,4 +1,4 @@
-"""The fourth pass of issue 25 on seeds 0-39: the brace (ankle response, active hold) and the agent's vision options
+"""PushRecovery's fourth pass on seeds 0-39: the brace (ankle response, active hold) and the agent's vision options
 on the wall turned per episode, with the one eye ``human_periphery(position_disarray=0.8)``.
 
 Each row sets the task's and body's module constants in this process only (as ``explore_scene.py``, whose

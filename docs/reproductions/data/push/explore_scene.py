@@ -1,4 +1,4 @@
-"""Scene and stance variants of PushRecovery-v0 tried in the third pass (issue 25), on seeds 0-39.
+"""Scene and stance variants of PushRecovery-v0 tried in the third pass, on seeds 0-39.
 
 Each variant overrides module constants of the task (``tasks/push_recovery.py``: the wall's yaw, distance,
 heights, gaps, the push's azimuth spread) or of the body's automatic postural response

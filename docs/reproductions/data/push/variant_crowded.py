@@ -1,6 +1,6 @@
 """``vmgym`` (or the static-posture search) on PushRecovery's fifth-pass candidate: a crowded row of cubes.
 
-Fifth pass of issue 25 (``docs/reproductions/eom.md``, "Fifth pass"): the fourth pass's scene (wall turned
+Fifth pass of PushRecovery (``docs/reproductions/eom.md``, "Fifth pass"): the fourth pass's scene (wall turned
 0..30 deg, ankle response on, the one eye ``human_periphery()``) with the row of cubes made dense enough to
 crowd (Bouma 1970): smaller cubes, narrower gaps, one row height. Set in this process only, through the
 environment variables (defaults in brackets): ``PUSH_HALF`` cube half-size range m [0.04,0.05], ``PUSH_GAP``

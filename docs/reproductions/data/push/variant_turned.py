@@ -1,6 +1,6 @@
 """``vmgym`` (or the static-posture search) on PushRecovery's fourth-pass candidate scene, in this process only.
 
-Fourth pass of issue 25 (``docs/reproductions/eom.md``, "Fourth pass"): the wall turned 0..30 deg per episode (``--yaw -20,45``: the wider range, files wide_*)
+Fourth pass of PushRecovery (``docs/reproductions/eom.md``, "Fourth pass"): the wall turned 0..30 deg per episode (``--yaw -20,45``: the wider range, files wide_*)
 (``tasks.push_recovery.WALL_YAW_DEG``; the push follows its normal), so the cube the hand needs moves by tens of
 cm and ~30 deg of gaze; the standing body's ankle response on (``body.standing.ANKLE_STRATEGY_GAIN`` 1); the
 eye ``human_periphery(position_disarray=0.8)`` (the registered ids' ``vision_params``). The definition keeps

@@ -1,5 +1,5 @@
 """``vmgym`` (or the static-posture search) on PushRecovery with the wall turned 0..30 deg forward, in this
-process only (``tasks.push_recovery.WALL_YAW_DEG``; the definition keeps it at 0). Third pass of issue 25:
+process only (``tasks.push_recovery.WALL_YAW_DEG``; the definition keeps it at 0). Third pass of PushRecovery:
 
     OPENBLAS_CORETYPE=Haswell MUJOCO_GL=egl python docs/reproductions/data/push/variant_yaw.py bench \
         --agent eom_brace:fall_direction=true --env PushRecovery-v0 --episodes 200 --seed 0 --out yaw30_eom200.json
