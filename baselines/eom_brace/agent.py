@@ -25,6 +25,19 @@ The agent sees observations only (the cubes only as the eye's samples of their f
    head return straight ahead (Eom: "it turns the head away from the wall"). The hand stays on the cube
    (not released: releasing tips the leaning body back over; see the reproduction page).
 
+Since PushRecovery's fourth pass (the wall turned per episode) the defaults are: samples that may be crowded
+are dropped and the rest fused to 40 deg (``drop_crowded``); the push is detected along the vestibular fall
+direction and the hand braces along it (``fall_direction``); the cube is chosen, looked at (verged at the wall's
+expected distance) and first aimed at by the mean direction of its samples (``choose_by_ray``,
+``verge_on_ray``, ``hand_on_cut``) until a fixated sample gives its depth; and the hand on the cube pushes
+with the trunk's lean (``hold_lean_gain``, ``hold_lean_damp``) instead of holding a fixed strut.
+
+Since the eighth pass (the wall on a random side, two arms) every right-side constant is mirrored for a wall on
+the left and the left arm braces there (the action's ``arm`` value): the side is that of the cubes' first samples
+before the push (the human field reaches 100 deg to each side), then that of the vestibular fall direction. An eye
+that never sees a cube (a static posture turned away from the wall) has none to brace on: the hand stays at its
+ready point, as the legs-only reference.
+
 ``gaze_blind`` is the twin with gaze, vergence and head held (zero actions); the registered
 ``gaze_blind:eom_brace`` wrapper gives the same. ``use_hand=false`` is the legs-only reference: the same
 agent whose hand stays at its ready point.
@@ -56,6 +69,12 @@ _FIX = OculomotorParams().fixation_range_m
 _LOG_FIX = (math.log(_FIX[0]), math.log(_FIX[1]))
 N = sn.N_BLOCKS
 SHOULDER = np.array([0.0, -0.2, 0.4])  # right shoulder, stance frame (envs_assets/push.xml: upper_arm)
+# The wall's side (PushRecovery's eighth pass: tasks.push_recovery.WALL_SIDE_RANDOM): every right-side constant below
+# (the shoulder, the hand's ready point, the scan's y, the expected wall normal) is mirrored (y -> -y) for a wall
+# on the left, and the left arm braces. Before the push the side is the sign of y of the cubes' lines of sight
+# (any sample, at any eccentricity: the human field reaches 100 deg to each side, Spector 1990); SIDE_SAMPLES
+# samples decide it (modelling choice); once the push is detected, the fall's direction (vestibular) decides.
+SIDE_SAMPLES = 2
 FOOT_HALF_WIDTH_M = 0.045  # envs_assets/push.xml: the foot box's half width
 FOOT_HALF_LENGTH_M = 0.13  # ... and half length (the sole site is at the box's centre)
 SAMPLE_DISTANCE_RANGE_M = (0.2, 2.0)  # samples outside are rejected: the cubes are 0.5-1.5 m from the eye (modelling choice)
@@ -94,38 +113,38 @@ class EomBraceParams:
     # distance: modelling choice, the middle of the task's 0.60-0.80 m), and the cube whose cut lies nearest
     # the fall line through the shoulder is chosen. A peripheral sample's direction is precise and its depth
     # coarse (the vision model), so a far cube believed near is not chosen (modelling choice).
-    choose_by_ray: bool = False
+    choose_by_ray: bool = True  # on since the fourth pass (the wall turned per episode)
     # drop_crowded: samples that may be crowded this step (another cube's perceived line of sight within the
     # critical spacing, baselines/crowding.py; Bouma 1970) are not fused: a pooled sample carries a
     # neighbour's position (modelling choice, as the walker baselines).
-    drop_crowded: bool = False
+    drop_crowded: bool = True  # on since the fourth pass
     ray_plane_m: float = 0.7
     # ... and the chosen cube is looked at on its mean line of sight at that plane until its belief's best
     # sample weight reaches cut_until_w (1/m^2: a depth std of 1/sqrt(w), 400 = 5 cm; modelling choice)
     cut_until_w: float = 400.0
-    hand_on_cut: bool = False  # ... and the hand aims there too until then (modelling choice)
+    hand_on_cut: bool = True  # ... and the hand aims there too until then (modelling choice; on since the fourth pass)
     # verge_on_ray: the vergence distance of a look at a cube is its line of sight's cut with that plane, not
     # the belief's distance (a belief from peripheral samples is wrong mostly along the line of sight, and a
     # fixation verged at the wrong distance keeps the depth coarse: the depth pedestal; modelling choice).
-    verge_on_ray: bool = False
+    verge_on_ray: bool = True  # on since the fourth pass
     verge_on_sample: bool = False
     verge_ecc_deg: float = 5.0
     hand_ready: tuple = (0.1, -0.4, 0.27)  # stance frame: the hand waits beside the hip, toward the wall (modelling choice)
     # The reaction: saccade and hand start this long after the detection. Arm reactions to a perturbation
     # start ~100-150 ms after it (Maki & McIlroy's reviews, REFERENCES.md, unconfirmed): modelling choice.
     reaction_latency_s: float = 0.1
-    # Samples beyond this eccentricity are not fused: there a cube's position is crowded by its neighbours
-    # (Bouma 1970: within ~0.5 x eccentricity; the cubes are ~20-25 deg apart at the wall's distance) and
-    # its depth coarse (modelling choice).
-    fuse_max_ecc_deg: float = 20.0
+    # Samples beyond this eccentricity are not fused: there a cube's depth is coarse and, beyond ~40 deg, its
+    # position crowded by its neighbours (Bouma 1970: within ~0.5 x eccentricity; the cubes are ~20-25 deg apart
+    # at the wall's distance); modelling choice: 40 with drop_crowded since the fourth pass (20 before).
+    fuse_max_ecc_deg: float = 40.0
     reset_ratio: float = 10.0  # a sample this much more precise restarts a cube's mean (modelling choice)
     cop_margin_m: float = 0.01  # CoP within 1 cm of the foot's outer edge: leaving the polygon (modelling choice)
     unload_fraction: float = 0.05  # or a foot carrying < 5 % of body weight (modelling choice)
     # fall_direction: detect the push from the pelvis's velocity direction (vestibular; once faster than
     # fall_speed_m_s) and the CoP within cop_margin_m of the support polygon's extent along it, then choose the
     # cube nearest the fall line through the shoulder and brace along that direction, for a wall that is not
-    # beside the body (task WALL_YAW_DEG). Off: the definition's wall on the right, as before (bit for bit).
-    fall_direction: bool = False
+    # beside the body (task WALL_YAW_DEG; on since the fourth pass). Off: the wall assumed on the right.
+    fall_direction: bool = True
     # reach_max_m (fifth pass, opt-in; 0 = off): a cube whose believed face lies farther than this from the
     # shoulder along the fall's direction is out of reach and not chosen while a nearer one is believed
     # (modelling choice: the arm's ~0.6 m plus the lean; a back row of cubes, tasks.push_recovery.BACK_ROW_M).
@@ -180,13 +199,13 @@ class EomBraceParams:
     # A negative value switches the yield off (the arm pushes as a strut throughout).
     yield_speed_m_s: float = 0.0
     yield_brace: float = 0.0  # the brace command while the arm yields (-1 relaxed .. 1 braced; modelling choice)
-    # The active hold (off at 0): once the hand is on the cube, it pushes along the fall's direction by
+    # The active hold (on since the fourth pass; 0 switches it off): once the hand is on the cube, it pushes along the fall's direction by
     # hold_lean_gain m per rad of the trunk's lean toward the wall beyond hold_lean_ref, plus hold_lean_damp m
     # per rad/s of the lean's rate (the vestibular tilt and rates), clipped to [-hold_retract_m, hold_push_m]:
     # the arm is a balance controller, not a fixed strut (modelling choice).
-    hold_lean_gain: float = 0.0
+    hold_lean_gain: float = 2.0
     hold_lean_ref: float = 0.0
-    hold_lean_damp: float = 0.0
+    hold_lean_damp: float = 0.1
     hold_push_m: float = 0.15
     hold_retract_m: float = 0.05
     still_rad_s: float = 0.15  # trunk still: every vestibular rate below this (modelling choice)
@@ -229,21 +248,23 @@ class EomBraceParams:
                 raise ValueError(f"EomBraceParams.{f.name} must be a finite number >= 0, got {v!r}")
 
 
-def encode(hand_target, brace: float, gaze, fixation_m, head, gaze_range: float) -> np.ndarray:
-    """The 9-dim PushRecovery action: hand target (stance frame), brace (-1..1), gaze change (rad), fixation
-    distance (m; None keeps the neutral value), neck (yaw, pitch; rad)."""
-    a = np.zeros(9, dtype=np.float32)
+def encode(hand_target, brace: float, gaze, fixation_m, head, gaze_range: float, left: bool = False) -> np.ndarray:
+    """The 10-dim PushRecovery action: hand target (stance frame), brace (-1..1), the arm (``left``: the left arm,
+    else the right), gaze change (rad), fixation distance (m; None keeps the neutral value), neck (yaw, pitch;
+    rad)."""
+    a = np.zeros(10, dtype=np.float32)
     a[:3] = sn.hand_target_action(np.asarray(hand_target) + sn.STANCE_ORIGIN)
     a[3] = brace
-    a[4] = np.clip(gaze[0] / gaze_range, -1.0, 1.0)
-    a[5] = np.clip(gaze[1] / gaze_range, -1.0, 1.0)
+    a[4] = 1.0 if left else -1.0
+    a[5] = np.clip(gaze[0] / gaze_range, -1.0, 1.0)
+    a[6] = np.clip(gaze[1] / gaze_range, -1.0, 1.0)
     if fixation_m is not None:
         lo, hi = _LOG_FIX
-        a[6] = np.clip(2.0 * (math.log(max(fixation_m, 1e-3)) - lo) / (hi - lo) - 1.0, -1.0, 1.0)
+        a[7] = np.clip(2.0 * (math.log(max(fixation_m, 1e-3)) - lo) / (hi - lo) - 1.0, -1.0, 1.0)
     for k in range(2):
         lo_h, hi_h = _NECK[k]
         h = math.degrees(float(head[k]))
-        a[7 + k] = np.clip(h / hi_h if h >= 0 else -h / lo_h, -1.0, 1.0)
+        a[8 + k] = np.clip(h / hi_h if h >= 0 else -h / lo_h, -1.0, 1.0)
     return a
 
 
@@ -293,9 +314,15 @@ class EomBraceAgent:
         self._slip_pose = None
         self.home: np.ndarray | None = None
         self.detected_at: float | None = None
+        self.side = -1  # the wall's side: -1 right (y < 0), +1 left; the right until the cubes or the fall say
+        self._side_sum = 0.0  # the summed y of the cubes' unit lines of sight (stance frame)
+        self._side_n = 0
+        self._side_known = False
+        self.shoulder = SHOULDER.copy()
         self.normal = np.array([0.0, -1.0, 0.0])
         self._scan_order = None
         self._look_normal = np.array([0.0, -1.0, 0.0])
+        self._set_side(-1)
         self._scan_k = -1
         self._scan_target = 0
         self.chosen: int | None = None
@@ -369,7 +396,7 @@ class EomBraceAgent:
         if not (v.crowding and v.foveated):
             return set()
         yaw = self.params.search_yaw_deg * DEG
-        n0 = self.normal if self.detected_at is not None else np.array([math.sin(yaw), -math.cos(yaw), 0.0])
+        n0 = self.normal if self.detected_at is not None else self._m(np.array([math.sin(yaw), -math.cos(yaw), 0.0]))
         believed = {}
         for j in range(N):
             if self.dir_n[j] > 0.0:
@@ -453,7 +480,7 @@ class EomBraceAgent:
         ll = np.sum(-0.5 * ((dist[:, None] - d) / sig) ** 2 - np.log(sig), axis=0)
         prob = np.exp(ll - ll.max())
         prob /= prob.sum()
-        reach = float(prob[(points - SHOULDER) @ n <= p.reach_max_m].sum()) if p.reach_max_m > 0 else 1.0
+        reach = float(prob[(points - self.shoulder) @ n <= p.reach_max_m].sum()) if p.reach_max_m > 0 else 1.0
         out = (points, prob, reach)
         self._post[key] = out
         return out
@@ -463,7 +490,7 @@ class EomBraceAgent:
         lies within reach along ``n`` when ``within_reach`` and that has any probability)."""
         points, prob, _ = self.posterior(i, n)
         if within_reach and self.params.reach_max_m > 0:
-            m = prob * (((points - SHOULDER) @ n) <= self.params.reach_max_m)
+            m = prob * (((points - self.shoulder) @ n) <= self.params.reach_max_m)
             if m.sum() > 1e-12:
                 prob = m / m.sum()
         x = prob @ points
@@ -509,10 +536,8 @@ class EomBraceAgent:
         t = float(obs[_S["time"]][0])
         rot = obs[_S["eye_rot"]].reshape(3, 3)
         eye = obs[_S["eye_pos"]].copy()
-        hand = obs[_S["hand_pos"]].copy()
         if not self.started:
             self.started = True
-            self.home = np.array(p.hand_ready)
         self.poses.append((rot.copy(), eye.copy(), float(obs[_S["fixation"]][0])))
         self._pose_pairs.append((rot.copy(), eye.copy()))
         if len(self.poses) == self.delay_steps + 1:
@@ -536,6 +561,15 @@ class EomBraceAgent:
             for i in seen:
                 if i not in skip:
                     self._fuse(i, pos[i].copy(), r0, e0, f0)
+            if self.detected_at is None:  # the wall's side, from any sample's line of sight
+                for i in range(N):
+                    if vis[i] > 0.5 and float(pos[i] @ pos[i]) > 0.0:
+                        u = pos[i] if pos[i][0] > 0.0 else -pos[i]
+                        self._side_sum += float((r0 @ u)[1]) / max(float(np.linalg.norm(u)), 1e-12)
+                        self._side_n += 1
+                if self._side_n >= SIDE_SAMPLES and self._side_sum != 0.0:
+                    self._side_known = True
+                    self._set_side(1 if self._side_sum > 0.0 else -1)
         self._post = {}
 
         # --- detection: the CoP at the support polygon's edge (or a foot unloaded) ---------------------
@@ -561,9 +595,12 @@ class EomBraceAgent:
                 if float(u[0] * cop[0] + u[1] * cop[1]) > ext - p.cop_margin_m \
                         or min(cop[2], cop[3]) < p.unload_fraction:
                     self.detected_at = t
+                    self._set_side(1 if u[1] > 0.0 else -1)
                     self.normal = u
                     self.events.append((t, "detect"))
         n = self.normal
+        left = self.side > 0
+        hand = obs[_S["left_hand_pos" if left else "hand_pos"]].copy()
 
         # --- which cube, and the hand ------------------------------------------------------------------
         target = self.home
@@ -572,21 +609,21 @@ class EomBraceAgent:
         look_block = None
         known = [i for i in range(N) if self.w[i] > 0]
         search_look = False
-        if t >= p.look_latency_s - 1e-9:
+        if t >= p.look_latency_s - 1e-9 and self._side_known:
             k = int((t - p.look_latency_s + 1e-9) // p.scan_dwell_s)
             if p.depth_search and known and k >= len(p.scan_x_m) and self.detected_at is None:
                 look_at, look_block = self._search_look(known, t)
                 search_look = True
             elif p.scan_blocks <= 0:
-                look_at = np.array([p.scan_x_m[k % len(p.scan_x_m)], p.scan_y_m, p.scan_z_m])
+                look_at = self._m(np.array([p.scan_x_m[k % len(p.scan_x_m)], p.scan_y_m, p.scan_z_m]))
             elif k < len(p.scan_x_m) or not known:
                 k = min(k, len(p.scan_x_m) - 1)
-                look_at = np.array([p.scan_x_m[k], p.scan_y_m, p.scan_z_m])
+                look_at = self._m(np.array([p.scan_x_m[k], p.scan_y_m, p.scan_z_m]))
             else:
                 # Then fixate the believed cubes nearest the shoulder in turn (they are where the hand may
                 # go): a fixated cube is localised by the fovea, laterally and, verged on, in depth.
                 if self._scan_order is None or k != self._scan_k:
-                    faces = np.array([self.estimate(i) for i in known]) - SHOULDER
+                    faces = np.array([self.estimate(i) for i in known]) - self.shoulder
                     if p.wall_normal:
                         n = self._wall_normal(faces, n)
                         self._look_normal = n
@@ -602,18 +639,18 @@ class EomBraceAgent:
                     look_at = self._direction_cut(self._scan_target, n)
                 look_block = self._scan_target
         if self.detected_at is not None and known and t >= self.detected_at + p.reaction_latency_s - 1e-9:
-            hand_speed = float(np.linalg.norm(obs[_S["hand_vel"]]))
+            hand_speed = float(np.linalg.norm(obs[_S["left_hand_vel" if left else "hand_vel"]]))
             if self.hold is None:
                 # The nearest believed face to the line of the fall through the right shoulder.
-                faces = np.array([self.estimate(i) for i in known]) - SHOULDER
+                faces = np.array([self.estimate(i) for i in known]) - self.shoulder
                 depth = faces @ n
                 if p.choose_by_ray:
-                    faces = np.array([self._direction_cut(i, n) for i in known]) - SHOULDER
+                    faces = np.array([self._direction_cut(i, n) for i in known]) - self.shoulder
                 lateral = np.linalg.norm(faces - np.outer(faces @ n, n), axis=1)
                 if p.depth_search and p.reach_max_m > 0:
                     # The cubes believed within reach (the vergence search's posterior), the nearest to the
                     # fall line by the face believed given reach; none: the likeliest to be within reach.
-                    faces = np.array([self._depth_point(i, n, True) for i in known]) - SHOULDER
+                    faces = np.array([self._depth_point(i, n, True) for i in known]) - self.shoulder
                     lateral = np.linalg.norm(faces - np.outer(faces @ n, n), axis=1)
                     pr = np.array([self.posterior(i, n)[2] for i in known])
                     lateral = np.where(pr >= 0.5, lateral, np.inf) if np.any(pr >= 0.5) else lateral + 10.0 * (1 - pr)
@@ -728,7 +765,22 @@ class EomBraceAgent:
                 sample = obs[_S["block_pos"]].reshape(N, 3)[look_block]
                 if sample[0] > 0 and foveation.eccentricity(sample) < p.verge_ecc_deg * DEG:
                     fixation = float(np.linalg.norm(sample))
-        return encode(target, brace, gaze, fixation, head, self.gaze_range)
+        return encode(target, brace, gaze, fixation, head, self.gaze_range, left=left)
+
+    def _m(self, p: np.ndarray) -> np.ndarray:
+        """A point or direction given for the wall on the right, mirrored (y -> -y) when the wall is on the left."""
+        return p if self.side < 0 else np.array([p[0], -p[1], p[2]])
+
+    def _set_side(self, side: int) -> None:
+        """The wall's side (-1 right, +1 left): the shoulder, the hand's ready point and the expected normal."""
+        if side == self.side and self.home is not None:
+            return
+        self.side = side
+        self.shoulder = self._m(SHOULDER)
+        self.home = self._m(np.array(self.params.hand_ready, dtype=float))
+        if self.detected_at is None:
+            self.normal = self._m(np.array([0.0, -1.0, 0.0]))
+            self._look_normal = self.normal.copy()
 
     def _search_look(self, known: list, t: float):
         """depth_search before the push: the cube to fixate and where (its most probable face: the gaze goes along
@@ -737,8 +789,8 @@ class EomBraceAgent:
         until each is known within reach or beyond; then the nearest believed within reach is kept."""
         p = self.params
         yaw = p.search_yaw_deg * DEG
-        n0 = np.array([math.sin(yaw), -math.cos(yaw), 0.0])
-        cuts = np.array([self._direction_cut(i, n0) for i in known]) - SHOULDER
+        n0 = self._m(np.array([math.sin(yaw), -math.cos(yaw), 0.0]))
+        cuts = np.array([self._direction_cut(i, n0) for i in known]) - self.shoulder
         lateral = np.linalg.norm(cuts - np.outer(cuts @ n0, n0), axis=1)
         order = [known[j] for j in np.argsort(lateral)][:max(p.search_blocks, 1)]
         reach = {i: self.posterior(i, n0)[2] for i in order}

@@ -1,7 +1,8 @@
 """The standing body of PushRecovery (Eom et al. 2019, section 7): a body that can fall.
 
 The walker's legs and pelvis on a **free joint** (``envs_assets/push.xml``), the seated body's waist
-(3-DOF torso joints) and 7-DOF right arm with its palm, and the shared head and eye. It stands on the
+(3-DOF torso joints), 7-DOF right arm with its palm and that arm mirrored as the left, and the shared head
+and eye. It stands on the
 floor through real foot-floor contact; the legs hold a fixed stance through position servos (their
 gains: ``envs_assets/README.md``, PushRecovery), so a push that carries the centre of mass past the
 feet's edge tips it over: nothing keeps it upright but its feet and, if it puts it there, its hand.
@@ -12,8 +13,13 @@ holding the body up.
 
 Actions: ``hand_target`` (3 values in [-1, 1] onto :data:`HAND_WORKSPACE`, stance frame) that the seated
 body's damped-least-squares controller (:mod:`visuomotor_gym.control.hand`) turns into waist and arm
-setpoints on the floating base, then ``brace`` (1 value): the arm's stiffness, from relaxed (-1:
-:data:`RELAXED_STIFFNESS` of the servos' gain) to braced (+1: the full gain of the seated arm's servos).
+setpoints on the floating base, then ``brace`` (1 value): the arms' stiffness, from relaxed (-1:
+:data:`RELAXED_STIFFNESS` of the servos' gain) to braced (+1: the full gain of the seated arm's servos), then
+``arm`` (1 value, since PushRecovery's eighth pass): which arm the hand target drives, <= 0 the right, > 0 the left
+(the sign of the stance frame's y on that side). The left arm is the right one mirrored (``l_`` names), driven
+by the same controller mirrored; the idle arm returns to hang at the side (:data:`REST_POSTURE_DEG`), and the
+arm taking over starts its reference where its hand is. At reset the right arm is active (in the ready posture)
+and the left one hangs. The target stays in the stance frame (world axes) whichever arm moves.
 
 Observations are in the **stance frame** (:data:`STANCE_FRAME`): origin at the pelvis's start (0, 0,
 0.93 m), axes of the world (x forward, y left, z up); the body does not walk, so the frame stays put
@@ -42,7 +48,14 @@ ROOT_JOINT = "root"
 FLOOR_GEOM = "floor"
 FEET_GEOMS = ("left_foot", "right_foot")
 SOLE_SITES = ("left_sole", "right_sole")
-HAND_GEOMS = ("palm", "forearm")  # the hand and the forearm that carries it (see the task: a brace)
+HAND_GEOMS = ("palm", "forearm", "l_palm", "l_forearm")  # each hand and the forearm that carries it (a brace)
+# The left arm (PushRecovery's eighth pass): the right arm mirrored across the sagittal plane, its names prefixed "l_"
+# (envs_assets/push.xml; the mirrored joints keep the right arm's angle meanings and ranges).
+LEFT_PREFIX = "l_"
+LEFT_ARM_JOINTS = tuple(LEFT_PREFIX + n for n in names.ARM_JOINTS)
+LEFT_ARM_ACTUATORS = LEFT_ARM_JOINTS
+LEFT_HAND = LEFT_PREFIX + names.HAND
+LEFT_PALM_CENTER = LEFT_PREFIX + names.PALM_CENTER
 LEG_JOINTS = ("left_hip_roll", "left_hip_pitch", "left_knee", "left_ankle_pitch", "left_ankle_roll",
               "right_hip_roll", "right_hip_pitch", "right_knee", "right_ankle_pitch", "right_ankle_roll")
 LEG_ACTUATORS = LEG_JOINTS
@@ -57,8 +70,9 @@ STANCE_HIP_ROLL_RAD = 0.08
 STANCE_ANKLE_PITCH_RAD = 0.03
 STANCE_RAD = (STANCE_HIP_ROLL_RAD, 0.0, 0.0, STANCE_ANKLE_PITCH_RAD, -STANCE_HIP_ROLL_RAD,
               -STANCE_HIP_ROLL_RAD, 0.0, 0.0, STANCE_ANKLE_PITCH_RAD, STANCE_HIP_ROLL_RAD)
-# The automatic postural response of the legs: OFF in the definition (every gain 0; the third pass of
-# PushRecovery's passes measured it, docs/reproductions/eom.md, "Tried in the third pass"). When on, each control step the
+# The automatic postural response of the legs: the ankle strategy is ON in the definition since the fourth pass
+# of PushRecovery (it stops the slow forward or backward topple once the hand has reversed the sideways fall; the
+# hip strategies stay off: docs/reproductions/eom.md, third and fourth passes). Each control step the
 # leg servos' setpoints are the stance plus offsets driven by the extrapolated centre of mass
 # (XCoM = x + v / omega0, Hof, Gazendam & Sinke 2005, J Biomech 38:1) seen POSTURAL_LATENCY_S earlier:
 # sagittally an ankle strategy (ankle pitch) and a hip strategy (hip pitch: the trunk bends to move the
@@ -75,7 +89,7 @@ POSTURE_REF_X_M = 0.05  # the CoM's x in quiet stance (measured: 4.9 cm ahead of
 POSTURE_DEAD_ZONE_M = 0.02  # within 2 cm the stiff stance alone holds (modelling choice)
 HIP_STRATEGY_GAIN = 0.0  # rad of hip pitch per m of XCoM error; 4 tried (modelling choice)
 HIP_STRATEGY_MAX_RAD = 0.5  # modelling choice
-ANKLE_STRATEGY_GAIN = 0.0  # rad of ankle pitch per m; 1 tried (modelling choice)
+ANKLE_STRATEGY_GAIN = 1.0  # rad of ankle pitch per m (modelling choice; 1 and 2 measured alike, seeds 0-79)
 ANKLE_STRATEGY_MAX_RAD = 0.15  # modelling choice
 HIP_ROLL_GAIN = 0.0  # rad of hip roll per m of lateral XCoM; 2 tried (modelling choice)
 HIP_ROLL_MAX_RAD = 0.3  # modelling choice
@@ -92,11 +106,12 @@ BLOCKS = tuple(f"block_{i}" for i in range(N_BLOCKS))
 SCENE_CAMERA = "scene_camera"
 FRONT_CAMERA = "front_camera"
 ALL_NAMES = {
-    "body": (PELVIS, names.TORSO, names.HEAD, names.HAND, *BLOCKS),
-    "joint": (ROOT_JOINT, *LEG_JOINTS, *names.BODY_JOINTS, *names.NECK_JOINTS, names.GRASP),
-    "actuator": (*LEG_ACTUATORS, *names.BODY_ACTUATORS, *names.NECK_ACTUATORS, names.GRASP_ACTUATOR),
+    "body": (PELVIS, names.TORSO, names.HEAD, names.HAND, LEFT_HAND, *BLOCKS),
+    "joint": (ROOT_JOINT, *LEG_JOINTS, *names.BODY_JOINTS, *LEFT_ARM_JOINTS, *names.NECK_JOINTS, names.GRASP),
+    "actuator": (*LEG_ACTUATORS, *names.BODY_ACTUATORS, *LEFT_ARM_ACTUATORS, *names.NECK_ACTUATORS,
+                 names.GRASP_ACTUATOR),
     "geom": (FLOOR_GEOM, *FEET_GEOMS, *HAND_GEOMS, *BLOCKS),
-    "site": (*SOLE_SITES, names.PALM_CENTER),
+    "site": (*SOLE_SITES, names.PALM_CENTER, LEFT_PALM_CENTER),
     "camera": (SCENE_CAMERA, FRONT_CAMERA, names.EYE_CAMERA),
 }
 
@@ -104,13 +119,20 @@ ALL_NAMES = {
 # proportions), axes of the world. A test checks it against the compiled model.
 STANCE_ORIGIN = np.array([0.0, 0.0, 0.93])
 STANCE_FRAME = FixedFrame(STANCE_ORIGIN)
-# Hand workspace of the hand_target action (stance frame, min/max, metres). Modelling choice: the right
-# arm's reach (upper arm 0.29 m + forearm 0.265 m + hand) from the right shoulder (0, -0.2, 0.4) with the
-# waist's help, and a body that leans up to ~30 deg toward a wall on its right.
-HAND_WORKSPACE = np.array([[-0.5, 0.7], [-1.1, 0.3], [-0.5, 0.9]])
+# Hand workspace of the hand_target action (stance frame, min/max, metres). Modelling choice: an arm's reach
+# (upper arm 0.29 m + forearm 0.265 m + hand) from its shoulder (0, -+0.2, 0.4) with the waist's help, and a body
+# that leans up to ~30 deg toward a wall on its side: y from -1.1 (the right arm's far reach) to 1.1 (the left
+# arm's, mirrored; 0.3 before the left arm: the right arm's reach across the body).
+HAND_WORKSPACE = np.array([[-0.5, 0.7], [-1.1, 1.1], [-0.5, 0.9]])
 # Ready posture at reset (degrees): the seated body's (hand in front of the belly), modelling choice.
 READY_POSTURE_DEG = {"shoulder_flex": 30.0, "shoulder_abd": 10.0, "shoulder_rot": 0.0, "elbow": 80.0,
                      "forearm_rot": 0.0, "wrist_flex": 0.0, "wrist_dev": 0.0}
+# The idle arm's posture (degrees; the mirrored joints of the left arm take the same angles): hanging at the side,
+# slightly abducted, as the fixed left arm of the one-armed body (modelling choice).
+REST_POSTURE_DEG = {"shoulder_flex": 0.0, "shoulder_abd": 5.0, "shoulder_rot": 0.0, "elbow": 0.0,
+                    "forearm_rot": 0.0, "wrist_flex": 0.0, "wrist_dev": 0.0}
+# ... to which an idle arm returns, its setpoints closing the gap with this time constant (s; modelling choice).
+IDLE_RETURN_S = 0.2
 # The hand controller of the standing body: the seated one's, with the waist weighted 0.05 instead of 0.35
 # (modelling choice: a standing person reaches with the arm; a waist that swings the trunk to move the
 # hand shifts the centre of mass over the heels' edge and tips the stance backward, as measured while
@@ -120,13 +142,20 @@ STANDING_HAND_PARAMS = HandControlParams(torso_weight=0.05)
 # carry the body's weight; modelling choice: a co-contraction command, stiffness rising with it).
 RELAXED_STIFFNESS = 0.15
 BRACED_JOINTS = ("shoulder_flex", "shoulder_abd", "shoulder_rot", "elbow")
+# The brace command sets both arms' stiffness (one co-contraction command; the idle arm returns to hang at the side).
+BRACED_ACTUATORS = BRACED_JOINTS + tuple(LEFT_PREFIX + n for n in BRACED_JOINTS)
 
 STANDING_BLOCKS = (
     Block("body_qpos", 10, "rad", "waist (yaw, pitch, roll) and arm (7) joint angles"),
     Block("body_qvel", 10, "rad/s", "waist and arm joint velocities"),
-    Block("hand_pos", 3, "m", "palm-centre position, stance frame"),
-    Block("hand_vel", 3, "m/s", "palm-centre velocity, stance frame"),
+    Block("hand_pos", 3, "m", "right palm-centre position, stance frame"),
+    Block("hand_vel", 3, "m/s", "right palm-centre velocity, stance frame"),
     Block("brace", 1, "0..1", "arm stiffness: 0 relaxed, 1 braced"),
+    Block("left_arm_qpos", 7, "rad", "left arm joint angles (the right arm's, mirrored)"),
+    Block("left_arm_qvel", 7, "rad/s", "left arm joint velocities"),
+    Block("left_hand_pos", 3, "m", "left palm-centre position, stance frame"),
+    Block("left_hand_vel", 3, "m/s", "left palm-centre velocity, stance frame"),
+    Block("arm", 1, "0/1", "the arm the hand target drives: 0 right, 1 left"),
     Block("vestibular", 8, "rad, rad/s, m/s",
           "trunk (pelvis) tilt: roll and pitch; its angular velocity (roll, pitch, yaw rates); pelvis linear "
           "velocity (x, y, z): the semicircular canals' and otoliths' signal of a push"),
@@ -142,8 +171,8 @@ class StandingBody(Body):
     frame = STANCE_FRAME
     observation_blocks = STANDING_BLOCKS
     trace_step_fields = ("hand_pos", "pelvis_pos", "cop")
-    action_structure = {"hand_target": 3, "brace": 1}  # noqa: RUF012  (read only)
-    n_action = 4
+    action_structure = {"hand_target": 3, "brace": 1, "arm": 1}  # noqa: RUF012  (read only)
+    n_action = 5
 
     def __init__(self, model: mujoco.MjModel, hand_params: HandControlParams, dt: float) -> None:
         m = model
@@ -169,7 +198,7 @@ class StandingBody(Body):
         self._actadr = np.array([m.actuator_actadr[a] for a in body_act])
         self._leg_act = np.array([aid(n) for n in LEG_ACTUATORS])
         self._leg_q = np.array([m.jnt_qposadr[jid(n)] for n in LEG_JOINTS])
-        self._braced = np.array([aid(n) for n in BRACED_JOINTS])
+        self._braced = np.array([aid(n) for n in BRACED_ACTUATORS])
         self._gain = m.actuator_gainprm[self._braced, 0].copy()
         self._grasp_act = aid(names.GRASP_ACTUATOR)
         root = jid(ROOT_JOINT)
@@ -186,9 +215,24 @@ class StandingBody(Body):
         self.floor_geom = gid(FLOOR_GEOM)
         self.weight = float(m.body_subtreemass[self.pelvis]) * 9.81
         self.ready = np.array([0.0, 0.0, 0.0] + [READY_POSTURE_DEG[n] * DEG for n in names.ARM_JOINTS])
+        self.rest = np.array([0.0, 0.0, 0.0] + [REST_POSTURE_DEG[n] * DEG for n in names.ARM_JOINTS])
         self.hand_params = hand_params
         self.hand = HandController(m, self.catch_site, self._dof, self._qpos, self.joint_range, self.ready,
                                    n_torso=len(names.TORSO_JOINTS), params=hand_params)
+        # The left arm: the same controller on the waist and the left arm (the waist is driven by the active arm).
+        left_j = [jid(n) for n in (*names.TORSO_JOINTS, *LEFT_ARM_JOINTS)]
+        self._l_qpos = np.array([m.jnt_qposadr[j] for j in left_j])
+        self._l_dof = np.array([m.jnt_dofadr[j] for j in left_j])
+        left_act = [aid(n) for n in (*names.TORSO_JOINTS, *LEFT_ARM_ACTUATORS)]
+        self._l_act = np.array(left_act)
+        self._l_actadr = np.array([m.actuator_actadr[a] for a in left_act])
+        self._l_arm_act = self._l_act[len(names.TORSO_JOINTS):]
+        self._r_arm_act = self._act[len(names.TORSO_JOINTS):]
+        self.left_site = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, LEFT_PALM_CENTER)
+        self.left_hand = HandController(m, self.left_site, self._l_dof, self._l_qpos, m.jnt_range[left_j].copy(),
+                                        self.ready, n_torso=len(names.TORSO_JOINTS), params=hand_params)
+        self.arm = 0  # the active arm: 0 right, 1 left (the action's "arm" block)
+        self._left_prev = (0.0, 0.0, 0.0)
         ws_lo = HAND_WORKSPACE[:, 0] + STANCE_ORIGIN
         ws_half = 0.5 * (HAND_WORKSPACE[:, 1] - HAND_WORKSPACE[:, 0])
         self._ws = (ws_lo, ws_half)
@@ -209,6 +253,9 @@ class StandingBody(Body):
         data.qpos[q + 3:q + 7] = (1.0, 0.0, 0.0, 0.0)
         data.qpos[self._qpos] = self.ready
         data.act[self._actadr] = self.ready
+        data.qpos[self._l_qpos] = self.ready  # both arms start in the ready posture (mirrored joints: same angles)
+        data.act[self._l_actadr] = self.ready
+        self.arm = 0
         data.ctrl[self._leg_act] = STANCE_RAD
         self._com_prev = None
         self._xcom.clear()
@@ -220,6 +267,8 @@ class StandingBody(Body):
         site = data.site_xpos[self.catch_site]
         self.hand.reset(site)
         self._hand_prev = tuple(site.tolist())
+        self.left_hand.reset(data.site_xpos[self.left_site])
+        self._left_prev = tuple(data.site_xpos[self.left_site].tolist())
         self._cop = self.centre_of_pressure(data)
 
     # --- control ------------------------------------------------------------------------------
@@ -236,10 +285,20 @@ class StandingBody(Body):
         d = data
         lo, half = self._ws
         target = lo + (a[:3] + 1.0) * half
-        self.hand.advance_reference(target, dt)
-        setpoint = d.act[self._actadr]
-        new_setpoint = self.hand.setpoints(d, setpoint)
-        d.ctrl[self._act] = (new_setpoint - setpoint) / dt  # MuJoCo clamps to ctrlrange: a rate limit
+        arm = 1 if al[4] > 0.0 else 0
+        if arm != self.arm:  # the other arm takes over: its reference starts where its hand is
+            self.arm = arm
+            (self.left_hand if arm else self.hand).reset(d.site_xpos[self.left_site if arm else self.catch_site])
+        if arm:
+            ctl, adr, act, idle = self.left_hand, self._l_actadr, self._l_act, self._r_arm_act
+        else:
+            ctl, adr, act, idle = self.hand, self._actadr, self._act, self._l_arm_act
+        ctl.advance_reference(target, dt)
+        setpoint = d.act[adr]
+        new_setpoint = ctl.setpoints(d, setpoint)
+        d.ctrl[act] = (new_setpoint - setpoint) / dt  # MuJoCo clamps to ctrlrange: a rate limit
+        idle_adr = self._l_actadr[3:] if not arm else self._actadr[3:]
+        d.ctrl[idle] = (self.rest[3:] - d.act[idle_adr]) / IDLE_RETURN_S  # the idle arm returns to hang at the side
         self._set_brace(0.5 * (al[3] + 1.0))
         d.ctrl[self._grasp_act] = 0.0
         d.ctrl[self._leg_act] = self._postural_response(d)  # the stance, and its automatic response
@@ -278,7 +337,8 @@ class StandingBody(Body):
 
     # --- state --------------------------------------------------------------------------------
     def hand_pos(self, data: mujoco.MjData) -> np.ndarray:
-        return data.site_xpos[self.catch_site]
+        """The active arm's palm centre (world)."""
+        return data.site_xpos[self.left_site if self.arm else self.catch_site]
 
     def head_height(self, data: mujoco.MjData) -> float:
         return float(data.xpos[self.head_body][2])
@@ -342,6 +402,12 @@ class StandingBody(Body):
         values += d.qvel[self._dof].tolist()
         values += (hx - ox, hy - oy, hz - oz, (hx - px) / dt, (hy - py) / dt, (hz - pz) / dt, self.brace_level)
         self._hand_prev = (hx, hy, hz)
+        values += d.qpos[self._l_qpos[len(names.TORSO_JOINTS):]].tolist()
+        values += d.qvel[self._l_dof[len(names.TORSO_JOINTS):]].tolist()
+        hx, hy, hz = d.site_xpos[self.left_site].tolist()
+        px, py, pz = self._left_prev
+        values += (hx - ox, hy - oy, hz - oz, (hx - px) / dt, (hy - py) / dt, (hz - pz) / dt, float(self.arm))
+        self._left_prev = (hx, hy, hz)
         r = d.xmat[self.pelvis]  # row-major world rotation of the pelvis
         roll = math.atan2(float(r[7]), float(r[8]))
         pitch = -math.asin(max(-1.0, min(1.0, float(r[6]))))
@@ -358,7 +424,8 @@ class StandingBody(Body):
 
     def info(self, data: mujoco.MjData) -> dict:
         cx, cy, fl, fr = self._cop
-        return {"hand_pos": data.site_xpos[self.catch_site].copy(),
+        return {"hand_pos": self.hand_pos(data).copy(),  # the active arm's
+                "arm": self.arm,
                 "pelvis_pos": data.xpos[self.pelvis].copy(),
                 "cop": np.array([cx, cy, fl + fr]),
                 "head_height": self.head_height(data)}

@@ -35,9 +35,10 @@ __all__ = ["PushRecoveryEnv", "push_observation"]
 
 REWARD_MODES = ("sparse", "shaped")
 # The family's eye: human peripheral vision, the four mechanisms of vision.foveation.HUMAN_PERIPHERY (human
-# field, position law E2 0.7 deg, crowding, depth pedestal 10 arcmin); see
-# docs/reproductions/gaze_default.md, "The human periphery, mechanism by mechanism".
-PUSH_VISION = human_periphery()
+# field, position law E2 0.7 deg, crowding, depth pedestal 10 arcmin) with the retinotopic positional disarray at
+# 0.8 (Hess & Field 1993; the suite's one eye); see docs/reproductions/gaze_default.md, "The human periphery,
+# mechanism by mechanism".
+PUSH_VISION = human_periphery(position_disarray=0.8)
 
 
 def push_observation():
@@ -50,27 +51,30 @@ class PushRecoveryEnv(VisuomotorEnv):
     ## Description
 
     A **standing body that can fall** (the walker's legs and pelvis on a free joint, standing on the
-    floor through real foot contact, the seated body's waist and 7-DOF right arm, the shared head and
-    cyclopean eye; ``envs_assets/push.xml``) stands beside a **wall of cube blocks** on its right (Eom et
-    al. 2019, section 7). Between 0.6 and 1.4 s after the start a **push** (a 150 ms horizontal force of
-    300-350 N on the torso, toward the wall within +-10 deg) tips it toward the wall: the legs hold their
-    stance through position servos but cannot stop the fall (a centre of mass carried past the feet's
-    edge falls). It stays upright only if its right hand lands on a cube and holds: **there is nothing
+    floor through real foot contact, the seated body's waist, its 7-DOF right arm and that arm mirrored as
+    the left, the shared head and cyclopean eye; ``envs_assets/push.xml``) stands beside a **wall of cube
+    blocks** (Eom et al. 2019, section 7) on its right or its left (drawn per episode, 50/50), the wall
+    turned 0-30 deg forward per episode. Between 0.6 and 1.4 s after the start
+    a **push** (a 150 ms horizontal force of 300-350 N on the torso, along the wall's normal within +-10 deg)
+    tips it toward the wall: the legs hold their stance through position servos with an automatic ankle
+    response to the extrapolated centre of mass, but cannot stop the fall (a centre of mass carried past the
+    feet's edge falls). It stays upright only if a hand lands on a cube and holds: **there is nothing
     behind or between the cubes**, so a hand that lands in a gap, slides off an edge or stops short of
     the wall does not hold. The wall's distance (0.60-0.80 m from the body's midline), each cube's size
     (14-22 cm), the gaps (12-30 cm), the cubes' heights (1.00-1.35 m) and how far each stands out of the
     wall (0-10 cm)
     are drawn per episode and reach the agent only as the eye's samples of the cubes' faces (foveated
     noise, field of view, saccadic suppression, delay): where the eye looks decides where the hand can go.
-    The eye has the **human periphery** (``vision.foveation.human_periphery()``: the human field, position
-    law E2 0.7 deg, crowding, depth pedestal 10 arcmin), as every family's.
+    The eye has the **human periphery** (``vision.foveation.human_periphery(position_disarray=0.8)``: the
+    human field, position law E2 0.7 deg, crowding, depth pedestal 10 arcmin, positional disarray 0.8), as
+    every family's.
 
     Physics 500 Hz, control 50 Hz. The observability ladder (Oracle, FullView, foveated, Delayed,
     PoorVision) is keyword arguments of this class (``visuomotor_gym.registration``).
 
     ## Action Space
 
-    ``Box(-1, 1, (9,), float32)``; ``env.unwrapped.action_structure`` gives the blocks. Finite values
+    ``Box(-1, 1, (10,), float32)``; ``env.unwrapped.action_structure`` gives the blocks. Finite values
     outside [-1, 1] are clipped; NaN, inf and wrong shapes raise.
 
     ACTION_TABLE
@@ -93,9 +97,9 @@ class PushRecoveryEnv(VisuomotorEnv):
     ## Starting State
 
     Standing still, legs straight, feet at shoulder width (sole centres 32 cm apart), the hand in front of the belly, looking straight
-    ahead (3 m away at 1.3 m height, with a 2 deg Gaussian jitter). ``info`` at reset: ``block_faces``
-    ((n, 3) true face centres), ``block_half_sizes``, ``push_time``, ``push_force``, ``push_dir``,
-    ``wall_distance`` (scoring only). The same seed gives the same wall and push on every rung.
+    ahead (3 m away at 1.3 m height, with a 2 deg Gaussian jitter); the right arm drives, the left hangs.
+    ``info`` at reset: ``block_faces`` ((n, 3) true face centres), ``block_half_sizes``, ``push_time``,
+    ``push_force``, ``push_dir``, ``wall_distance``, ``wall_side`` (-1 right, +1 left) (scoring only). The same seed gives the same wall and push on every rung.
 
     ## Episode End
 
@@ -116,6 +120,21 @@ class PushRecoveryEnv(VisuomotorEnv):
       best static posture of the eye (with eom_brace) held 72 % of the bodies upright under the former
       eye and holds 73.5 % under this one (verged at 0.5 m; eom_brace 82 % and 77.5 %). Former
       leaderboard entries are superseded.
+    * v0, redefined in place again (PushRecovery's fourth pass): the wall turned 0-30 deg forward per episode (the
+      cube the hand needs moves up to ~25 cm and ~30 deg of gaze), the stance's automatic ankle response on,
+      and the eye with the positional disarray at 0.8 (the suite's one eye). On the pinned seeds 0-199
+      eom_brace (its new defaults: the active hold, choice by direction) keeps 91 % upright (77.5 % before),
+      the Oracle rung 97.5 %; the best static posture searched on the design seeds holds 75 % (gaze gain
+      +16) and a posture picked by hand 86.5 % (docs/reproductions/eom.md). Former leaderboard entries are
+      superseded.
+    * v0, redefined in place again (PushRecovery's eighth pass): the wall (with its turn and the push) on the body's
+      right or left, 50/50 per episode (drawn last: a seed's left wall is its right wall mirrored), and a left
+      arm, the right one mirrored; the action gains the ``arm`` value (10 values), the observation the left
+      arm's joints, its palm and the active arm (113 values). No one posture of the eye sees both walls within
+      40 deg. On the pinned seeds 0-199 eom_brace keeps 90 % upright, the Oracle rung 97.5 %; the static
+      posture searched on the design seeds holds 46.5 % (gaze gain +43.5), the held twin 22.5 %; a posture
+      picked by hand toward the left wall 55 % (107 of the 200 walls are on the left; docs/reproductions/eom.md,
+      eighth pass). Former leaderboard entries are superseded.
     """
 
     render_cameras: ClassVar[dict[str, tuple[str, ...]]] = {
@@ -182,11 +201,12 @@ def _action_table() -> str:
     rows = [
         "| index | meaning |",
         "|---|---|",
-        f"| 0-2 | hand target (catch-site centre), stance frame, mapped from [-1, 1] to x in [{x0}, {x1}], y in [{y0}, {y1}], z in [{z0}, {z1}] m |",
-        f"| 3 | brace: arm stiffness, -1 relaxed ({sn.RELAXED_STIFFNESS:g} of the servo gain) ... 1 braced (full gain) |",
-        "| 4-5 | requested gaze change (azimuth, elevation) of the current eye frame, times ``gaze_action_range_deg`` |",
-        "| 6 | fixation (vergence) distance, log-mapped onto [0.1, 20] m |",
-        "| 7-8 | head target: neck yaw in [-80, 80] deg and pitch in [-50, 40] deg |",
+        f"| 0-2 | hand target (the active arm's palm centre), stance frame, mapped from [-1, 1] to x in [{x0}, {x1}], y in [{y0}, {y1}], z in [{z0}, {z1}] m |",
+        f"| 3 | brace: both arms' stiffness, -1 relaxed ({sn.RELAXED_STIFFNESS:g} of the servo gain) ... 1 braced (full gain) |",
+        "| 4 | arm: the hand target drives the right arm (<= 0) or the left arm (> 0); the idle arm hangs at the side |",
+        "| 5-6 | requested gaze change (azimuth, elevation) of the current eye frame, times ``gaze_action_range_deg`` |",
+        "| 7 | fixation (vergence) distance, log-mapped onto [0.1, 20] m |",
+        "| 8-9 | head target: neck yaw in [-80, 80] deg and pitch in [-50, 40] deg |",
     ]
     return "\n    ".join(rows)
 

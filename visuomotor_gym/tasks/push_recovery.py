@@ -2,8 +2,8 @@
 pushed toward it; it stays upright only if it puts its hand on a block.
 
 The scene (``envs_assets/push.xml``): a pool of :data:`~visuomotor_gym.body.standing.N_BLOCKS` cube
-blocks on mocap bodies, placed and resized per episode in a row beside the body's right side (the
-"wall of multiple cube blocks"): the wall's distance, each cube's size, the gaps between them, each
+blocks on mocap bodies, placed and resized per episode in a row beside the body's right side, or with
+:data:`WALL_SIDE_RANDOM` on half the episodes mirrored to its left (the "wall of multiple cube blocks"): the wall's distance, each cube's size, the gaps between them, each
 cube's height and how far it stands out of the wall plane are drawn from the episode's generator.
 There is nothing behind or between the cubes: a hand that lands in a gap or misses an edge goes
 through, and one that stops short touches nothing. Each cube is a
@@ -89,10 +89,18 @@ PUSH_FORCE_N = (300.0, 350.0)
 # sagittal margin, 10 cm behind the centre of mass to the heels, is the body's weak direction once braced).
 PUSH_AZIMUTH_DEG = 10.0
 # The wall's yaw, drawn per episode (deg; its normal turned forward from the body's right; the push follows
-# the normal): (0, 0) in the definition, no draw. PushRecovery's third pass tried 0..30, 30..60, -30..0 and
-# -10..35 so that the cube the hand needs is not always beside the shoulder (docs/reproductions/eom.md,
-# "Tried in the third pass"): the braced stance falls on forward and backward components (modelling choice).
-WALL_YAW_DEG = (0.0, 0.0)
+# the normal), drawn last. 0..30 so that the cube the hand needs is not always beside the shoulder: it moves up to
+# ~25 cm forward and ~30 deg of gaze azimuth (modelling choice). PushRecovery's fourth pass
+# (docs/reproductions/eom.md) measured the brace on the Oracle rung: 96 % at 0..30, 83.5 % at -20..45 (past ~35 deg
+# the next cubes stand in front of the falling chest; a wall turned backward lets the upper arm strike cube 0).
+# (0, 0): the wall beside the body, no draw (the definition before the fourth pass).
+WALL_YAW_DEG = (0.0, 30.0)
+# The wall on a random side (PushRecovery's eighth pass): per episode the wall, its cubes and the push are mirrored
+# across the body's sagittal plane (y -> -y) with probability 1/2, drawn after every other draw (so a seed's
+# wall is the same up to the side); the body braces with its left arm there. False: the wall on the right.
+# The two walls are 180 deg apart, so no one posture of the eye sees both within the foveated agents' trusted
+# eccentricity (modelling choice; docs/reproductions/eom.md, eighth pass).
+WALL_SIDE_RANDOM = True
 
 # --- the outcome -----------------------------------------------------------------------------------
 HOLD_S = 2.5  # upright this long after the push's onset: success (modelling choice; Eom's clip ~2-3 s)
@@ -195,8 +203,14 @@ class PushRecoveryTask(Task):
         self.gaze_offset = rng.normal(0.0, GAZE_JITTER_DEG * DEG, 2)
         # The wall's yaw: its normal turned forward from the body's right by yaw (0: beside the body).
         yaw = float(rng.uniform(*WALL_YAW_DEG)) * DEG if WALL_YAW_DEG[1] > WALL_YAW_DEG[0] else WALL_YAW_DEG[0] * DEG
+        # The side: -1 the right (y < 0), +1 the left, mirrored (drawn last, only with WALL_SIDE_RANDOM).
+        self.wall_side = (1 if rng.random() < 0.5 else -1) if WALL_SIDE_RANDOM else -1
+        mirror = self.wall_side > 0
+        if mirror:
+            yaw = -yaw  # the mirrored wall turns forward from the body's left
         self.wall_yaw = yaw
-        normal = np.array([math.sin(yaw), -math.cos(yaw), 0.0])  # from the body toward the wall
+        sgn = 1.0 if mirror else -1.0
+        normal = np.array([-sgn * math.sin(yaw), sgn * math.cos(yaw), 0.0])  # from the body toward the wall
         along = np.array([math.cos(yaw), math.sin(yaw), 0.0])  # along the wall, forward at yaw 0
         self.wall_normal = normal
         quat = (math.cos(0.5 * yaw), 0.0, 0.0, math.sin(0.5 * yaw))
@@ -225,6 +239,8 @@ class PushRecoveryTask(Task):
         self.block_faces = np.array(faces)
         self.block_half_sizes = np.array(sizes)
         self.clutter_faces = self._place_clutter(rng, rows, wall, along, normal) if self.clutter else np.zeros((0, 3))
+        if mirror:
+            az = -az  # the push mirrored too: a seed's left wall is its right wall's mirror image
         c, sn_ = math.cos(az), math.sin(az)
         self.push_dir = np.array([c * normal[0] - sn_ * normal[1], sn_ * normal[0] + c * normal[1], 0.0])
         data.xfrc_applied[:] = 0.0
@@ -278,7 +294,7 @@ class PushRecoveryTask(Task):
     def trace_episode_fields(self) -> dict:
         return {"block_faces": self.block_faces.copy(), "block_half_sizes": self.block_half_sizes.copy(),
                 "push_time": self.push_time, "push_force": self.push_force, "push_dir": self.push_dir.copy(),
-                "wall_distance": self.wall_distance}
+                "wall_distance": self.wall_distance, "wall_side": self.wall_side}
 
     @staticmethod
     def trace_final_fields(info: dict) -> dict:

@@ -19,7 +19,7 @@ rng = np.random.default_rng(0)
 env.reset(seed=0)
 n = 0
 t0 = time.perf_counter()
-a = np.zeros(9, np.float32)
+a = np.zeros(env.action_space.shape[0], np.float32)
 while n < 3000:
     _o, _r, term, trunc, _i = env.step(a)
     n += 1
@@ -42,7 +42,7 @@ steps, episodes, bad = 0, 0, 0
 warn0 = 0
 env.reset(seed=10_000)
 while steps < limit:
-    obs, _r, term, trunc, info = env.step(rng.uniform(-1, 1, 9).astype(np.float32))
+    obs, _r, term, trunc, info = env.step(rng.uniform(-1, 1, env.action_space.shape[0]).astype(np.float32))
     steps += 1
     if not np.all(np.isfinite(obs)) or info["physics_diverged"]:
         bad += 1
