@@ -271,6 +271,12 @@ REGISTERED_BEFORE_THE_RECORDS = (
     ('SteppingStones-v0', 'stones:SteppingStonesEnv', {}, 1000, 'stones'),
     ('SteppingStonesDelayed-v0', 'stones:SteppingStonesEnv', {'visual_delay_s': 0.1}, 1000, 'stones'),
     ('SteppingStonesPoorVision-v0', 'stones:SteppingStonesEnv', {'vision_noise_scale': 2.0}, 1000, 'stones'),
+    # The first family added on the records: its ids follow from its record alone.
+    ('PushRecoveryOracle-v0', 'push:PushRecoveryEnv', {'vision': 'oracle'}, 200, 'push'),
+    ('PushRecoveryFullView-v0', 'push:PushRecoveryEnv', {'vision': 'full_view'}, 200, 'push'),
+    ('PushRecovery-v0', 'push:PushRecoveryEnv', {}, 200, 'push'),
+    ('PushRecoveryDelayed-v0', 'push:PushRecoveryEnv', {'visual_delay_s': 0.1}, 200, 'push'),
+    ('PushRecoveryPoorVision-v0', 'push:PushRecoveryEnv', {'vision_noise_scale': 2.0}, 200, 'push'),
 )
 
 

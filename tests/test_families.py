@@ -61,6 +61,8 @@ DOCUMENTED_CONSTANTS: tuple[tuple[str, str, tuple[str, ...] | None, str], ...] =
     ("stones", r"stone_\d+\[0\]|stones_left\[0\]", None,
      ("course index / stones left change only once a stone is stepped on; random footsteps fall first "
       "(tests/test_stepping_stones.py steps on stones)")),
+    ("push", r"block_age\[0\]", None, "the age of the visual samples is the rung's visual latency"),
+    ("push", r"block_visible\[\d\]", ("oracle", "full_view"), "every cube is seen without a field-of-view limit"),
     ("catch", r"balls_caught\[[01]\]|holding\[0\]", None,
      "touch blocks change only on a catch, which random actions do not make (tests/test_two_balls.py)"),
 )

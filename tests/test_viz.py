@@ -217,6 +217,8 @@ FAMILY_EPISODES = {
     "stones": ("SteppingStones-v0", "lookahead", 200, ("Top view", "Gaze over time", "Which stone")),
     "dodge": ("ObstacleDodge-v0", "fajen_warren", 250, ("Top view", "Gaze over time", "each pedestrian",
                                                         "distance to each pedestrian")),
+    "push": ("PushRecovery-v0", "eom_brace", 200, ("The wall seen from the body", "Gaze over time",
+                                                  "Hand and centre of pressure")),
 }
 
 

@@ -498,3 +498,15 @@ def _lookahead(env_id, action_dim, seed, **kw):
 register_agent("lookahead", _lookahead,
                "stones family: fixates the stone two steps ahead from the swing start (Patla & Vickers 2003, "
                "Eom 7), fused percepts, footsteps onto the believed stones")
+
+
+def _eom_brace(env_id, action_dim, seed, **kw):
+    from visuomotor_gym.baselines.eom_brace import EomBraceAgent
+
+    return EomBraceAgent.for_env(env_id, **kw)
+
+
+# Push family. Its gaze-blind twin is ``gaze_blind:eom_brace`` (gaze, vergence and head held).
+register_agent("eom_brace", _eom_brace,
+               "push family: detects the CoP at the support polygon's edge, saccades to the nearest believed cube "
+               "and keeps gaze on it while the hand braces there (Eom et al. 2019, section 7)")

@@ -19,6 +19,7 @@ FAMILY_MODULES = (
     "visuomotor_gym.envs.reach",
     "visuomotor_gym.envs.dodge",
     "visuomotor_gym.envs.stones",
+    "visuomotor_gym.envs.push",
 )
 
 
