@@ -134,7 +134,10 @@ class PushRecoveryEnv(VisuomotorEnv):
       40 deg. On the pinned seeds 0-199 eom_brace keeps 90 % upright, the Oracle rung 97.5 %; the static
       posture searched on the design seeds holds 46.5 % (gaze gain +43.5), the held twin 22.5 %; a posture
       picked by hand toward the left wall 55 % (107 of the 200 walls are on the left; docs/reproductions/eom.md,
-      eighth pass). Former leaderboard entries are superseded.
+      eighth pass). Former leaderboard entries are superseded. With the one eye's lateral noise drawn as an
+      angle (``human_periphery()``'s ``angular_lateral_noise``, on for every family): eom_brace 91.0 %, the
+      held twin 23.5 %, the searched posture 46.0 %, the hand-picked posture toward the left wall 54.0 %, kept
+      as the static twin (gaze gain +37.0; +45.0 against the searched posture).
     """
 
     render_cameras: ClassVar[dict[str, tuple[str, ...]]] = {
