@@ -15,7 +15,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-FOVEATED_IDS = ("EyeCatch-v0", "ShelfReach-v0", "ObstacleWalk-v0", "SteppingStones-v0", "ObstacleDodge-v0")
+FOVEATED_IDS = ("EyeCatch-v0", "ShelfReach-v0", "ObstacleWalk-v0", "SteppingStones-v0", "ObstacleDodge-v0",
+                "PushRecovery-v0")
 
 
 def table(folder: Path, ids=FOVEATED_IDS) -> str:
