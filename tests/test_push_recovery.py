@@ -469,7 +469,7 @@ def test_a_sample_put_behind_the_eye_is_kept_as_a_negative_distance():
     assert signed == pytest.approx(-0.4) and ecc == pytest.approx(0.0)
 
 
-SEED_BACK = 3
+SEED_BACK = 2  # seeds 2 and 5 of 0-5 show it under the one eye (angular lateral noise); 3 did before
 
 
 def test_the_vergence_search_holds_on_a_back_row_where_the_fifth_pass_agent_falls(monkeypatch):

@@ -138,8 +138,8 @@ def test_every_registered_id_has_hyperparameters_and_the_non_catch_ones_play_fre
         assert config["belief"] is False and config["hand_action"] == "absolute", env_id
         shaping = config["env_kwargs"]
         assert "catch" not in json.dumps(shaping), env_id  # the catch family's reward is not merged in
-        if env_id.startswith("ShelfReach"):
-            assert shaping["reward"] == "shaped"
+        if env_id.startswith(("ShelfReach", "PushRecovery")):
+            assert shaping["reward"] == "shaped"  # the env's own shaped terms
         else:
             assert shaping["reward_weights"]["progress"] > 0  # the named training-only progress term
         gym.make(env_id, **shaping).close()  # the env accepts its training kwargs
