@@ -6,9 +6,10 @@ only, with the parts of every family's figure (:mod:`visuomotor_gym.viz.family_p
   the faces, coloured by time, saccade onsets ringed;
 * **gaze over time**: the angle between the line of sight and each cube's face centre (the nearest one
   to the line of sight in black), saccade onsets dotted, the push's onset dashed;
-* **hand and centre of pressure**: the hand's distance to the nearest face, and the centre of
-  pressure's lateral position with the right foot's outer edge (-0.205 m: the stance of
-  ``body.standing``), hand contacts shaded.
+* **hand and centre of pressure**: the active hand's distance to the nearest face, and the centre of
+  pressure's lateral position with the outer edge of the foot on the wall's side (the right foot's at
+  -0.205 m, the stance of ``body.standing``; the left foot's at +0.205 m for a wall on the left), hand
+  contacts shaded.
 """
 
 from __future__ import annotations
@@ -34,6 +35,8 @@ def push_figure(trace):
     push_t = float(task["push_time"])
     touching = np.asarray(task.get("hand_on_block", np.zeros(len(t), bool)), dtype=bool)
     cop = np.asarray(task.get("cop", np.zeros((len(t), 3))), dtype=float)
+    left = int(task.get("wall_side", -1)) > 0  # the wall (and the push) on the body's left
+    edge, foot = (-RIGHT_FOOT_EDGE_M, "left") if left else (RIGHT_FOOT_EDGE_M, "right")
 
     fig = _new_figure((15, 10))
     grid = fig.add_gridspec(2, 2, width_ratios=(1.1, 1.0))
@@ -76,7 +79,7 @@ def push_figure(trace):
     d = np.linalg.norm(hand[:, None, :] - faces[None, :, :], axis=2).min(axis=1)
     bal.plot(t, 100 * d, color=HAND_COLOR, label="hand to nearest face (cm)")
     bal.plot(t, 100 * cop[:, 1], color="tab:purple", label="centre of pressure y (cm)")
-    bal.axhline(100 * RIGHT_FOOT_EDGE_M, color="tab:purple", ls=":", label="right foot's outer edge")
+    bal.axhline(100 * edge, color="tab:purple", ls=":", label=f"{foot} foot's outer edge")
     for i in np.flatnonzero(touching):
         bal.axvspan(t[i] - float(trace.dt), t[i], color="tab:green", alpha=0.2, lw=0)
     bal.axvline(push_t, color="k", ls="--")
