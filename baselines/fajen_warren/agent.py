@@ -197,11 +197,10 @@ def group_prior(env_id: str) -> dict:
     import gymnasium as gym
 
     from visuomotor_gym.core import args
-    from visuomotor_gym.tasks.obstacle_dodge import DEFAULT_CROWD, CrowdDistribution, crowd_preset
+    from visuomotor_gym.tasks.obstacle_dodge import CrowdDistribution, crowd_preset
 
     kw = gym.spec(env_id).kwargs or {}
-    given = kw.get("crowd_distribution")  # None: the env's default crowd, as ObstacleDodgeEnv reads it
-    dist = args.coerce(CrowdDistribution, crowd_preset(DEFAULT_CROWD if given is None else given), "crowd_distribution")
+    dist = args.coerce(CrowdDistribution, crowd_preset(kw.get("crowd_distribution")), "crowd_distribution")
     if not dist.groups:
         return {}
     return {"companion_m": 0.5 * (dist.group_spacing_m[0] + dist.group_spacing_m[1]),

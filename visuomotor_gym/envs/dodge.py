@@ -20,7 +20,6 @@ from visuomotor_gym.core.head import HEAD_BLOCKS
 from visuomotor_gym.core.observation import ObservationLayout
 from visuomotor_gym.envs.walk import WalkerEnv
 from visuomotor_gym.tasks.obstacle_dodge import (
-    DEFAULT_CROWD,
     DEFAULT_REWARD_WEIGHTS,
     PERCEPT_BLOCKS,
     REWARD_TERMS,
@@ -168,8 +167,7 @@ class ObstacleDodgeEnv(WalkerEnv):
         crowd_distribution: CrowdDistribution | dict | str | None = None,
         **shared: Any,
     ):
-        preset = crowd_preset(DEFAULT_CROWD if crowd_distribution is None else crowd_distribution)
-        self.crowd_distribution = args.coerce(CrowdDistribution, preset, "crowd_distribution")
+        self.crowd_distribution = args.coerce(CrowdDistribution, crowd_preset(crowd_distribution), "crowd_distribution")
         super().__init__(render_mode, **shared)
 
     def _build_task(self, body: DodgeBody) -> ObstacleDodgeTask:

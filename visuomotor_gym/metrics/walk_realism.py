@@ -144,6 +144,13 @@ def _gaze_hits(eye: np.ndarray, gaze: np.ndarray, z: float) -> np.ndarray:
     return eye[:, :2] + s[:, None] * gaze[:, :2]
 
 
+def _holds(points: np.ndarray, dt: float) -> np.ndarray:
+    """(T,) rows whose point (``_gaze_hits``) moved slower than ``STABLE_GAZE_M_S`` since the previous row
+    (False on the first row and where the point is undefined)."""
+    speed = np.r_[np.inf, np.linalg.norm(np.diff(points, axis=0), axis=1) / dt]
+    return np.nan_to_num(speed, nan=np.inf) <= STABLE_GAZE_M_S
+
+
 def _frame(trace):
     """(obstacles, to_path) of a trace: on the winding walkway (the trace's ``path``) the obstacles in path
     coordinates (s along the centre line, n across it) and a map of (T, 2) world points into them; else the
@@ -187,10 +194,10 @@ def obstacle_shares(trace) -> tuple[float, float]:
     for ob in obstacles:
         near, far = ob[0] - 0.5 * ob[2], ob[0] + 0.5 * ob[2]
         hits = _gaze_hits(eye, gaze, ob[4])
-        speed = np.r_[np.inf, np.linalg.norm(np.diff(hits, axis=0), axis=1) / dt]
+        holds = _holds(hits, dt)
         if to_path is not None:
             hits = to_path(hits)
-        on = _on(hits, ob, ON_OBSTACLE_M) & (np.nan_to_num(speed, nan=np.inf) <= STABLE_GAZE_M_S)
+        on = _on(hits, ob, ON_OBSTACLE_M) & holds
         a = (px >= near - APPROACH_START_M) & (px < near - CROSSING_M)
         c = (px >= near - CROSSING_M) & (px <= far + CROSSING_M)
         looked = False
@@ -221,19 +228,18 @@ def on_walkway(trace) -> np.ndarray:
     return out
 
 
-def path_fixation_share(trace) -> float:
-    """Share of the resting rows whose gaze is on the walkway ahead (:func:`on_walkway`)."""
-    return strategy.fixation_share(trace, on_walkway(trace))
+def path_fixation_share(trace, walkway: np.ndarray | None = None) -> float:
+    """Share of the resting rows whose gaze is on the walkway ahead (:func:`on_walkway`, or ``walkway``
+    when the caller has it)."""
+    return strategy.fixation_share(trace, on_walkway(trace) if walkway is None else walkway)
 
 
-def ground_fixation_share(trace) -> float:
-    """Share of the resting rows with gaze on the walkway ahead (:func:`on_walkway`) whose floor point holds
-    (moves slower than ``STABLE_GAZE_M_S`` since the previous row)."""
+def ground_fixation_share(trace, walkway: np.ndarray | None = None) -> float:
+    """Share of the resting rows with gaze on the walkway ahead (:func:`on_walkway`, or ``walkway`` when the
+    caller has it) whose floor point holds (moves slower than ``STABLE_GAZE_M_S`` since the previous row)."""
     eye, gaze = np.asarray(trace.eye_pos, dtype=float), np.asarray(trace.gaze_dir, dtype=float)
-    ground = _gaze_hits(eye, gaze, 0.0)
-    speed = np.r_[np.inf, np.linalg.norm(np.diff(ground, axis=0), axis=1) / float(trace.dt)]
-    holds = np.nan_to_num(speed, nan=np.inf) <= STABLE_GAZE_M_S
-    return strategy.fixation_share(trace, holds, rows=on_walkway(trace))
+    holds = _holds(_gaze_hits(eye, gaze, 0.0), float(trace.dt))
+    return strategy.fixation_share(trace, holds, rows=on_walkway(trace) if walkway is None else walkway)
 
 
 def travel_fixation_distance(trace) -> float:
@@ -260,13 +266,14 @@ def gaze_below_horizon(trace) -> float:
 
 def episode_measures(trace) -> dict[str, float]:
     share, crossing = obstacle_shares(trace)
+    walkway = on_walkway(trace)  # once: on the winding walkway it maps every row into path coordinates
     return {
         "saccade_rate_hz": strategy.saccade_rate(trace),
         "fixation_duration_s": strategy.fixation_duration(trace),
         "obstacle_fixation_share": share,
         "fixation_while_crossing": crossing,
-        "ground_fixation_share": ground_fixation_share(trace),
-        "path_fixation_share": path_fixation_share(trace),
+        "ground_fixation_share": ground_fixation_share(trace, walkway),
+        "path_fixation_share": path_fixation_share(trace, walkway),
         "travel_fixation_distance_m": travel_fixation_distance(trace),
         "gaze_below_horizon_deg": gaze_below_horizon(trace),
     }

@@ -105,9 +105,11 @@ CROWD_RULES = {
 }
 
 
-def crowd_preset(value) -> CrowdDistribution | dict | None:
+def crowd_preset(value) -> CrowdDistribution | dict:
     """``value`` itself, or the :data:`CROWD_PRESETS` entry it names (a ``ValueError`` naming the presets
-    for an unknown name)."""
+    for an unknown name); ``None`` names :data:`DEFAULT_CROWD`, the env's default crowd."""
+    if value is None:
+        value = DEFAULT_CROWD
     if isinstance(value, str):
         if value not in CROWD_PRESETS:
             raise ValueError(f"crowd_distribution: unknown preset {value!r}; presets: {sorted(CROWD_PRESETS)}, "
