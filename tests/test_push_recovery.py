@@ -633,3 +633,52 @@ def test_eom_brace_finds_the_wall_s_side_before_the_push(monkeypatch):
         action, _ = agent.predict(obs)
         obs, *_ = env.step(action)
     assert agent.side == 1 and agent._side_known and action[4] > 0
+
+
+# --- no hidden truth: the wall's side is seen, not given ---------------------------------------------------
+PERCEPT_KEYS = ("block_pos", "block_visible", "block_age")
+
+
+def _first_left_seed():
+    for seed in range(20):
+        env = gym.make(ENV)
+        env.reset(seed=seed)
+        left = env.unwrapped.task.wall_side > 0
+        env.close()
+        if left:
+            return seed
+    raise AssertionError("no left wall in seeds 0-19")
+
+
+@pytest.mark.parametrize("vision", ["foveated", "oracle"])
+def test_no_observation_leak_of_the_wall_before_the_push(monkeypatch, vision):
+    """The same seed with its wall on the left and (WALL_SIDE_RANDOM off, drawn last) on the right: until the
+    push, every block but the cube percepts is identical, and a cube percept is non-zero only on a step
+    that produced a sample of it (so the side and the faces are known only through the eye). On both rungs
+    the percepts themselves do differ (the foveated eye sees the cubes in its field before the push; the
+    Oracle rung sees the true faces), so the comparison is not vacuous."""
+    seed = _first_left_seed()
+    a = gym.make(ENV, vision=vision, obs_mode="dict")
+    oa, _ = a.reset(seed=seed)
+    monkeypatch.setattr(pr, "WALL_SIDE_RANDOM", False)
+    b = gym.make(ENV, vision=vision, obs_mode="dict")
+    ob, _ = b.reset(seed=seed)
+    assert a.unwrapped.task.wall_side > 0 > b.unwrapped.task.wall_side
+    push = a.unwrapped.task.push_time
+    assert b.unwrapped.task.push_time == push
+    zero = np.zeros(a.action_space.shape, dtype=np.float32)  # gaze held, hand at its ready point
+    percepts_differ = False
+    while a.unwrapped.data.time + a.unwrapped.dt < push:
+        for key in oa:
+            if key in PERCEPT_KEYS:
+                percepts_differ |= not np.array_equal(oa[key], ob[key])
+            else:
+                np.testing.assert_array_equal(oa[key], ob[key], err_msg=key)
+        for o in (oa, ob):
+            unseen = np.repeat(o["block_visible"] < 0.5, 3)
+            assert not np.any(o["block_pos"][unseen]), "a cube percept without a sample"
+        oa, *_ = a.step(zero)
+        ob, *_ = b.step(zero)
+    assert percepts_differ  # the two walls are seen differently (both rungs see them before the push)
+    a.close()
+    b.close()
