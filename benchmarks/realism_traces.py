@@ -113,7 +113,8 @@ def family_reference(env_id: str) -> dict:
 
         return load_reference()
     module, name = {"reach": ("reach_realism", "REACH_REFERENCE"), "walk": ("walk_realism", "WALK_REFERENCE"),
-                    "stones": ("stones_realism", "STONES_REFERENCE"), "dodge": ("dodge_realism", "DODGE_REFERENCE")}[family]
+                    "stones": ("stones_realism", "STONES_REFERENCE"), "dodge": ("dodge_realism", "DODGE_REFERENCE"),
+                    "push": ("push_realism", "PUSH_REFERENCE")}[family]
     import importlib
 
     return getattr(importlib.import_module(f"visuomotor_gym.metrics.{module}"), name)
