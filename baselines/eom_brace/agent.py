@@ -55,8 +55,8 @@ from visuomotor_gym.baselines.crowding import crowded
 from visuomotor_gym.body import standing as sn
 from visuomotor_gym.core.head import neck_range_deg
 from visuomotor_gym.core.observation import ObservationLayout
+from visuomotor_gym.envs.actions import eye_head_action
 from visuomotor_gym.envs.push import push_observation
-from visuomotor_gym.oculomotor.plant import OculomotorParams
 from visuomotor_gym.registration import env_vision
 from visuomotor_gym.vision import foveation
 from visuomotor_gym.vision.foveation import VisionParams
@@ -65,8 +65,6 @@ DEG = math.pi / 180.0
 _LAYOUT = ObservationLayout(push_observation())
 _S = _LAYOUT.slices
 _NECK = neck_range_deg()
-_FIX = OculomotorParams().fixation_range_m
-_LOG_FIX = (math.log(_FIX[0]), math.log(_FIX[1]))
 N = sn.N_BLOCKS
 SHOULDER = np.array([0.0, -0.2, 0.4])  # right shoulder, stance frame (envs_assets/push.xml: upper_arm)
 # The wall's side (PushRecovery's eighth pass: tasks.push_recovery.WALL_SIDE_RANDOM): every right-side constant below
@@ -256,15 +254,7 @@ def encode(hand_target, brace: float, gaze, fixation_m, head, gaze_range: float,
     a[:3] = sn.hand_target_action(np.asarray(hand_target) + sn.STANCE_ORIGIN)
     a[3] = brace
     a[4] = 1.0 if left else -1.0
-    a[5] = np.clip(gaze[0] / gaze_range, -1.0, 1.0)
-    a[6] = np.clip(gaze[1] / gaze_range, -1.0, 1.0)
-    if fixation_m is not None:
-        lo, hi = _LOG_FIX
-        a[7] = np.clip(2.0 * (math.log(max(fixation_m, 1e-3)) - lo) / (hi - lo) - 1.0, -1.0, 1.0)
-    for k in range(2):
-        lo_h, hi_h = _NECK[k]
-        h = math.degrees(float(head[k]))
-        a[8 + k] = np.clip(h / hi_h if h >= 0 else -h / lo_h, -1.0, 1.0)
+    a[5:10] = eye_head_action(gaze, fixation_m, head, gaze_range)
     return a
 
 

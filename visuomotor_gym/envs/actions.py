@@ -17,6 +17,23 @@ _FIX = OculomotorParams().fixation_range_m
 _LOG_FIX = (math.log(_FIX[0]), math.log(_FIX[1]))
 
 
+def eye_head_action(gaze, fixation_m: float | None, head, gaze_range_rad: float) -> np.ndarray:
+    """The gaze (2), fixation (1) and head (2) blocks every body shares, as the env maps them back: gaze change
+    (retinal azimuth, elevation; rad) over the gaze action range, fixation distance log-mapped onto the plant's
+    range (None keeps the neutral 0), neck (yaw, pitch; rad) onto [-1, 1] of each joint's range."""
+    a = np.zeros(5, dtype=np.float32)
+    a[0] = np.clip(gaze[0] / gaze_range_rad, -1.0, 1.0)
+    a[1] = np.clip(gaze[1] / gaze_range_rad, -1.0, 1.0)
+    if fixation_m is not None:
+        lo_f, hi_f = _LOG_FIX
+        a[2] = np.clip(2.0 * (math.log(max(fixation_m, 1e-3)) - lo_f) / (hi_f - lo_f) - 1.0, -1.0, 1.0)
+    for k in range(2):
+        lo_h, hi_h = NECK_RANGE_DEG[k]
+        h = math.degrees(float(head[k]))
+        a[3 + k] = np.clip(h / hi_h if h >= 0 else -h / lo_h, -1.0, 1.0)
+    return a
+
+
 def hand_target_action(hand_target_world) -> np.ndarray:
     """The hand-target block (3 values in [-1, 1]) of a ``control="hand"`` action for a world point
     (clipped to the hand workspace)."""
@@ -37,13 +54,5 @@ def hand_action(
     a = np.zeros(9, dtype=np.float32)
     a[:3] = hand_target_action(hand_target_world)
     a[3] = 1.0 if grasp_closed else -1.0
-    a[4] = np.clip(gaze[0] / gaze_range_rad, -1.0, 1.0)
-    a[5] = np.clip(gaze[1] / gaze_range_rad, -1.0, 1.0)
-    if fixation_m is not None:
-        lo_f, hi_f = _LOG_FIX
-        a[6] = np.clip(2.0 * (math.log(max(fixation_m, 1e-3)) - lo_f) / (hi_f - lo_f) - 1.0, -1.0, 1.0)
-    for k in range(2):
-        lo_h, hi_h = NECK_RANGE_DEG[k]
-        h = math.degrees(float(head[k]))
-        a[7 + k] = np.clip(h / hi_h if h >= 0 else -h / lo_h, -1.0, 1.0)
+    a[4:9] = eye_head_action(gaze, fixation_m, head, gaze_range_rad)
     return a
