@@ -34,6 +34,10 @@ def test_names_are_registered_and_parse():
     assert parse_agent_spec("gaze_blind:eyecatch") == ("gaze_blind", {"base": "eyecatch"})
     assert parse_agent_spec("gaze_blind:eyecatch:update_period_s=0.3") == (
         "gaze_blind", {"base": "eyecatch:update_period_s=0.3"})
+    assert parse_agent_spec("fajen_warren:search_azimuths_deg=45;70,speed=1") == (
+        "fajen_warren", {"search_azimuths_deg": (45, 70), "speed": 1})
+    assert parse_agent_spec("fajen_warren:los_hypotheses_std=-1.5;") == (
+        "fajen_warren", {"los_hypotheses_std": (-1.5,)})
     assert is_deterministic("fixed_gaze") and is_deterministic("gaze_blind:belief_mpc")
     assert not is_deterministic("gaze_blind:random")
     with pytest.raises(ValueError, match="wraps another agent"):

@@ -7,6 +7,7 @@ reward terms, memory) run for every rung in tests/test_families.py."""
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import math
 from types import SimpleNamespace
 
@@ -248,6 +249,46 @@ def test_fajen_warren_holds_a_dodge_under_way_when_no_change_can_show_in_time():
     agent.command = (-math.radians(18.0), 0.7)
     course, speed = agent._evade((0.0, 0.0, 0.0), (0.9, 0.0))
     assert (course, speed) == (-math.radians(18.0), 0.7)
+
+
+def test_depth_hypotheses_lie_on_the_line_of_sight_with_the_bearing_rate_kept():
+    """Hand-computed: a pedestrian estimated 4 m straight left of the walker (at the origin, walking +x at
+    1.3 m/s), at rest, with a 2 m std along the line of sight (the y axis) and 0.1 m across. With
+    ``los_hypotheses_std=(-1.5, -0.75)`` the hypotheses are the mean moved 3 m and 1.5 m toward the walker
+    (y = 1 and 2.5 m); the bearing rate relative to the walker, -1.3 m/s / 4 m, is kept, so the velocity
+    across the line (x) becomes 1.3 - 1.3 * r/4: 0.975 at r = 1, 0.4875 at r = 2.5. Below the std
+    threshold there are none."""
+    agent = _agent_with_pedestrian(0.0, 4.0, 0.0, 0.0)
+    agent.params = dataclasses.replace(agent.params, los_hypotheses_std=(-1.5, -0.75))
+    f = agent.filters[0]
+    f.P = np.diag([0.1 ** 2, 2.0 ** 2, 0.01, 0.01])
+    hyp = agent._hypotheses(f, 0.0, 0.0, 1.3, 0.0)
+    assert hyp[0] == (0.0, 4.0, 0.0, 0.0)
+    np.testing.assert_allclose(hyp[1:], [(0.0, 1.0, 0.975, 0.0), (0.0, 2.5, 0.4875, 0.0)], atol=1e-12)
+    f.P = np.diag([2.0 ** 2, 0.2 ** 2, 0.01, 0.01])  # uncertain across the line only: the depth is known
+    assert agent._hypotheses(f, 0.0, 0.0, 1.3, 0.0) == [(0.0, 4.0, 0.0, 0.0)]
+
+
+def test_a_near_pedestrian_placed_far_in_depth_is_a_threat_only_with_the_hypotheses():
+    """A pedestrian whose mean lies 2 m ahead and 7 m to the left, walking toward the path at 1.3 m/s,
+    with a 3 m std along the line of sight: at its mean it passes 3.5 m from the walker (no threat, no
+    change of course or speed: beyond the evasion's 2.5 m margin); 1.5 stds nearer (2.8 m away, its
+    bearing rate kept) it would pass within 0.6 m about 1.7 s later. With the hypotheses the agent counts
+    it as a threat and leaves the nominal course or speed."""
+    agent = _agent_with_pedestrian(2.0, 7.0, 0.0, -1.3)
+    f = agent.filters[0]
+    u = np.array([2.0, 7.0]) / math.hypot(2.0, 7.0)
+    f.P = np.zeros((4, 4))
+    f.P[:2, :2] = 3.0 ** 2 * np.outer(u, u) + 0.05 ** 2 * np.eye(2)
+    f.P[2:, 2:] = 0.01 * np.eye(2)
+    (_, _, dmin_mean, _, _), = agent._threats((0.0, 0.0, 0.0))
+    assert dmin_mean > agent.params.avoid_distance_m
+    assert agent._evade((0.0, 0.0, 0.0), (1.3, 0.0)) == (0.0, 1.3)
+    agent.params = dataclasses.replace(agent.params, los_hypotheses_std=(-1.5, -0.75))
+    (_, _, dmin_worst, _, relevant), = agent._threats((0.0, 0.0, 0.0))
+    assert relevant and dmin_worst < agent.params.avoid_distance_m
+    agent.command = None
+    assert agent._evade((0.0, 0.0, 0.0), (1.3, 0.0)) != (0.0, 1.3)
 
 
 def test_speed_action_spans_the_gaits_steps_with_zero_at_the_nominal_speed():

@@ -104,7 +104,8 @@ class PolicyFileNotFound(FileNotFoundError, PolicyFileError):
 
 def parse_agent_spec(spec: str) -> tuple[str, dict[str, Any]]:
     """``"eyecatch:alpha=1,beta=x"`` -> ``("eyecatch", {"alpha": 1, "beta": "x"})``;
-    ``"ppo:runs/a=b/model.zip"`` -> ``("ppo", {"path": "runs/a=b/model.zip"})`` (:data:`PATH_AGENTS`)."""
+    ``"ppo:runs/a=b/model.zip"`` -> ``("ppo", {"path": "runs/a=b/model.zip"})`` (:data:`PATH_AGENTS`);
+    a value with semicolons is a tuple: ``"fajen_warren:search_azimuths_deg=45;70"``."""
     if not isinstance(spec, str):
         raise ValueError(f"an agent spec is a string such as 'eyecatch', got {spec!r}")
     name, colon, rest = spec.partition(":")
@@ -142,6 +143,8 @@ def _parse_overrides(text: str, spec: str) -> dict[str, Any]:
 
 
 def _parse_value(text: str) -> Any:
+    if ";" in text:  # "search_azimuths_deg=45;70": a tuple (a comma separates overrides)
+        return tuple(_parse_value(v.strip()) for v in text.split(";") if v.strip())
     for cast in (int, float):
         try:
             return cast(text)

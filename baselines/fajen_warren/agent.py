@@ -189,6 +189,21 @@ class FajenWarrenParams:
     notice_s: float = 0.15
     # ... and the risk counts the position estimate's std too, this many s per m (modelling choice)
     pos_std_weight: float = 1.0
+    # Depth hypotheses along the line of sight (ObstacleDodge-v0's fourth agent; () = before it): a pedestrian
+    # seen only in the periphery is placed well in direction and poorly in depth (the human periphery's depth
+    # law: a few metres of std at 40-100 deg off a far fixation), so its mean can lie metres behind a
+    # pedestrian about to cut across the walker's path. While the estimate's std along the line of sight
+    # exceeds ``los_std_min_m``, the agent also considers the pedestrian at the mean's distance plus each of
+    # these multiples of that std (nearer ones first; never nearer than ``los_min_distance_m``), with the
+    # lateral velocity its bearing rate then implies: the threat test, the evasion and the choice of fixation
+    # take the most dangerous one, so the eye goes to a near, badly placed pedestrian and the fovea settles
+    # its distance. Humans treat an unresolved peripheral object as a possible obstacle and fixate it before
+    # they pass it (Jovancevic, Sullivan & Hayhoe 2006: fixations on pedestrians on a collision course);
+    # the multiples and thresholds are modelling choices (sweep: docs/reproductions/data/terrain/dodge_groups.md).
+    los_hypotheses_std: tuple = ()
+    los_hypotheses_evade: bool = True  # False: the hypotheses choose the fixation only (not the steering, evasion)
+    los_std_min_m: float = 0.3
+    los_min_distance_m: float = 0.5
 
 
 def group_prior(env_id: str) -> dict:
@@ -301,7 +316,10 @@ class FajenWarrenAgent:
     """See the module docstring. ``predict(obs) -> (action, state)`` on flat ObstacleDodge observations."""
 
     def __init__(self, params: FajenWarrenParams | None = None) -> None:
-        self.params = p = params or FajenWarrenParams()
+        p = params or FajenWarrenParams()
+        if not isinstance(p.los_hypotheses_std, tuple):  # "los_hypotheses_std=-1" in a spec: one multiple
+            p = replace(p, los_hypotheses_std=tuple(np.atleast_1d(np.asarray(p.los_hypotheses_std, float)).tolist()))
+        self.params = p
         self.vision = VisionParams(noise_scale=p.vision_noise_scale, foveated=p.foveated)
         self.delay_steps = round(p.visual_delay_s / p.control_dt)
         self.gaze_range = p.gaze_action_range_deg * DEG
@@ -386,7 +404,7 @@ class FajenWarrenAgent:
         goal = (odo[0] + c * ol[g0] - s * ol[g0 + 1], odo[1] + s * ol[g0] + c * ol[g0 + 1])
         self._odo = (odo[0], odo[1], odo[2])
         threats = self._threats(odo)
-        self._steer(odo, goal, threats)
+        self._steer(odo, goal, threats if p.los_hypotheses_evade else self._threats(odo, hypotheses=False))
         v0 = _S["pelvis"].start
         course, speed = self._evade(odo, (ol[v0 + 1], ol[v0 + 2]))
         action = np.zeros(7, dtype=np.float32)
@@ -442,9 +460,10 @@ class FajenWarrenAgent:
             self.filters[k].update(t, z, R, self.params.accel_std,
                                    self.params.velocity_prior_std if self.vision.periphery_on else None)
 
-    def _threats(self, odo) -> list[tuple]:
+    def _threats(self, odo, hypotheses: bool = True) -> list[tuple]:
         """Per known pedestrian: (slot, closest-approach time, predicted closest distance, its position
-        then, whether it is still ahead or approaching)."""
+        then, whether it is still ahead or approaching); of its most dangerous depth hypothesis unless
+        ``hypotheses`` is False (the mean only)."""
         p = self.params
         wx, wy = odo[0], odo[1]
         wvx, wvy = p.speed * math.cos(self.phi), p.speed * math.sin(self.phi)
@@ -452,13 +471,45 @@ class FajenWarrenAgent:
         for k, f in enumerate(self.filters):
             if not f.known:
                 continue
-            x, y, vx, vy = f.x.tolist()
-            rx, ry, ux, uy = x - wx, y - wy, vx - wvx, vy - wvy
-            w2 = ux * ux + uy * uy
-            tca = min(max(-(rx * ux + ry * uy) / w2, 0.0), p.horizon_s) if w2 > 1e-9 else 0.0
-            dmin = math.hypot(rx + ux * tca, ry + uy * tca)
-            relevant = tca > 0.0 or rx > -0.5
-            out.append((k, tca, dmin, (x + vx * tca, y + vy * tca), relevant))
+            worst = None
+            for x, y, vx, vy in (self._hypotheses(f, wx, wy, wvx, wvy) if hypotheses else [tuple(f.x.tolist())]):
+                rx, ry, ux, uy = x - wx, y - wy, vx - wvx, vy - wvy
+                w2 = ux * ux + uy * uy
+                tca = min(max(-(rx * ux + ry * uy) / w2, 0.0), p.horizon_s) if w2 > 1e-9 else 0.0
+                dmin = math.hypot(rx + ux * tca, ry + uy * tca)
+                relevant = tca > 0.0 or rx > -0.5
+                if worst is None or (relevant, -dmin) > (worst[4], -worst[2]):
+                    worst = (k, tca, dmin, (x + vx * tca, y + vy * tca), relevant)
+            out.append(worst)
+        return out
+
+    def _hypotheses(self, f: PedestrianFilter, wx: float, wy: float, wvx: float, wvy: float) -> list:
+        """The states (x, y, vx, vy) the agent considers for the pedestrian of ``f``: its mean first, then
+        (``los_hypotheses_std``, while the std along the line of sight from the walker exceeds
+        ``los_std_min_m``) the mean moved along that line by each multiple of the std, its velocity across
+        the line rescaled so that the bearing rate relative to the walker (moving at ``wvx, wvy``) stays
+        the estimated one."""
+        p = self.params
+        x, y, vx, vy = f.x.tolist()
+        out = [(x, y, vx, vy)]
+        if not p.los_hypotheses_std:
+            return out
+        rx, ry = x - wx, y - wy
+        r = math.hypot(rx, ry)
+        if r < 1e-6:
+            return out
+        ux, uy = rx / r, ry / r
+        sd = math.sqrt(max(ux * ux * f.P[0, 0] + 2.0 * ux * uy * f.P[0, 1] + uy * uy * f.P[1, 1], 0.0))
+        if sd <= p.los_std_min_m:
+            return out
+        nx, ny = -uy, ux
+        v_along = vx * ux + vy * uy
+        rel_across = (vx - wvx) * nx + (vy - wvy) * ny
+        w_across = wvx * nx + wvy * ny
+        for n in p.los_hypotheses_std:
+            r2 = max(r + n * sd, p.los_min_distance_m)
+            across = w_across + rel_across * r2 / r
+            out.append((wx + ux * r2, wy + uy * r2, v_along * ux + across * nx, v_along * uy + across * ny))
         return out
 
     def _steer(self, odo, goal, threats) -> None:
@@ -543,7 +594,13 @@ class FajenWarrenAgent:
         """The pedestrians' predicted positions at ``tau`` (N', T, 2): each at its estimated velocity, and
         for one whose velocity changed lately (a veer?) also the ``veer_return_s`` hypotheses."""
         p = self.params
-        peds = np.array([f.x for f in known] + [c for c, _ in self._companions()]).reshape(-1, 4)  # (N, 4)
+        peds = [f.x for f in known]
+        if p.los_hypotheses_std and p.los_hypotheses_evade:  # the depth hypotheses of the pedestrians placed poorly along the line of sight
+            wx, wy = self._odo[0], self._odo[1]
+            wvx, wvy = p.speed * math.cos(self.phi), p.speed * math.sin(self.phi)
+            for f in known:
+                peds += [np.array(h) for h in self._hypotheses(f, wx, wy, wvx, wvy)[1:]]
+        peds = np.array(peds + [c for c, _ in self._companions()]).reshape(-1, 4)  # (N, 4)
         tracks = [peds[:, None, :2] + tau[None, :, None] * peds[:, None, 2:]]
         if p.veer_return_s and self.poses:
             t = self.poses[-1][4]
