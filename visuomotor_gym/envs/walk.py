@@ -317,5 +317,5 @@ FAMILY = Family(
     doc_links=(("Iwao et al.: gaze while walking over obstacles", "reproductions/iwao.md"),
                ("PPO baselines (the walk recipe)", "baselines/ppo.md")),
     doc_pictures=(("images/obstaclewalk_iwao_seed0_frame.png",
-                   "The iwao agent on ObstacleWalk-v0: side view with the line of sight, and its eye camera"),),
+                   "The iwao agent on the winding walkway: its line of sight on a floor hazard, and its eye camera"),),
 )
