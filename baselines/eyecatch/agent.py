@@ -368,22 +368,18 @@ class EyecatchAgent:
             raise ValueError(f"EyecatchAgent expects the flat EyeCatch observation of size {ObservationLayout().size}")
         return self._act(obs), state
 
-    def _act(self, obs: np.ndarray) -> np.ndarray:
-        p = self.params
-        t = float(obs[_S["time"]][0])
+    def perceive(self, obs: np.ndarray) -> None:
+        """One step of this agent's perception only (the filter's prediction and the fusion of the step's sample,
+        with the pose and look histories), as :meth:`_act` does it: for an agent that plans on this belief."""
         rot = obs[_S["eye_rot"]].reshape(3, 3)
         eye = obs[_S["eye_pos"]] + SEAT_ORIGIN
-        hand = obs[_S["hand_pos"]] + SEAT_ORIGIN
         if not self.started:
             self.started = True
             wanted = RetinalBiasFilter if self._models_disarray else BallKalmanFilter
             if type(self.filter) is not wanted:  # the eye is known now (match_vision sets it after __init__)
                 self.filter = wanted(self.dt, self.kalman_params)
-            self.hand = _Superposition(hand)
-            self.head = _Superposition(obs[_S["head_qpos"]])
-        self.t = t
-
-        # --- perception: predict, then fuse the (possibly delayed) visual sample --------------
+        self.t = float(obs[_S["time"]][0])
+        # predict, then fuse the (possibly delayed) visual sample
         if self.filter.initialised:
             self.filter.predict()
         self.pose_history.append((rot.copy(), eye.copy()))
@@ -395,6 +391,17 @@ class EyecatchAgent:
         if obs[_S["ball_visible"]][0] > 0.5:
             self._fuse(obs)
         self.prev_gaze = rot[:, 0].copy()
+
+    def _act(self, obs: np.ndarray) -> np.ndarray:
+        p = self.params
+        t = float(obs[_S["time"]][0])
+        rot = obs[_S["eye_rot"]].reshape(3, 3)
+        eye = obs[_S["eye_pos"]] + SEAT_ORIGIN
+        hand = obs[_S["hand_pos"]] + SEAT_ORIGIN
+        if not self.started:
+            self.hand = _Superposition(hand)
+            self.head = _Superposition(obs[_S["head_qpos"]])
+        self.perceive(obs)
         if not self.filter.initialised:
             return self._action(hand, obs, gaze=(0.0, 0.0), head=obs[_S["head_qpos"]])
         # The filter runs at the sample time; the present is delay_steps ahead of it.
