@@ -856,6 +856,8 @@ def test_belief_mpc_params_round_trip_every_family(env_id):
 
     reference = make_agent("belief_mpc", env_id, gym.make(env_id).action_space.shape[0])
     assert type(agent) is type(reference) and agent.params == reference.params
+    if env_id == "EyeCatch-v0":  # the loaded planner builds the same Eyecatch perception as the spec's
+        assert agent._eyecatch_perception(1) is not None and reference._eyecatch_perception(1) is not None
 
 
 def test_belief_mpc_params_reject_a_malformed_tuple():

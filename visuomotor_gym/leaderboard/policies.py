@@ -286,6 +286,7 @@ def _belief_mpc_load(data: bytes, env_id: str) -> Policy:
     if vision:
         return agent_cls(params, vision=env_vision_params(env_id))
     agent = agent_cls(params)
+    agent.env_id = env_id  # as for_env sets it (the catch planner builds its Eyecatch perception for this id)
     from visuomotor_gym.families import family_for
 
     if family_for(env_id).belief_mpc.env_vision:
