@@ -488,3 +488,31 @@ def test_experiment_measures_on_a_recorded_two_ball_episode():
     assert gaze["both_in_flight_steps"] > 0
     assert gaze["on_ball1"] + gaze["on_ball2"] + gaze["on_neither"] == pytest.approx(1.0)
     assert len(ep["sigma"]) == len(ep["time"]) - 1 and len(ep["sigma"][0]) == 2
+
+
+def test_one_ball_belief_under_the_one_eye_is_the_eyecatch_perception():
+    """On EyeCatch-v0 (the human periphery, one ball) the planner's real update is the Eyecatch agent's
+    perception: fed the same observations, a standalone Eyecatch agent's ``perceive`` gives the planner's
+    belief bit for bit; with ``eyecatch_perception=false`` (or two balls) the planner keeps its own update."""
+    import gymnasium as gym
+
+    env = gym.make("EyeCatch-v0")
+    n = env.action_space.shape[0]
+    agent = make_agent("belief_mpc", "EyeCatch-v0", n)
+    own = make_agent("belief_mpc:eyecatch_perception=false", "EyeCatch-v0", n)
+    eyes = make_agent("eyecatch", "EyeCatch-v0", n)
+    obs, _ = env.reset(seed=3)
+    for policy in (agent, own, eyes):
+        policy.reset()
+    for _ in range(30):
+        action, _ = agent.predict(obs, deterministic=True)
+        own.predict(obs, deterministic=True)
+        eyes.perceive(np.asarray(obs, dtype=float))  # as predict() converts it
+        obs, *_ = env.step(action)
+    assert agent._eyes is not None and agent.balls[0].filter is agent._eyes.filter
+    assert eyes.filter.initialised
+    np.testing.assert_array_equal(agent.balls[0].filter.x, eyes.filter.x)
+    np.testing.assert_array_equal(agent.balls[0].filter.P, eyes.filter.P)
+    assert own._eyes is None and not np.array_equal(own.balls[0].filter.x, eyes.filter.x)
+    two = make_agent("belief_mpc", "EyeCatchTwoBalls-v0", n)
+    assert two._eyecatch_perception(2) is None
