@@ -267,6 +267,8 @@ def test_depth_hypotheses_lie_on_the_line_of_sight_with_the_bearing_rate_kept():
     np.testing.assert_allclose(hyp[1:], [(0.0, 1.0, 0.975, 0.0), (0.0, 2.5, 0.4875, 0.0)], atol=1e-12)
     f.P = np.diag([2.0 ** 2, 0.2 ** 2, 0.01, 0.01])  # uncertain across the line only: the depth is known
     assert agent._hypotheses(f, 0.0, 0.0, 1.3, 0.0) == [(0.0, 4.0, 0.0, 0.0)]
+    with pytest.raises(ValueError, match="los_hypotheses_std must be a tuple"):
+        make_agent("fajen_warren:los_hypotheses_std=-1", "ObstacleDodge-v0", 7)
 
 
 def test_a_near_pedestrian_placed_far_in_depth_is_a_threat_only_with_the_hypotheses():

@@ -182,6 +182,7 @@ class BeliefMPCAgent:
         self.params = params or BeliefMPCParams()
         p = self.params
         self.dt = float(dt)
+        self.env_id: str | None = None  # the registered id (for_env and the leaderboard loader set it)
         self.vision = VisionParams(noise_scale=p.vision_noise_scale, foveated=p.foveated)
         self.noise = ObservationNoise.from_vision(self.vision, eps_deg=p.fovea_smoothing_deg,
                                                   angular=p.angular_uncertainty)
@@ -211,12 +212,11 @@ class BeliefMPCAgent:
     def _eyecatch_perception(self, n_balls: int):
         """The Eyecatch agent whose perception is the one ball's real update (``eyecatch_perception``; one ball,
         the human periphery, an agent made by :meth:`for_env`), with this agent's eye; None otherwise."""
-        env_id = getattr(self, "env_id", None)
-        if not (self.params.eyecatch_perception and n_balls == 1 and env_id and getattr(self.vision, "periphery_on", False)):
+        if not (self.params.eyecatch_perception and n_balls == 1 and self.env_id and self.vision.periphery_on):
             return None
         from visuomotor_gym.baselines.eyecatch import EyecatchAgent
 
-        eyes = EyecatchAgent.for_env(env_id)
+        eyes = EyecatchAgent.for_env(self.env_id)
         eyes.vision = self.vision
         return eyes
 

@@ -317,8 +317,9 @@ class FajenWarrenAgent:
 
     def __init__(self, params: FajenWarrenParams | None = None) -> None:
         p = params or FajenWarrenParams()
-        if not isinstance(p.los_hypotheses_std, tuple):  # "los_hypotheses_std=-1" in a spec: one multiple
-            p = replace(p, los_hypotheses_std=tuple(np.atleast_1d(np.asarray(p.los_hypotheses_std, float)).tolist()))
+        if not isinstance(p.los_hypotheses_std, tuple):
+            raise ValueError(f"los_hypotheses_std must be a tuple of std multiples (in a spec: "
+                             f"los_hypotheses_std=-1.5;-0.75, or -1; for one), got {p.los_hypotheses_std!r}")
         self.params = p
         self.vision = VisionParams(noise_scale=p.vision_noise_scale, foveated=p.foveated)
         self.delay_steps = round(p.visual_delay_s / p.control_dt)
