@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 import scipy.linalg
 from visuomotor_gym.baselines.belief_mpc import BeliefMPCAgent, BeliefMPCParams, ilqr
+from visuomotor_gym.baselines.belief_mpc.agent import _LAYOUTS
 from visuomotor_gym.baselines.belief_mpc.belief import (
     ObservationNoise,
     belief_step,
@@ -516,3 +517,47 @@ def test_one_ball_belief_under_the_one_eye_is_the_eyecatch_perception():
     assert own._eyes is None and not np.array_equal(own.balls[0].filter.x, eyes.filter.x)
     two = make_agent("belief_mpc", "EyeCatchTwoBalls-v0", n)
     assert two._eyecatch_perception(2) is None
+
+
+def test_hand_takes_a_new_plan_at_saccade_onsets_and_the_head_takes_up_the_gaze():
+    """hand_update="saccade" (the default): the hand's plan changes only with a saccade onset, when the
+    first saccade is due, or after hand_update_max_gap_s without one (Eyecatch Sec. 1, Fig. 4); "plan"
+    follows every re-plan. eye_dead_zone_deg narrows the planner's eye-in-head bound to +-20 deg."""
+    import gymnasium as gym
+
+    env = gym.make("EyeCatch-v0")
+    n = env.action_space.shape[0]
+    agent = make_agent("belief_mpc", "EyeCatch-v0", n)
+    plan = make_agent("belief_mpc:hand_update=plan", "EyeCatch-v0", n)
+    p = agent.params
+    assert p.hand_update == "saccade" and p.eye_dead_zone_deg == 20.0
+    obs, _ = env.reset(seed=3)
+    agent.reset()
+    plan.reset()
+    S = _LAYOUTS[obs.shape[0]][1].slices
+    changes, last_t0 = [], None
+    for _ in range(60):
+        t = float(obs[S["time"]][0])
+        onset = obs[S["saccade"]][0] > 0.5 and obs[S["saccade"]][1] < 1.5 * agent.dt
+        action, _ = agent.predict(obs, deterministic=True)
+        plan.predict(obs, deterministic=True)
+        t0 = None if agent.hand_plan is None else agent.hand_plan.t0
+        if t < p.first_saccade_min_latency_s - 0.01:
+            assert t0 is None  # the hand waits at its ready point for the first visuomotor update
+        if t0 != last_t0:
+            since = math.inf if last_t0 is None else t - last_t0
+            assert onset or last_t0 is None or since >= p.hand_update_max_gap_s - 0.5 * agent.dt
+            changes.append(t)
+        last_t0 = t0
+        obs, _, term, trunc, _ = env.step(action)
+        if term or trunc:
+            break
+    assert len(changes) >= 3  # the first update and at least two saccade-synchronised ones
+    assert plan.hand_plan is None  # "plan": no held hand plan, the latest re-plan every step
+    lim = agent.gaze_limits()
+    assert lim.eye_azimuth_deg == (-20.0 - lim.range_margin_deg, 20.0 + lim.range_margin_deg)
+    prob = agent.problems(1)[0]
+    np.testing.assert_allclose(prob.hi[:2], 20.0 * DEG)
+    assert make_agent("belief_mpc:eye_dead_zone_deg=0", "EyeCatch-v0", n).gaze_limits() == Limits()
+    with pytest.raises(ValueError, match="hand_update"):
+        BeliefMPCParams(hand_update="often")

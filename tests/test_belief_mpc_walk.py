@@ -214,3 +214,38 @@ def test_dodge_determinism():
         return np.array(out)
 
     assert np.array_equal(run(), run())
+
+
+def _dodge_choices(spec: str, seed: int = 1, steps: int = 400):
+    """Per gaze choice of a dodge belief_mpc episode: (chosen key, the slots fajen_warren would look at)."""
+    env = gym.make("ObstacleDodge-v0")
+    agent = make_agent(spec, "ObstacleDodge-v0", env.action_space.shape[0])
+    seen = []
+    choose = agent._choose
+
+    def recording(threats, t):
+        allowed = {k for k, _tca, _d, _p, relevant in threats if relevant and agent._ahead(agent.filters[k])}
+        key = choose(threats, t)
+        seen.append((key, allowed))
+        return key
+
+    agent._choose = recording
+    obs, _ = env.reset(seed=seed)
+    for _ in range(steps):
+        a, _ = agent.predict(obs)
+        obs, _, term, trunc, _ = env.step(a)
+        if term or trunc:
+            break
+    env.close()
+    return agent, seen
+
+
+def test_dodge_planner_looks_only_at_fajen_warrens_pedestrians_and_verges():
+    """relevant_only (the default): every pedestrian the plan fixates is one fajen_warren's gaze rule would
+    look at (approaching or ahead within its bearing limit); without it the plan also fixates others."""
+    agent, seen = _dodge_choices("belief_mpc")
+    peds = [(key[1], allowed) for key, allowed in seen if key is not None and key[0] == "ped"]
+    assert peds and all(k in allowed for k, allowed in peds)
+    assert agent.params.verge and agent.params.relevant_only and agent.params.threat_weight == 10.0
+    _, seen_all = _dodge_choices("belief_mpc:relevant_only=false,threat_weight=0")
+    assert any(key[1] not in allowed for key, allowed in seen_all if key is not None and key[0] == "ped")

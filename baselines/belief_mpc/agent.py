@@ -66,6 +66,7 @@ from .tracker import ObjectBelief
 DEG = math.pi / 180.0
 CONTROL_DT_REFERENCE = 0.02  # Eom's alpha is per integration step h; we read it per 20 ms
 GAZE_COSTS = ("uncertainty", "distance", "sequential")
+HAND_UPDATES = ("plan", "saccade")
 _LAYOUTS = {ObservationLayout(catch_observation(n)).size: (n, ObservationLayout(catch_observation(n)))
             for n in (1, 2)}
 
@@ -117,6 +118,18 @@ class BeliefMPCParams:
     saccade_refractory_s: float = 0.2  # the plant's (Young & Stark 1963)
     fixation_lookahead_s: float = 0.08  # the plan's fixated object is read this far ahead (2 nodes), where
     # the plan has caught up with it (modelling choice)
+    # When the hand takes a new plan. "saccade": the hand keeps its plan between visuomotor updates and
+    # takes the latest one at each saccade onset (none before the first saccade is due: it waits at its ready point), or
+    # after hand_update_max_gap_s without one (Eyecatch Sec. 1, Fig. 4 and 4.1: hand submovements start
+    # with the catch-up saccades; the gap is one 400 ms submovement, modelling choice). On EyeCatch-v0
+    # seeds 0-39: 37/40 caught either way, saccade-hand synchrony 0.46 with "plan", 0.96 with "saccade".
+    # "plan": every re-plan (Eom: the whole state is re-optimised each window).
+    hand_update: str = "saccade"
+    hand_update_max_gap_s: float = 0.4
+    # > 0: the planner keeps the eye within this of the head's axis (a soft bound, as its range's), so the
+    # head takes up the rest of the gaze: the dead zone of Eyecatch Eq. 17 (0.349 rad = 20 deg). 0: the
+    # plant's eye range only (Eom 4.1). Seeds 0-39: head contribution 0.28 with 0, 0.97 with 20 deg.
+    eye_dead_zone_deg: float = 20.0
     first_saccade_min_latency_s: float = 0.18  # gaze held until then: human saccadic latency 180-200 ms
     # (REFERENCES.md; the Eyecatch agent's value)
     # Vision assumed by the brain (set from the env id by ``for_env``).
@@ -138,6 +151,8 @@ class BeliefMPCParams:
     def __post_init__(self) -> None:
         if self.gaze_cost not in GAZE_COSTS:
             raise ValueError(f"gaze_cost must be one of {GAZE_COSTS}, got {self.gaze_cost!r}")
+        if self.hand_update not in HAND_UPDATES:
+            raise ValueError(f"BeliefMPCParams.hand_update must be one of {HAND_UPDATES}, got {self.hand_update!r}")
         for f in fields(self):
             value = getattr(self, f.name)
             if isinstance(value, (bool, str)):
@@ -223,10 +238,22 @@ class BeliefMPCAgent:
     def problems(self, n_objects: int) -> tuple[GazeBeliefProblem, HandProblem]:
         if n_objects not in self._problems:
             p = self.params
-            gaze = GazeBeliefProblem(n_objects, self.N, self.h, self.planning_noise, self.q_plan, p.weights(), Limits(),
+            gaze = GazeBeliefProblem(n_objects, self.N, self.h, self.planning_noise, self.q_plan, p.weights(),
+                                     self.gaze_limits(),
                                      gaze_cost="distance" if p.gaze_cost == "distance" else "uncertainty")
             self._problems[n_objects] = (gaze, HandProblem(self.N, self.h, p.weights(), Limits()))
         return self._problems[n_objects]
+
+    def gaze_limits(self) -> Limits:
+        """The planner's soft bounds of the gaze problem: the eye-in-head range narrowed to
+        ``eye_dead_zone_deg`` when that is > 0 (the head then takes up the gaze beyond it)."""
+        z = self.params.eye_dead_zone_deg
+        if z <= 0.0:
+            return Limits()
+        lim = Limits()
+        m = lim.range_margin_deg
+        clip = lambda r: (max(r[0], -z - m), min(r[1], z + m))  # noqa: E731
+        return replace(lim, eye_azimuth_deg=clip(lim.eye_azimuth_deg), eye_elevation_deg=clip(lim.eye_elevation_deg))
 
     @property
     def planning_noise(self) -> ObservationNoise:
@@ -241,6 +268,7 @@ class BeliefMPCAgent:
         self.started = False
         self.balls: list[ObjectBelief] = []
         self.plan: Plan | None = None
+        self.hand_plan: Plan | None = None  # the plan the hand follows (hand_update)
         self.steps = 0
         self.ready: np.ndarray | None = None
         self.pose_history: list[tuple[np.ndarray, np.ndarray]] = []
@@ -366,7 +394,8 @@ class BeliefMPCAgent:
         gaze_target = self._gaze_request(t, obs, S, gaze, eye, live, delay)
         gaze_ret = _retinal(rot, gaze_target)
         head_t = self.plan.state_at(t + p.head_lead_s, h)[2:4]
-        hand_t = self.plan.state_at(t + p.hand_lead_s, h)[4:7]
+        hand_plan = self._hand_plan(t, obs, S)
+        hand_t = self.ready if hand_plan is None else hand_plan.state_at(t + p.hand_lead_s, h)
         fixation = None
         if target is not None:
             fixation = float(np.linalg.norm(self.balls[target].filter.extrapolate(delay)[0] - eye))
@@ -374,6 +403,24 @@ class BeliefMPCAgent:
         action = self._action(_within_reach(hand_t, p.max_reach_m), gaze_ret=gaze_ret, head=head_t, fixation=fixation)
         self._lap("execution")
         return action
+
+    def _hand_plan(self, t: float, obs, S) -> Plan | None:
+        """The plan the hand follows (``hand_update``): the latest, or the one taken at the last visuomotor
+        update; None (hold the ready point) before the first update under ``"saccade"``."""
+        p = self.params
+        latest = Plan(t0=self.plan.t0, X=self.plan.X[:, 4:7], U=self.plan.U[:, 4:])
+        if p.hand_update == "plan":
+            return latest
+        # a saccade started during the last step (the plant's flag and time since onset, as Eyecatch's agent)
+        onset = bool(obs[S["saccade"]][0] > 0.5) and float(obs[S["saccade"]][1]) < 1.5 * self.dt
+        if self.hand_plan is None:  # the first update: with the first saccade, or when it is due (as
+            # Eyecatch's agent, whose hand starts when it releases its first saccade, whether the eye moves)
+            if onset or t >= p.first_saccade_min_latency_s - 0.5 * self.dt:
+                self.hand_plan = latest
+            return self.hand_plan
+        if onset or t - self.hand_plan.t0 >= p.hand_update_max_gap_s - 0.5 * self.dt:
+            self.hand_plan = latest
+        return self.hand_plan
 
     # ------------------------------------------------------------------------------------------
     def _replan(self, t, g_az, g_el, head, hand, eye, obs, S, live, target, intercepts, delay) -> None:
