@@ -223,10 +223,13 @@ def _dodge_choices(spec: str, seed: int = 1, steps: int = 400):
     seen = []
     choose = agent._choose
 
+    agent._saccade_log = []
+
     def recording(threats, t):
         allowed = {k for k, _tca, _d, _p, relevant in threats if relevant and agent._ahead(agent.filters[k])}
         key = choose(threats, t)
         seen.append((key, allowed))
+        agent._saccade_log.append((t, agent._in_saccade, key))
         return key
 
     agent._choose = recording
@@ -247,5 +250,14 @@ def test_dodge_planner_looks_only_at_fajen_warrens_pedestrians_and_verges():
     peds = [(key[1], allowed) for key, allowed in seen if key is not None and key[0] == "ped"]
     assert peds and all(k in allowed for k, allowed in peds)
     assert agent.params.verge and agent.params.relevant_only and agent.params.threat_weight == 10.0
-    _, seen_all = _dodge_choices("belief_mpc:relevant_only=false,threat_weight=0")
+    # min_fixation_s: once a saccade has landed, the plan keeps its object for at least 0.2 s
+    landed = [i for i in range(1, len(agent._saccade_log)) if agent._saccade_log[i - 1][1] and not agent._saccade_log[i][1]]
+    assert landed
+    for i in landed:
+        t0, _, key0 = agent._saccade_log[i]
+        for t, in_sacc, key in agent._saccade_log[i:]:
+            if t - t0 >= agent.params.min_fixation_s - 1e-9 or in_sacc:
+                break
+            assert key == key0 or key0 is None
+    _, seen_all = _dodge_choices("belief_mpc:relevant_only=false,threat_weight=0,min_fixation_s=0")
     assert any(key[1] not in allowed for key, allowed in seen_all if key is not None and key[0] == "ped")
