@@ -50,7 +50,9 @@ MAX_MINUTES = 7 * 24 * 60.0
 MAX_SEED = 2**31 - 1
 MAX_N_ENVS = 256
 CHOICES = {"belief": ("", "yes", "no", "true", "false", "1", "0"), "hand_action": ("", "absolute", "intercept"),
-           "gaze_action": ("", "free", "gated", "frozen")}
+           "gaze_action": ("", "free", "gated", "frozen", "free_belief")}
+GAZE_BLOCK = slice(4, 6)  # the policy action's gaze block (retinal azimuth, elevation), for gaze_log_std_init
+EYE_HEAD_BLOCK = slice(6, 9)  # its fixation and head blocks, for eye_head_log_std_init
 
 
 @dataclass
@@ -78,7 +80,11 @@ class Args:
     belief's interception point); overrides the config"""
     gaze_action: str = ""
     """'free' (the gaze block is the policy's own) or 'gated' (a look gate: gate > 0 sends the eye to the
-    belief's ball, Eyecatch 4.1, plus a small gaze residual; needs hand_action=intercept); overrides the config"""
+    belief's ball, Eyecatch 4.1, plus a small gaze residual; needs hand_action=intercept) or 'free_belief' (the gated
+    mode's inputs, the believed ball on the retina, with the env's own free gaze action); overrides the config"""
+    recipe: str = ""
+    """a named recipe of the hyperparameter file's `recipes` section, applied over the env id's entry
+    (e.g. 'free_belief': the free-gaze EyeCatch recipe of docs/baselines/rl.md)"""
     hyperparams: str = ""
     """YAML file of hyperparameters (default: the packaged hyperparams.yml)"""
     set: list = field(default_factory=list)
@@ -171,6 +177,15 @@ def _check_config(config: dict) -> None:
         raise TrainArgumentError(f"algo must be PPO or RecurrentPPO, got {config.get('algo')!r}")
 
 
+def _merge(base: dict, over: dict) -> dict:
+    """``base`` with ``over`` merged in, mappings recursively (a recipe's ``reward_weights: {foveation: 0.05}``
+    changes that one weight and keeps the others)."""
+    out = dict(base)
+    for key, value in over.items():
+        out[key] = _merge(out[key], value) if isinstance(value, dict) and isinstance(out.get(key), dict) else value
+    return out
+
+
 def load_config(args: Args) -> dict:
     """Hyperparameters: ``default``, then the env id's entry, then ``--set`` overrides."""
     if args.hyperparams:
@@ -192,6 +207,11 @@ def load_config(args: Args) -> dict:
             config[key] = {**config[key], **value}
         else:
             config[key] = value
+    if args.recipe:
+        recipes = table.get("recipes") or {}
+        if args.recipe not in recipes:
+            raise TrainArgumentError(f"--recipe must be one of {sorted(recipes)}, got {args.recipe!r}")
+        config = _merge(config, recipes[args.recipe] or {})
     for item in args.set:
         key, eq, value = item.partition("=")
         if not eq or key not in config:
@@ -213,8 +233,22 @@ def load_config(args: Args) -> dict:
     config.setdefault("intercept_residual_m", 0.15)
     config.setdefault("gaze_action", "free")
     config.setdefault("gaze_residual_deg", 3.0)
-    if config["gaze_action"] not in ("free", "gated", "frozen"):
-        raise TrainArgumentError(f"gaze_action must be 'free', 'gated' or 'frozen', got {config['gaze_action']!r}")
+    config.setdefault("gaze_log_std_init", None)
+    config.setdefault("eye_head_log_std_init", None)
+    for key, what in (("gaze_shaping", "reward per rad of the ball off the line of sight"),
+                      ("vergence_shaping", "reward per unit of |ln(fixation / ball distance)|")):
+        config.setdefault(key, 0.0)
+        w = config[key]
+        if isinstance(w, bool) or not isinstance(w, (int, float)) or not 0.0 <= w <= 100.0:
+            raise TrainArgumentError(f"{key} must be a number in [0, 100] ({what}), got {w!r}")
+    if config["gaze_action"] not in CHOICES["gaze_action"][1:]:
+        raise TrainArgumentError(f"gaze_action must be one of {list(CHOICES['gaze_action'][1:])}, "
+                                 f"got {config['gaze_action']!r}")
+    for key in ("gaze_log_std_init", "eye_head_log_std_init"):
+        g = config[key]
+        if g is not None and (isinstance(g, bool) or not isinstance(g, (int, float)) or not -10.0 <= g <= 2.0):
+            raise TrainArgumentError(f"{key} must be null or a number in [-10, 2] (log of the block's initial "
+                                     f"action std), got {g!r}")
     if config["gaze_action"] != "free" and config["hand_action"] != "intercept":
         raise TrainArgumentError(f"gaze_action={config['gaze_action']} needs hand_action=intercept (and the belief features)")
     if config["hand_action"] not in ("absolute", "intercept"):
@@ -244,9 +278,40 @@ class InterceptShaping:
         return _Wrapper(env)
 
 
+class LookShaping:
+    """Training-only reward shaping, every step, seen or not, privileged like :class:`InterceptShaping` and
+    only in the reward: ``gaze``, minus ``gaze_weight`` x the angle (rad) between the line of sight and the
+    true ball; ``vergence``, minus ``vergence_weight`` x |ln(fixation distance / true ball distance)|.
+    Unlike the env's ``foveation`` term (a 5 deg Gaussian, flat and zero for a ball 15 deg away), both pay
+    for every degree (every percent of depth) the eye comes nearer, so a small exploration of the gaze and
+    fixation blocks is rewarded from the first step."""
+
+    def __new__(cls, env, gaze_weight: float, vergence_weight: float = 0.0):
+        import gymnasium as gym
+
+        from visuomotor_gym.envs.observation import ObservationLayout
+
+        fixation = ObservationLayout().slices["fixation"]
+
+        class _Wrapper(gym.Wrapper):
+            def step(self, action):
+                obs, reward, terminated, truncated, info = self.env.step(action)
+                to_ball = np.asarray(info["ball_pos"], dtype=float) - np.asarray(info["eye_pos"], dtype=float)
+                distance = max(float(np.linalg.norm(to_ball)), 1e-9)
+                cos = float(np.dot(info["gaze_dir"], to_ball)) / distance
+                terms = {"gaze": -gaze_weight * float(np.arccos(np.clip(cos, -1.0, 1.0)))}
+                if vergence_weight:
+                    fix = max(float(np.asarray(obs)[fixation][0]), 1e-3)
+                    terms["vergence"] = -vergence_weight * abs(float(np.log(fix / distance)))
+                info = {**info, "reward_terms": {**info["reward_terms"], **terms}}
+                return obs, reward + sum(terms.values()), terminated, truncated, info
+
+        return _Wrapper(env)
+
+
 def make_env_fn(env_id: str, env_kwargs: dict, belief: bool, seed: int, intercept_shaping: float = 0.0,
                 hand_action: str = "absolute", residual_m: float = 0.15, gaze_action: str = "free",
-                gaze_residual_deg: float = 3.0):
+                gaze_residual_deg: float = 3.0, gaze_shaping: float = 0.0, vergence_shaping: float = 0.0):
     """A thunk for SB3's vec envs: the env, optional shaping and belief features (and the
     belief-relative hand action), a Monitor."""
 
@@ -259,6 +324,8 @@ def make_env_fn(env_id: str, env_kwargs: dict, belief: bool, seed: int, intercep
         env = gym.make(env_id, **env_kwargs)
         if intercept_shaping:
             env = InterceptShaping(env, intercept_shaping)
+        if gaze_shaping or vergence_shaping:
+            env = LookShaping(env, gaze_shaping, vergence_shaping)
         if belief:
             from visuomotor_gym.baselines.ppo.belief import BeliefObservation
 
@@ -268,6 +335,19 @@ def make_env_fn(env_id: str, env_kwargs: dict, belief: bool, seed: int, intercep
         return env
 
     return thunk
+
+
+def set_block_log_std(model, block: slice, value) -> None:
+    """Set the initial log action std of a block of the policy's action (the gaze block 4-5, or the fixation
+    and head block 6-8) to ``value`` (None: leave ``log_std_init`` there). SB3's diagonal Gaussian has one learned ``log_std`` per action value;
+    with the 60 deg gaze range, the default std 0.37 explores +-22 deg and the plant saccades nearly every
+    step (docs/baselines/ppo.md, "Left open"), so the free-gaze recipe starts the gaze block lower."""
+    if value is None:
+        return
+    import torch
+
+    with torch.no_grad():
+        model.policy.log_std[block] = float(value)
 
 
 def run_meta(model, train_env, config: dict, args: Args, wall_s: float) -> dict:
@@ -287,6 +367,9 @@ def run_meta(model, train_env, config: dict, args: Args, wall_s: float) -> dict:
     if config.get("gaze_action", "free") != "free":  # old metas have no key: free gaze
         meta["gaze_action"] = config["gaze_action"]
         meta["gaze_residual_deg"] = float(config["gaze_residual_deg"])
+    for key in ("gaze_log_std_init", "eye_head_log_std_init"):  # training only: a block's initial action std
+        if config.get(key) is not None:
+            meta[key] = float(config[key])
     if isinstance(train_env, VecNormalize) and config["normalize_obs"]:
         meta["obs_mean"] = train_env.obs_rms.mean.tolist()
         meta["obs_var"] = train_env.obs_rms.var.tolist()
@@ -324,7 +407,10 @@ def main(argv=None) -> Path:
     hand = {"hand_action": config["hand_action"], "residual_m": float(config["intercept_residual_m"]),
             "gaze_action": config["gaze_action"], "gaze_residual_deg": float(config["gaze_residual_deg"])}
     train_env = DummyVecEnv([make_env_fn(args.env, config["env_kwargs"], config["belief"], args.seed + i,
-                                         float(config.get("intercept_shaping", 0.0)), **hand) for i in range(n_envs)])
+                                         float(config.get("intercept_shaping", 0.0)), **hand,
+                                         gaze_shaping=float(config.get("gaze_shaping", 0.0)),
+                                         vergence_shaping=float(config.get("vergence_shaping", 0.0)))
+                             for i in range(n_envs)])
     eval_env = DummyVecEnv([make_env_fn(args.env, {}, config["belief"], 10_000 + args.seed, **hand)])
     if config["normalize_obs"] or config["normalize_reward"]:
         train_env = VecNormalize(train_env, norm_obs=config["normalize_obs"], norm_reward=config["normalize_reward"],
@@ -352,6 +438,8 @@ def main(argv=None) -> Path:
         model = PPO("MlpPolicy", train_env, **common)
     else:
         raise SystemExit(f"algo must be PPO or RecurrentPPO, got {config['algo']!r}")
+    set_block_log_std(model, GAZE_BLOCK, config.get("gaze_log_std_init"))
+    set_block_log_std(model, EYE_HEAD_BLOCK, config.get("eye_head_log_std_init"))
     model.set_logger(configure(str(run_dir), ["csv", "tensorboard"]))
 
     # 3. Callbacks: evaluation on the registered env (with the training normalisation), checkpoints,
