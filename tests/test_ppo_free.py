@@ -88,7 +88,7 @@ def test_bad_gaze_options_are_refused_with_the_option_named():
         for bad in ("yes", "5", "-11", "[1]"):
             with pytest.raises(train.TrainArgumentError, match=f"{key} must be null or a number in"):
                 train.load_config(train.parse_args(["--env", "EyeCatch-v0", "--set", f"{key}={bad}"]))
-    for key in ("gaze_shaping", "vergence_shaping"):
+    for key in ("gaze_shaping", "vergence_shaping", "eye_centre_shaping"):
         for bad in ("-0.1", "null", "abc", "101"):
             with pytest.raises(train.TrainArgumentError, match=f"{key} must be a number in"):
                 train.load_config(train.parse_args(["--env", "EyeCatch-v0", "--set", f"{key}={bad}"]))
@@ -102,13 +102,14 @@ def test_free_belief_recipe_resolves_over_the_catch_recipe():
     assert config["gaze_action"] == "free_belief" and config["gaze_log_std_init"] == -3.0
     assert config["eye_head_log_std_init"] == -2.0
     assert config["gaze_shaping"] == 0.5 and config["vergence_shaping"] == 0.5
+    assert config["eye_centre_shaping"] == 0.3
     assert config["hand_action"] == "intercept" and config["belief"] is True
     # the recipe changes one reward weight and keeps the others
     assert config["env_kwargs"]["reward_weights"] == {"catch": 10.0, "miss": -1.0, "approach": -0.05,
                                                       "foveation": 0.05, "effort": -0.001}
     plain = train.load_config(train.parse_args(["--env", "EyeCatch-v0"]))
     assert plain["gaze_action"] == "free" and plain["gaze_log_std_init"] is None
-    assert plain["gaze_shaping"] == plain["vergence_shaping"] == 0.0
+    assert plain["gaze_shaping"] == plain["vergence_shaping"] == plain["eye_centre_shaping"] == 0.0
 
 
 def test_gaze_block_starts_with_its_own_std_and_the_run_records_it(tmp_path):
@@ -129,8 +130,8 @@ def test_gaze_block_starts_with_its_own_std_and_the_run_records_it(tmp_path):
 
 def test_look_shaping_terms_are_the_true_angle_and_depth_mismatch():
     """The training-only terms: -w x the angle between gaze_dir and the true ball, -w x |ln(fixation /
-    true distance)|, added to the reward and named in reward_terms."""
-    env = train.LookShaping(gym.make("EyeCatch-v0"), 0.5, 0.25)
+    true distance)|, -w x the eye's angle in the head, added to the reward and named in reward_terms."""
+    env = train.LookShaping(gym.make("EyeCatch-v0"), 0.5, 0.25, 0.3)
     env.reset(seed=3)
     base = gym.make("EyeCatch-v0")
     base.reset(seed=3)
@@ -142,7 +143,10 @@ def test_look_shaping_terms_are_the_true_angle_and_depth_mismatch():
     assert angle > np.radians(2.0)
     assert np.isclose(info["reward_terms"]["gaze"], -0.5 * angle)
     assert np.isclose(info["reward_terms"]["vergence"], -0.25 * abs(np.log(obs[22] / np.linalg.norm(to_ball))))
-    assert np.isclose(reward, reward0 + info["reward_terms"]["gaze"] + info["reward_terms"]["vergence"])
+    assert np.isclose(info["reward_terms"]["eye_centre"], -0.3 * np.hypot(*obs[20:22]))
+    assert info["reward_terms"]["eye_centre"] < 0
+    added = sum(info["reward_terms"][k] for k in ("gaze", "vergence", "eye_centre"))
+    assert np.isclose(reward, reward0 + added)
 
 
 def test_committed_free_policy_loads_and_plays_one_episode():

@@ -236,7 +236,8 @@ def load_config(args: Args) -> dict:
     config.setdefault("gaze_log_std_init", None)
     config.setdefault("eye_head_log_std_init", None)
     for key, what in (("gaze_shaping", "reward per rad of the ball off the line of sight"),
-                      ("vergence_shaping", "reward per unit of |ln(fixation / ball distance)|")):
+                      ("vergence_shaping", "reward per unit of |ln(fixation / ball distance)|"),
+                      ("eye_centre_shaping", "reward per rad of the eye's angle in the head")):
         config.setdefault(key, 0.0)
         w = config[key]
         if isinstance(w, bool) or not isinstance(w, (int, float)) or not 0.0 <= w <= 100.0:
@@ -281,17 +282,20 @@ class InterceptShaping:
 class LookShaping:
     """Training-only reward shaping, every step, seen or not, privileged like :class:`InterceptShaping` and
     only in the reward: ``gaze``, minus ``gaze_weight`` x the angle (rad) between the line of sight and the
-    true ball; ``vergence``, minus ``vergence_weight`` x |ln(fixation distance / true ball distance)|.
+    true ball; ``vergence``, minus ``vergence_weight`` x |ln(fixation distance / true ball distance)|;
+    ``eye_centre``, minus ``centre_weight`` x the eye's angle in the head (rad; the head carries the gaze, as
+    in Eyecatch 4.2, before the eye reaches its orbital limit, +27.7 deg up).
     Unlike the env's ``foveation`` term (a 5 deg Gaussian, flat and zero for a ball 15 deg away), both pay
     for every degree (every percent of depth) the eye comes nearer, so a small exploration of the gaze and
     fixation blocks is rewarded from the first step."""
 
-    def __new__(cls, env, gaze_weight: float, vergence_weight: float = 0.0):
+    def __new__(cls, env, gaze_weight: float, vergence_weight: float = 0.0, centre_weight: float = 0.0):
         import gymnasium as gym
 
         from visuomotor_gym.envs.observation import ObservationLayout
 
         fixation = ObservationLayout().slices["fixation"]
+        eye_in_head = ObservationLayout().slices["eye_in_head"]
 
         class _Wrapper(gym.Wrapper):
             def step(self, action):
@@ -303,6 +307,8 @@ class LookShaping:
                 if vergence_weight:
                     fix = max(float(np.asarray(obs)[fixation][0]), 1e-3)
                     terms["vergence"] = -vergence_weight * abs(float(np.log(fix / distance)))
+                if centre_weight:
+                    terms["eye_centre"] = -centre_weight * float(np.hypot(*np.asarray(obs)[eye_in_head]))
                 info = {**info, "reward_terms": {**info["reward_terms"], **terms}}
                 return obs, reward + sum(terms.values()), terminated, truncated, info
 
@@ -311,7 +317,8 @@ class LookShaping:
 
 def make_env_fn(env_id: str, env_kwargs: dict, belief: bool, seed: int, intercept_shaping: float = 0.0,
                 hand_action: str = "absolute", residual_m: float = 0.15, gaze_action: str = "free",
-                gaze_residual_deg: float = 3.0, gaze_shaping: float = 0.0, vergence_shaping: float = 0.0):
+                gaze_residual_deg: float = 3.0, gaze_shaping: float = 0.0, vergence_shaping: float = 0.0,
+                eye_centre_shaping: float = 0.0):
     """A thunk for SB3's vec envs: the env, optional shaping and belief features (and the
     belief-relative hand action), a Monitor."""
 
@@ -324,8 +331,8 @@ def make_env_fn(env_id: str, env_kwargs: dict, belief: bool, seed: int, intercep
         env = gym.make(env_id, **env_kwargs)
         if intercept_shaping:
             env = InterceptShaping(env, intercept_shaping)
-        if gaze_shaping or vergence_shaping:
-            env = LookShaping(env, gaze_shaping, vergence_shaping)
+        if gaze_shaping or vergence_shaping or eye_centre_shaping:
+            env = LookShaping(env, gaze_shaping, vergence_shaping, eye_centre_shaping)
         if belief:
             from visuomotor_gym.baselines.ppo.belief import BeliefObservation
 
@@ -409,7 +416,8 @@ def main(argv=None) -> Path:
     train_env = DummyVecEnv([make_env_fn(args.env, config["env_kwargs"], config["belief"], args.seed + i,
                                          float(config.get("intercept_shaping", 0.0)), **hand,
                                          gaze_shaping=float(config.get("gaze_shaping", 0.0)),
-                                         vergence_shaping=float(config.get("vergence_shaping", 0.0)))
+                                         vergence_shaping=float(config.get("vergence_shaping", 0.0)),
+                                         eye_centre_shaping=float(config.get("eye_centre_shaping", 0.0)))
                              for i in range(n_envs)])
     eval_env = DummyVecEnv([make_env_fn(args.env, {}, config["belief"], 10_000 + args.seed, **hand)])
     if config["normalize_obs"] or config["normalize_reward"]:
