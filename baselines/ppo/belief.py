@@ -251,3 +251,44 @@ class InterceptBase:
         if self.features.gaze_action == "gated" and self.look:
             action[ENV_ACTION_DIM] = 1.0
         return self.features.env_action(action), state
+
+
+class LookTeacher:
+    """A scripted demonstrator for the behaviour-cloning warm start of the free-gaze recipe (``bc_episodes`` in
+    hyperparams.yml; training only, never at evaluation): the policy action (``gaze_action="free_belief"``, 9
+    values) that looks at, verges on and turns the head toward the believed ball, from the policy's own
+    inputs (the flat observation and the free_belief features) only.
+
+    * hand residual 0 (the belief's interception point), grasp closed (1);
+    * gaze: the believed ball's retinal azimuth and elevation (the free_belief inputs) over the gaze range:
+      the request the gated mode's open gate makes (Eyecatch 4.1);
+    * fixation: the believed distance one step ahead (the free_belief input; Eyecatch agent's vergence lead);
+    * head: neck target = present neck angles + half the believed ball's retinal angles (modelling choice: the
+      head takes over part of each gaze shift, as in Eyecatch 4.2, so the eye stays off its orbital limit).
+
+    Before the filter's first sample: gaze, fixation and head 0 (held). On 30 pinned throws of EyeCatch-v0 it
+    catches 30 (with the head held, 13 of 30; docs/baselines/rl.md).
+    """
+
+    HEAD_SHARE = 0.5  # the head's share of the believed ball's retinal angle per step (modelling choice)
+
+    def __init__(self, features: BeliefFeatures):
+        if features.gaze_action != "free_belief":
+            raise ValueError(f"LookTeacher needs gaze_action='free_belief' features, got {features.gaze_action!r}")
+        self.features = features
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        """The teacher's policy action for the features' latest input ``x`` (flat observation + features)."""
+        from visuomotor_gym.envs.actions import eye_head_action
+
+        f = self.features
+        action = np.zeros(ENV_ACTION_DIM, dtype=np.float32)
+        action[3] = 1.0
+        if f.look_gaze is None:
+            return action
+        look = np.asarray(f.look_gaze, dtype=float)
+        n_obs = len(x) - f.size
+        distance = math.exp(float(x[n_obs + N_BELIEF + N_INTERCEPT + N_GAZE]))
+        head = np.asarray(x[_S["head_qpos"]], dtype=float) + self.HEAD_SHARE * look
+        action[4:9] = eye_head_action(look, distance, head, f._agent.gaze_range)
+        return action

@@ -3,6 +3,7 @@
     python -m visuomotor_gym.baselines.ppo.train --env EyeCatchOracle-v0 --timesteps 2000000
     vmgym train ppo --env EyeCatch-v0 --timesteps 3000000 --minutes 55
     vmgym train ppo --env SteppingStones-v0 --recurrent --timesteps 100000
+    vmgym train ppo --env EyeCatch-v0 --recipe free_belief --minutes 62 --timesteps 5000000   (free gaze)
 
 Every registered id has hyperparameters in ``hyperparams.yml``: the catch ids default to the project's
 recipe (belief features, intercept hand action); every other family plays free gaze (the env's own
@@ -235,6 +236,20 @@ def load_config(args: Args) -> dict:
     config.setdefault("gaze_residual_deg", 3.0)
     config.setdefault("gaze_log_std_init", None)
     config.setdefault("eye_head_log_std_init", None)
+    for key, default, low, high in (("bc_episodes", 0, 0, 100_000), ("bc_epochs", 20, 1, 10_000),
+                                    ("bc_dagger_rounds", 0, 0, 100)):
+        config.setdefault(key, default)
+        v = config[key]
+        if isinstance(v, bool) or not isinstance(v, int) or not low <= v <= high:
+            raise TrainArgumentError(f"{key} must be an integer in [{low}, {high}], got {v!r}")
+    for key, default, low, high in (("bc_noise", 0.02, 0.0, 1.0), ("bc_lr", 1e-3, 1e-6, 1.0)):
+        config.setdefault(key, default)
+        v = config[key]
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not low <= v <= high:
+            raise TrainArgumentError(f"{key} must be a number in [{low}, {high}], got {v!r}")
+    if config["bc_episodes"] and config["gaze_action"] != "free_belief":
+        raise TrainArgumentError(f"bc_episodes needs gaze_action=free_belief (the LookTeacher's inputs), "
+                                 f"got gaze_action={config['gaze_action']}")
     for key, what in (("gaze_shaping", "reward per rad of the ball off the line of sight"),
                       ("vergence_shaping", "reward per unit of |ln(fixation / ball distance)|"),
                       ("eye_centre_shaping", "reward per rad of the eye's angle in the head")):
@@ -357,6 +372,126 @@ def set_block_log_std(model, block: slice, value) -> None:
         model.policy.log_std[block] = float(value)
 
 
+def behaviour_clone(model, train_env, env_fn, config: dict, seed: int, log: Path) -> dict:
+    """Warm start (training only): play ``bc_episodes`` throws of the training env with the scripted
+    :class:`~visuomotor_gym.baselines.ppo.belief.LookTeacher` (its actions plus Gaussian noise of std
+    ``bc_noise`` for state coverage; labels are the teacher's clean actions), fold their observations and
+    returns into the VecNormalize statistics, then fit the policy's mean action (MSE) and its value
+    (discounted normalised shaped return, MSE) for ``bc_epochs`` epochs with Adam (lr ``bc_lr``). PPO then
+    trains from there with the env's free action. Returns what it did (kept in the run's ``bc.json``)."""
+    import torch
+    from stable_baselines3.common.vec_env import VecNormalize
+
+    from visuomotor_gym.baselines.ppo.belief import BeliefObservation, LookTeacher
+
+    rng = np.random.default_rng(seed)
+    env = env_fn()
+    inner = env
+    while not isinstance(inner, BeliefObservation):
+        inner = inner.env
+    teacher = LookTeacher(inner.features)
+    noise = float(config["bc_noise"])
+    gamma = float(config["gamma"])
+    policy = model.policy
+    rounds = []
+
+    def play(n_episodes: int, first_seed: int, learner: bool):
+        """Throws played by the teacher (or, DAgger, by the policy's mean action), each step labelled with
+        the teacher's clean action; noise on the played action."""
+        xs, ys, rewards, dones, caught = [], [], [], [], 0
+        for episode in range(n_episodes):
+            x, _ = env.reset(seed=first_seed + episode)
+            done = False
+            while not done:
+                a = teacher(x)
+                xs.append(x)
+                ys.append(a)
+                if learner:
+                    obs_n = train_env.normalize_obs(x[None]) if isinstance(train_env, VecNormalize) else x[None]
+                    with torch.no_grad():
+                        mean = policy.get_distribution(torch.as_tensor(np.asarray(obs_n, np.float32)))
+                        a = mean.distribution.mean.numpy()[0]
+                played = np.clip(a + noise * rng.standard_normal(a.shape).astype(np.float32), -1.0, 1.0)
+                x, r, terminated, truncated, info = env.step(played)
+                done = terminated or truncated
+                rewards.append(float(r))
+                dones.append(done)
+            caught += bool(info.get("is_success"))
+        rounds.append({"player": "policy" if learner else "teacher", "episodes": n_episodes, "caught": caught,
+                       "transitions": len(xs)})
+        return xs, ys, rewards, dones
+
+    data = [play(int(config["bc_episodes"]), seed + 1_000_000, False)]
+    losses = []
+    for k in range(int(config["bc_dagger_rounds"]) + 1):
+        if k:  # DAgger (Ross et al. 2011): the states the cloned policy visits, labelled by the teacher
+            data.append(play(int(config["bc_episodes"]), seed + 1_000_000 + k * 100_000, True))
+        losses += _fit(model, train_env, [d for d in data], config, seed, gamma, first=(k == 0))
+    env.close()
+    info = {"episodes": int(config["bc_episodes"]), "dagger_rounds": int(config["bc_dagger_rounds"]),
+            "rounds": rounds, "transitions": sum(r["transitions"] for r in rounds),
+            "teacher_catches": rounds[0]["caught"], "noise": noise, "epochs": int(config["bc_epochs"]),
+            "lr": float(config["bc_lr"]), "policy_mse_per_epoch": [round(v, 6) for v in losses]}
+    log.write_text(json.dumps(info, indent=1))
+    return info
+
+
+def _fit(model, train_env, data, config: dict, seed: int, gamma: float, first: bool) -> list:
+    """Fit the policy's mean action to the teacher labels and its value to the discounted normalised
+    return, on all transitions in ``data``; returns the policy MSE per epoch."""
+    import torch
+    from stable_baselines3.common.vec_env import VecNormalize
+
+    xs = np.asarray([x for d in data for x in d[0]], np.float32)
+    ys = np.asarray([y for d in data for y in d[1]], np.float32)
+    rewards = np.asarray([r for d in data for r in d[2]])
+    dones = np.asarray([e for d in data for e in d[3]])
+    obs = xs
+    scaled = rewards
+    if isinstance(train_env, VecNormalize):
+        if train_env.norm_obs:
+            if first:  # the statistics are fixed after the first fit: later rounds refit on the same scale
+                train_env.obs_rms.update(xs)
+            obs = train_env.normalize_obs(xs)
+        if train_env.norm_reward and first:  # VecNormalize's running discounted return, as it would have seen it
+            ret, rets = 0.0, []
+            for r, d in zip(rewards, dones):
+                ret = ret * gamma + r
+                rets.append(ret)
+                if d:
+                    ret = 0.0
+            train_env.ret_rms.update(np.asarray(rets))
+        if train_env.norm_reward:
+            scaled = np.clip(rewards / np.sqrt(train_env.ret_rms.var + train_env.epsilon),
+                             -train_env.clip_reward, train_env.clip_reward)
+    targets, g = np.zeros(len(scaled)), 0.0
+    for i in range(len(scaled) - 1, -1, -1):  # discounted return to the episode's end
+        g = scaled[i] + gamma * (0.0 if dones[i] else g)
+        targets[i] = g
+    policy = model.policy
+    opt = torch.optim.Adam(policy.parameters(), lr=float(config["bc_lr"]))
+    x_t = torch.as_tensor(np.asarray(obs, np.float32))
+    y_t = torch.as_tensor(ys)
+    v_t = torch.as_tensor(targets, dtype=torch.float32)
+    gen = torch.Generator().manual_seed(seed)
+    losses = []
+    for _ in range(int(config["bc_epochs"])):
+        order = torch.randperm(len(x_t), generator=gen)
+        total = 0.0
+        for start in range(0, len(order), 256):
+            idx = order[start : start + 256]
+            dist = policy.get_distribution(x_t[idx])
+            loss_pi = ((dist.distribution.mean - y_t[idx]) ** 2).mean()
+            loss_v = ((policy.predict_values(x_t[idx]).flatten() - v_t[idx]) ** 2).mean()
+            loss = loss_pi + 0.5 * loss_v
+            opt.zero_grad()
+            loss.backward()
+            opt.step()
+            total += float(loss_pi.detach()) * len(idx)
+        losses.append(total / len(order))
+    return losses
+
+
 def run_meta(model, train_env, config: dict, args: Args, wall_s: float) -> dict:
     """What ``ppo:<path>`` needs besides the zip: algorithm, inputs, hand action, normalisation."""
     from stable_baselines3.common.vec_env import VecNormalize
@@ -448,6 +583,17 @@ def main(argv=None) -> Path:
         raise SystemExit(f"algo must be PPO or RecurrentPPO, got {config['algo']!r}")
     set_block_log_std(model, GAZE_BLOCK, config.get("gaze_log_std_init"))
     set_block_log_std(model, EYE_HEAD_BLOCK, config.get("eye_head_log_std_init"))
+    if int(config.get("bc_episodes", 0)) > 0:
+        t0 = time.time()
+        bc = behaviour_clone(model, train_env, make_env_fn(args.env, config["env_kwargs"], config["belief"],
+                             args.seed, float(config.get("intercept_shaping", 0.0)), **hand,
+                             gaze_shaping=float(config.get("gaze_shaping", 0.0)),
+                             vergence_shaping=float(config.get("vergence_shaping", 0.0)),
+                             eye_centre_shaping=float(config.get("eye_centre_shaping", 0.0))),
+                             config, args.seed, run_dir / "bc.json")
+        print(f"behaviour cloning: {bc['transitions']} teacher transitions ({bc['teacher_catches']}/{bc['episodes']} "
+              f"caught), policy MSE {bc['policy_mse_per_epoch'][0]:.4f} -> {bc['policy_mse_per_epoch'][-1]:.4f}, "
+              f"{time.time() - t0:.0f} s", flush=True)
     model.set_logger(configure(str(run_dir), ["csv", "tensorboard"]))
 
     # 3. Callbacks: evaluation on the registered env (with the training normalisation), checkpoints,
