@@ -82,7 +82,7 @@ def test_bad_gaze_options_are_refused_with_the_option_named():
         BeliefFeatures("EyeCatch-v0", "absolute", gaze_action="free_belief")
     with pytest.raises(train.TrainArgumentError, match=r"--gaze-action must be one of .*free_belief"):
         train.check_args(train.parse_args(["--env", "EyeCatch-v0", "--gaze-action", "belief"]))
-    with pytest.raises(train.TrainArgumentError, match=r"--recipe must be one of \['free_belief'\], got 'nope'"):
+    with pytest.raises(train.TrainArgumentError, match=r"--recipe must be one of \['free_belief', 'free_belief_bc'\], got 'nope'"):
         train.load_config(train.parse_args(["--env", "EyeCatch-v0", "--recipe", "nope"]))
     for key in ("gaze_log_std_init", "eye_head_log_std_init"):
         for bad in ("yes", "5", "-11", "[1]"):
@@ -157,3 +157,50 @@ def test_committed_free_policy_loads_and_plays_one_episode():
     trace = evaluate(f"ppo:{POLICY}", "EyeCatch-v0", 1, 0, workers=1).traces[0]
     assert trace.action.shape[1] == 9 and len(trace.action) > 10
     assert trace.saccade_onset.sum() >= 1  # its own gaze moves the eye
+
+
+def test_look_teacher_acts_from_the_policy_inputs_and_catches():
+    """The warm start's scripted teacher: hand residual 0, grasp closed, the gaze request to the believed ball,
+    vergence on its believed distance, the head toward it; it plays only free_belief features, and it catches
+    (the recipe's premise: the free action can catch when it looks)."""
+    from visuomotor_gym.baselines.ppo.belief import BeliefObservation, LookTeacher
+
+    from visuomotor_gym.envs.actions import eye_head_action
+
+    with pytest.raises(ValueError, match="LookTeacher needs gaze_action='free_belief'"):
+        LookTeacher(BeliefFeatures("EyeCatch-v0", "intercept", gaze_action="gated"))
+    env = BeliefObservation(gym.make("EyeCatch-v0"), "EyeCatch-v0", "intercept", 0.15, "free_belief")
+    teacher = LookTeacher(env.features)
+    caught = 0
+    for seed in range(3):
+        x, _ = env.reset(seed=seed)
+        done, checked = False, False
+        while not done:
+            a = teacher(x)
+            assert a.shape == (9,) and np.all(a[:3] == 0) and a[3] == 1.0
+            look = env.features.look_gaze
+            if look is not None and not checked:
+                want = eye_head_action(look, np.exp(x[-1]), x[25:27] + 0.5 * np.asarray(look), np.radians(60.0))
+                np.testing.assert_allclose(a[4:9], want, atol=1e-6)
+                checked = True
+            x, _, terminated, truncated, info = env.step(a)
+            done = terminated or truncated
+        caught += info["is_success"]
+        assert checked
+    assert caught == 3
+
+
+def test_behaviour_cloning_warm_start_runs_and_records_its_rounds(tmp_path):
+    run = train.main(["--env", "EyeCatch-v0", "--recipe", "free_belief_bc", "--timesteps", "256", "--out", str(tmp_path),
+                      "--run-name", "b", "--no-progress-bar", "--set", "n_envs=2", "n_steps=128", "batch_size=128",
+                      "eval_freq=100000", "eval_episodes=1", "checkpoint_freq=100000", "bc_episodes=2",
+                      "bc_dagger_rounds=1", "bc_epochs=3"])
+    bc = json.loads((run / "bc.json").read_text())
+    assert [r["player"] for r in bc["rounds"]] == ["teacher", "policy"]
+    assert len(bc["policy_mse_per_epoch"]) == 6 and bc["policy_mse_per_epoch"][-1] < bc["policy_mse_per_epoch"][0]
+    for bad, match in (("bc_episodes=-1", "bc_episodes must be an integer"), ("bc_epochs=0", "bc_epochs must be"),
+                       ("bc_noise=2", "bc_noise must be a number"), ("bc_dagger_rounds=1.5", "bc_dagger_rounds must")):
+        with pytest.raises(train.TrainArgumentError, match=match):
+            train.load_config(train.parse_args(["--env", "EyeCatch-v0", "--recipe", "free_belief_bc", "--set", bad]))
+    with pytest.raises(train.TrainArgumentError, match="bc_episodes needs gaze_action=free_belief"):
+        train.load_config(train.parse_args(["--env", "EyeCatch-v0", "--set", "bc_episodes=5"]))

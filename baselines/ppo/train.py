@@ -242,7 +242,8 @@ def load_config(args: Args) -> dict:
         v = config[key]
         if isinstance(v, bool) or not isinstance(v, int) or not low <= v <= high:
             raise TrainArgumentError(f"{key} must be an integer in [{low}, {high}], got {v!r}")
-    for key, default, low, high in (("bc_noise", 0.02, 0.0, 1.0), ("bc_lr", 1e-3, 1e-6, 1.0)):
+    for key, default, low, high in (("bc_noise", 0.02, 0.0, 1.0), ("bc_lr", 1e-3, 1e-6, 1.0),
+                                    ("bc_gaze_weight", 1.0, 0.0, 1000.0)):
         config.setdefault(key, default)
         v = config[key]
         if isinstance(v, bool) or not isinstance(v, (int, float)) or not low <= v <= high:
@@ -381,7 +382,6 @@ def behaviour_clone(model, train_env, env_fn, config: dict, seed: int, log: Path
     trains from there with the env's free action. Returns what it did (kept in the run's ``bc.json``)."""
     import torch
     from stable_baselines3.common.vec_env import VecNormalize
-
     from visuomotor_gym.baselines.ppo.belief import BeliefObservation, LookTeacher
 
     rng = np.random.default_rng(seed)
@@ -426,7 +426,7 @@ def behaviour_clone(model, train_env, env_fn, config: dict, seed: int, log: Path
     for k in range(int(config["bc_dagger_rounds"]) + 1):
         if k:  # DAgger (Ross et al. 2011): the states the cloned policy visits, labelled by the teacher
             data.append(play(int(config["bc_episodes"]), seed + 1_000_000 + k * 100_000, True))
-        losses += _fit(model, train_env, [d for d in data], config, seed, gamma, first=(k == 0))
+        losses += _fit(model, train_env, data, config, seed, gamma, first=(k == 0))
     env.close()
     info = {"episodes": int(config["bc_episodes"]), "dagger_rounds": int(config["bc_dagger_rounds"]),
             "rounds": rounds, "transitions": sum(r["transitions"] for r in rounds),
@@ -474,6 +474,8 @@ def _fit(model, train_env, data, config: dict, seed: int, gamma: float, first: b
     y_t = torch.as_tensor(ys)
     v_t = torch.as_tensor(targets, dtype=torch.float32)
     gen = torch.Generator().manual_seed(seed)
+    weight = torch.ones(y_t.shape[1])
+    weight[GAZE_BLOCK] = float(config["bc_gaze_weight"])  # the gaze block's share of the imitation loss
     losses = []
     for _ in range(int(config["bc_epochs"])):
         order = torch.randperm(len(x_t), generator=gen)
@@ -481,7 +483,7 @@ def _fit(model, train_env, data, config: dict, seed: int, gamma: float, first: b
         for start in range(0, len(order), 256):
             idx = order[start : start + 256]
             dist = policy.get_distribution(x_t[idx])
-            loss_pi = ((dist.distribution.mean - y_t[idx]) ** 2).mean()
+            loss_pi = (weight * (dist.distribution.mean - y_t[idx]) ** 2).mean()
             loss_v = ((policy.predict_values(x_t[idx]).flatten() - v_t[idx]) ** 2).mean()
             loss = loss_pi + 0.5 * loss_v
             opt.zero_grad()
