@@ -57,6 +57,8 @@ NPZ_META_NUMBERS = {
     "epsilon": (float, 0.0, 1.0),
     "intercept_residual_m": (float, 0.0, 10.0),
     "gaze_residual_deg": (float, 0.0, 90.0),
+    "gaze_log_std_init": (float, -10.0, 2.0),
+    "eye_head_log_std_init": (float, -10.0, 2.0),
     "seed": (int, 0, None),
     "timesteps": (int, 0, None),
     "train_wall_s": (float, 0.0, None),

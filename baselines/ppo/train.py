@@ -3,6 +3,7 @@
     python -m visuomotor_gym.baselines.ppo.train --env EyeCatchOracle-v0 --timesteps 2000000
     vmgym train ppo --env EyeCatch-v0 --timesteps 3000000 --minutes 55
     vmgym train ppo --env SteppingStones-v0 --recurrent --timesteps 100000
+    vmgym train ppo --env EyeCatch-v0 --recipe free_belief --minutes 62 --timesteps 5000000   (free gaze)
 
 Every registered id has hyperparameters in ``hyperparams.yml``: the catch ids default to the project's
 recipe (belief features, intercept hand action); every other family plays free gaze (the env's own
@@ -50,7 +51,9 @@ MAX_MINUTES = 7 * 24 * 60.0
 MAX_SEED = 2**31 - 1
 MAX_N_ENVS = 256
 CHOICES = {"belief": ("", "yes", "no", "true", "false", "1", "0"), "hand_action": ("", "absolute", "intercept"),
-           "gaze_action": ("", "free", "gated", "frozen")}
+           "gaze_action": ("", "free", "gated", "frozen", "free_belief")}
+GAZE_BLOCK = slice(4, 6)  # the policy action's gaze block (retinal azimuth, elevation), for gaze_log_std_init
+EYE_HEAD_BLOCK = slice(6, 9)  # its fixation and head blocks, for eye_head_log_std_init
 
 
 @dataclass
@@ -78,7 +81,11 @@ class Args:
     belief's interception point); overrides the config"""
     gaze_action: str = ""
     """'free' (the gaze block is the policy's own) or 'gated' (a look gate: gate > 0 sends the eye to the
-    belief's ball, Eyecatch 4.1, plus a small gaze residual; needs hand_action=intercept); overrides the config"""
+    belief's ball, Eyecatch 4.1, plus a small gaze residual; needs hand_action=intercept) or 'free_belief' (the gated
+    mode's inputs, the believed ball on the retina, with the env's own free gaze action); overrides the config"""
+    recipe: str = ""
+    """a named recipe of the hyperparameter file's `recipes` section, applied over the env id's entry
+    (e.g. 'free_belief': the free-gaze EyeCatch recipe of docs/baselines/rl.md)"""
     hyperparams: str = ""
     """YAML file of hyperparameters (default: the packaged hyperparams.yml)"""
     set: list = field(default_factory=list)
@@ -171,6 +178,15 @@ def _check_config(config: dict) -> None:
         raise TrainArgumentError(f"algo must be PPO or RecurrentPPO, got {config.get('algo')!r}")
 
 
+def _merge(base: dict, over: dict) -> dict:
+    """``base`` with ``over`` merged in, mappings recursively (a recipe's ``reward_weights: {foveation: 0.05}``
+    changes that one weight and keeps the others)."""
+    out = dict(base)
+    for key, value in over.items():
+        out[key] = _merge(out[key], value) if isinstance(value, dict) and isinstance(out.get(key), dict) else value
+    return out
+
+
 def load_config(args: Args) -> dict:
     """Hyperparameters: ``default``, then the env id's entry, then ``--set`` overrides."""
     if args.hyperparams:
@@ -192,6 +208,11 @@ def load_config(args: Args) -> dict:
             config[key] = {**config[key], **value}
         else:
             config[key] = value
+    if args.recipe:
+        recipes = table.get("recipes") or {}
+        if args.recipe not in recipes:
+            raise TrainArgumentError(f"--recipe must be one of {sorted(recipes)}, got {args.recipe!r}")
+        config = _merge(config, recipes[args.recipe] or {})
     for item in args.set:
         key, eq, value = item.partition("=")
         if not eq or key not in config:
@@ -213,8 +234,38 @@ def load_config(args: Args) -> dict:
     config.setdefault("intercept_residual_m", 0.15)
     config.setdefault("gaze_action", "free")
     config.setdefault("gaze_residual_deg", 3.0)
-    if config["gaze_action"] not in ("free", "gated", "frozen"):
-        raise TrainArgumentError(f"gaze_action must be 'free', 'gated' or 'frozen', got {config['gaze_action']!r}")
+    config.setdefault("gaze_log_std_init", None)
+    config.setdefault("eye_head_log_std_init", None)
+    for key, default, low, high in (("bc_episodes", 0, 0, 100_000), ("bc_epochs", 20, 1, 10_000),
+                                    ("bc_dagger_rounds", 0, 0, 100)):
+        config.setdefault(key, default)
+        v = config[key]
+        if isinstance(v, bool) or not isinstance(v, int) or not low <= v <= high:
+            raise TrainArgumentError(f"{key} must be an integer in [{low}, {high}], got {v!r}")
+    for key, default, low, high in (("bc_noise", 0.02, 0.0, 1.0), ("bc_lr", 1e-3, 1e-6, 1.0),
+                                    ("bc_gaze_weight", 1.0, 0.0, 1000.0)):
+        config.setdefault(key, default)
+        v = config[key]
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not low <= v <= high:
+            raise TrainArgumentError(f"{key} must be a number in [{low}, {high}], got {v!r}")
+    if config["bc_episodes"] and config["gaze_action"] != "free_belief":
+        raise TrainArgumentError(f"bc_episodes needs gaze_action=free_belief (the LookTeacher's inputs), "
+                                 f"got gaze_action={config['gaze_action']}")
+    for key, what in (("gaze_shaping", "reward per rad of the ball off the line of sight"),
+                      ("vergence_shaping", "reward per unit of |ln(fixation / ball distance)|"),
+                      ("eye_centre_shaping", "reward per rad of the eye's angle in the head")):
+        config.setdefault(key, 0.0)
+        w = config[key]
+        if isinstance(w, bool) or not isinstance(w, (int, float)) or not 0.0 <= w <= 100.0:
+            raise TrainArgumentError(f"{key} must be a number in [0, 100] ({what}), got {w!r}")
+    if config["gaze_action"] not in CHOICES["gaze_action"][1:]:
+        raise TrainArgumentError(f"gaze_action must be one of {list(CHOICES['gaze_action'][1:])}, "
+                                 f"got {config['gaze_action']!r}")
+    for key in ("gaze_log_std_init", "eye_head_log_std_init"):
+        g = config[key]
+        if g is not None and (isinstance(g, bool) or not isinstance(g, (int, float)) or not -10.0 <= g <= 2.0):
+            raise TrainArgumentError(f"{key} must be null or a number in [-10, 2] (log of the block's initial "
+                                     f"action std), got {g!r}")
     if config["gaze_action"] != "free" and config["hand_action"] != "intercept":
         raise TrainArgumentError(f"gaze_action={config['gaze_action']} needs hand_action=intercept (and the belief features)")
     if config["hand_action"] not in ("absolute", "intercept"):
@@ -244,9 +295,46 @@ class InterceptShaping:
         return _Wrapper(env)
 
 
+class LookShaping:
+    """Training-only reward shaping, every step, seen or not, privileged like :class:`InterceptShaping` and
+    only in the reward: ``gaze``, minus ``gaze_weight`` x the angle (rad) between the line of sight and the
+    true ball; ``vergence``, minus ``vergence_weight`` x |ln(fixation distance / true ball distance)|;
+    ``eye_centre``, minus ``centre_weight`` x the eye's angle in the head (rad; the head carries the gaze, as
+    in Eyecatch 4.2, before the eye reaches its orbital limit, +27.7 deg up).
+    Unlike the env's ``foveation`` term (a 5 deg Gaussian, flat and zero for a ball 15 deg away), both pay
+    for every degree (every percent of depth) the eye comes nearer, so a small exploration of the gaze and
+    fixation blocks is rewarded from the first step."""
+
+    def __new__(cls, env, gaze_weight: float, vergence_weight: float = 0.0, centre_weight: float = 0.0):
+        import gymnasium as gym
+
+        from visuomotor_gym.envs.observation import ObservationLayout
+
+        fixation = ObservationLayout().slices["fixation"]
+        eye_in_head = ObservationLayout().slices["eye_in_head"]
+
+        class _Wrapper(gym.Wrapper):
+            def step(self, action):
+                obs, reward, terminated, truncated, info = self.env.step(action)
+                to_ball = np.asarray(info["ball_pos"], dtype=float) - np.asarray(info["eye_pos"], dtype=float)
+                distance = max(float(np.linalg.norm(to_ball)), 1e-9)
+                cos = float(np.dot(info["gaze_dir"], to_ball)) / distance
+                terms = {"gaze": -gaze_weight * float(np.arccos(np.clip(cos, -1.0, 1.0)))}
+                if vergence_weight:
+                    fix = max(float(np.asarray(obs)[fixation][0]), 1e-3)
+                    terms["vergence"] = -vergence_weight * abs(float(np.log(fix / distance)))
+                if centre_weight:
+                    terms["eye_centre"] = -centre_weight * float(np.hypot(*np.asarray(obs)[eye_in_head]))
+                info = {**info, "reward_terms": {**info["reward_terms"], **terms}}
+                return obs, reward + sum(terms.values()), terminated, truncated, info
+
+        return _Wrapper(env)
+
+
 def make_env_fn(env_id: str, env_kwargs: dict, belief: bool, seed: int, intercept_shaping: float = 0.0,
                 hand_action: str = "absolute", residual_m: float = 0.15, gaze_action: str = "free",
-                gaze_residual_deg: float = 3.0):
+                gaze_residual_deg: float = 3.0, gaze_shaping: float = 0.0, vergence_shaping: float = 0.0,
+                eye_centre_shaping: float = 0.0):
     """A thunk for SB3's vec envs: the env, optional shaping and belief features (and the
     belief-relative hand action), a Monitor."""
 
@@ -259,6 +347,8 @@ def make_env_fn(env_id: str, env_kwargs: dict, belief: bool, seed: int, intercep
         env = gym.make(env_id, **env_kwargs)
         if intercept_shaping:
             env = InterceptShaping(env, intercept_shaping)
+        if gaze_shaping or vergence_shaping or eye_centre_shaping:
+            env = LookShaping(env, gaze_shaping, vergence_shaping, eye_centre_shaping)
         if belief:
             from visuomotor_gym.baselines.ppo.belief import BeliefObservation
 
@@ -268,6 +358,140 @@ def make_env_fn(env_id: str, env_kwargs: dict, belief: bool, seed: int, intercep
         return env
 
     return thunk
+
+
+def set_block_log_std(model, block: slice, value) -> None:
+    """Set the initial log action std of a block of the policy's action (the gaze block 4-5, or the fixation
+    and head block 6-8) to ``value`` (None: leave ``log_std_init`` there). SB3's diagonal Gaussian has one learned ``log_std`` per action value;
+    with the 60 deg gaze range, the default std 0.37 explores +-22 deg and the plant saccades nearly every
+    step (docs/baselines/ppo.md, "Left open"), so the free-gaze recipe starts the gaze block lower."""
+    if value is None:
+        return
+    import torch
+
+    with torch.no_grad():
+        model.policy.log_std[block] = float(value)
+
+
+def behaviour_clone(model, train_env, env_fn, config: dict, seed: int, log: Path) -> dict:
+    """Warm start (training only): play ``bc_episodes`` throws of the training env with the scripted
+    :class:`~visuomotor_gym.baselines.ppo.belief.LookTeacher` (its actions plus Gaussian noise of std
+    ``bc_noise`` for state coverage; labels are the teacher's clean actions), fold their observations and
+    returns into the VecNormalize statistics, then fit the policy's mean action (MSE) and its value
+    (discounted normalised shaped return, MSE) for ``bc_epochs`` epochs with Adam (lr ``bc_lr``). PPO then
+    trains from there with the env's free action. Returns what it did (kept in the run's ``bc.json``)."""
+    import torch
+    from stable_baselines3.common.vec_env import VecNormalize
+    from visuomotor_gym.baselines.ppo.belief import BeliefObservation, LookTeacher
+
+    rng = np.random.default_rng(seed)
+    env = env_fn()
+    inner = env
+    while not isinstance(inner, BeliefObservation):
+        inner = inner.env
+    teacher = LookTeacher(inner.features)
+    noise = float(config["bc_noise"])
+    gamma = float(config["gamma"])
+    policy = model.policy
+    rounds = []
+
+    def play(n_episodes: int, first_seed: int, learner: bool):
+        """Throws played by the teacher (or, DAgger, by the policy's mean action), each step labelled with
+        the teacher's clean action; noise on the played action."""
+        xs, ys, rewards, dones, caught = [], [], [], [], 0
+        for episode in range(n_episodes):
+            x, _ = env.reset(seed=first_seed + episode)
+            done = False
+            while not done:
+                a = teacher(x)
+                xs.append(x)
+                ys.append(a)
+                if learner:
+                    obs_n = train_env.normalize_obs(x[None]) if isinstance(train_env, VecNormalize) else x[None]
+                    with torch.no_grad():
+                        mean = policy.get_distribution(torch.as_tensor(np.asarray(obs_n, np.float32)))
+                        a = mean.distribution.mean.numpy()[0]
+                played = np.clip(a + noise * rng.standard_normal(a.shape).astype(np.float32), -1.0, 1.0)
+                x, r, terminated, truncated, info = env.step(played)
+                done = terminated or truncated
+                rewards.append(float(r))
+                dones.append(done)
+            caught += bool(info.get("is_success"))
+        rounds.append({"player": "policy" if learner else "teacher", "episodes": n_episodes, "caught": caught,
+                       "transitions": len(xs)})
+        return xs, ys, rewards, dones
+
+    data = [play(int(config["bc_episodes"]), seed + 1_000_000, False)]
+    losses = []
+    for k in range(int(config["bc_dagger_rounds"]) + 1):
+        if k:  # DAgger (Ross et al. 2011): the states the cloned policy visits, labelled by the teacher
+            data.append(play(int(config["bc_episodes"]), seed + 1_000_000 + k * 100_000, True))
+        losses += _fit(model, train_env, data, config, seed, gamma, first=(k == 0))
+    env.close()
+    info = {"episodes": int(config["bc_episodes"]), "dagger_rounds": int(config["bc_dagger_rounds"]),
+            "rounds": rounds, "transitions": sum(r["transitions"] for r in rounds),
+            "teacher_catches": rounds[0]["caught"], "noise": noise, "epochs": int(config["bc_epochs"]),
+            "lr": float(config["bc_lr"]), "policy_mse_per_epoch": [round(v, 6) for v in losses]}
+    log.write_text(json.dumps(info, indent=1))
+    return info
+
+
+def _fit(model, train_env, data, config: dict, seed: int, gamma: float, first: bool) -> list:
+    """Fit the policy's mean action to the teacher labels and its value to the discounted normalised
+    return, on all transitions in ``data``; returns the policy MSE per epoch."""
+    import torch
+    from stable_baselines3.common.vec_env import VecNormalize
+
+    xs = np.asarray([x for d in data for x in d[0]], np.float32)
+    ys = np.asarray([y for d in data for y in d[1]], np.float32)
+    rewards = np.asarray([r for d in data for r in d[2]])
+    dones = np.asarray([e for d in data for e in d[3]])
+    obs = xs
+    scaled = rewards
+    if isinstance(train_env, VecNormalize):
+        if train_env.norm_obs:
+            if first:  # the statistics are fixed after the first fit: later rounds refit on the same scale
+                train_env.obs_rms.update(xs)
+            obs = train_env.normalize_obs(xs)
+        if train_env.norm_reward and first:  # VecNormalize's running discounted return, as it would have seen it
+            ret, rets = 0.0, []
+            for r, d in zip(rewards, dones):
+                ret = ret * gamma + r
+                rets.append(ret)
+                if d:
+                    ret = 0.0
+            train_env.ret_rms.update(np.asarray(rets))
+        if train_env.norm_reward:
+            scaled = np.clip(rewards / np.sqrt(train_env.ret_rms.var + train_env.epsilon),
+                             -train_env.clip_reward, train_env.clip_reward)
+    targets, g = np.zeros(len(scaled)), 0.0
+    for i in range(len(scaled) - 1, -1, -1):  # discounted return to the episode's end
+        g = scaled[i] + gamma * (0.0 if dones[i] else g)
+        targets[i] = g
+    policy = model.policy
+    opt = torch.optim.Adam(policy.parameters(), lr=float(config["bc_lr"]))
+    x_t = torch.as_tensor(np.asarray(obs, np.float32))
+    y_t = torch.as_tensor(ys)
+    v_t = torch.as_tensor(targets, dtype=torch.float32)
+    gen = torch.Generator().manual_seed(seed)
+    weight = torch.ones(y_t.shape[1])
+    weight[GAZE_BLOCK] = float(config["bc_gaze_weight"])  # the gaze block's share of the imitation loss
+    losses = []
+    for _ in range(int(config["bc_epochs"])):
+        order = torch.randperm(len(x_t), generator=gen)
+        total = 0.0
+        for start in range(0, len(order), 256):
+            idx = order[start : start + 256]
+            dist = policy.get_distribution(x_t[idx])
+            loss_pi = (weight * (dist.distribution.mean - y_t[idx]) ** 2).mean()
+            loss_v = ((policy.predict_values(x_t[idx]).flatten() - v_t[idx]) ** 2).mean()
+            loss = loss_pi + 0.5 * loss_v
+            opt.zero_grad()
+            loss.backward()
+            opt.step()
+            total += float(loss_pi.detach()) * len(idx)
+        losses.append(total / len(order))
+    return losses
 
 
 def run_meta(model, train_env, config: dict, args: Args, wall_s: float) -> dict:
@@ -287,6 +511,9 @@ def run_meta(model, train_env, config: dict, args: Args, wall_s: float) -> dict:
     if config.get("gaze_action", "free") != "free":  # old metas have no key: free gaze
         meta["gaze_action"] = config["gaze_action"]
         meta["gaze_residual_deg"] = float(config["gaze_residual_deg"])
+    for key in ("gaze_log_std_init", "eye_head_log_std_init"):  # training only: a block's initial action std
+        if config.get(key) is not None:
+            meta[key] = float(config[key])
     if isinstance(train_env, VecNormalize) and config["normalize_obs"]:
         meta["obs_mean"] = train_env.obs_rms.mean.tolist()
         meta["obs_var"] = train_env.obs_rms.var.tolist()
@@ -324,7 +551,11 @@ def main(argv=None) -> Path:
     hand = {"hand_action": config["hand_action"], "residual_m": float(config["intercept_residual_m"]),
             "gaze_action": config["gaze_action"], "gaze_residual_deg": float(config["gaze_residual_deg"])}
     train_env = DummyVecEnv([make_env_fn(args.env, config["env_kwargs"], config["belief"], args.seed + i,
-                                         float(config.get("intercept_shaping", 0.0)), **hand) for i in range(n_envs)])
+                                         float(config.get("intercept_shaping", 0.0)), **hand,
+                                         gaze_shaping=float(config.get("gaze_shaping", 0.0)),
+                                         vergence_shaping=float(config.get("vergence_shaping", 0.0)),
+                                         eye_centre_shaping=float(config.get("eye_centre_shaping", 0.0)))
+                             for i in range(n_envs)])
     eval_env = DummyVecEnv([make_env_fn(args.env, {}, config["belief"], 10_000 + args.seed, **hand)])
     if config["normalize_obs"] or config["normalize_reward"]:
         train_env = VecNormalize(train_env, norm_obs=config["normalize_obs"], norm_reward=config["normalize_reward"],
@@ -352,6 +583,19 @@ def main(argv=None) -> Path:
         model = PPO("MlpPolicy", train_env, **common)
     else:
         raise SystemExit(f"algo must be PPO or RecurrentPPO, got {config['algo']!r}")
+    set_block_log_std(model, GAZE_BLOCK, config.get("gaze_log_std_init"))
+    set_block_log_std(model, EYE_HEAD_BLOCK, config.get("eye_head_log_std_init"))
+    if int(config.get("bc_episodes", 0)) > 0:
+        t0 = time.time()
+        bc = behaviour_clone(model, train_env, make_env_fn(args.env, config["env_kwargs"], config["belief"],
+                             args.seed, float(config.get("intercept_shaping", 0.0)), **hand,
+                             gaze_shaping=float(config.get("gaze_shaping", 0.0)),
+                             vergence_shaping=float(config.get("vergence_shaping", 0.0)),
+                             eye_centre_shaping=float(config.get("eye_centre_shaping", 0.0))),
+                             config, args.seed, run_dir / "bc.json")
+        print(f"behaviour cloning: {bc['transitions']} teacher transitions ({bc['teacher_catches']}/{bc['episodes']} "
+              f"caught), policy MSE {bc['policy_mse_per_epoch'][0]:.4f} -> {bc['policy_mse_per_epoch'][-1]:.4f}, "
+              f"{time.time() - t0:.0f} s", flush=True)
     model.set_logger(configure(str(run_dir), ["csv", "tensorboard"]))
 
     # 3. Callbacks: evaluation on the registered env (with the training normalisation), checkpoints,
