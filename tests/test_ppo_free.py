@@ -82,7 +82,7 @@ def test_bad_gaze_options_are_refused_with_the_option_named():
         BeliefFeatures("EyeCatch-v0", "absolute", gaze_action="free_belief")
     with pytest.raises(train.TrainArgumentError, match=r"--gaze-action must be one of .*free_belief"):
         train.check_args(train.parse_args(["--env", "EyeCatch-v0", "--gaze-action", "belief"]))
-    with pytest.raises(train.TrainArgumentError, match=r"--recipe must be one of \['free_belief', 'free_belief_bc'\], got 'nope'"):
+    with pytest.raises(train.TrainArgumentError, match=r"--recipe must be one of \['free_belief', 'free_belief_bc', 'free_clone_stones'\], got 'nope'"):
         train.load_config(train.parse_args(["--env", "EyeCatch-v0", "--recipe", "nope"]))
     for key in ("gaze_log_std_init", "eye_head_log_std_init"):
         for bad in ("yes", "5", "-11", "[1]"):

@@ -248,9 +248,23 @@ def load_config(args: Args) -> dict:
         v = config[key]
         if isinstance(v, bool) or not isinstance(v, (int, float)) or not low <= v <= high:
             raise TrainArgumentError(f"{key} must be a number in [{low}, {high}], got {v!r}")
-    if config["bc_episodes"] and config["gaze_action"] != "free_belief":
-        raise TrainArgumentError(f"bc_episodes needs gaze_action=free_belief (the LookTeacher's inputs), "
-                                 f"got gaze_action={config['gaze_action']}")
+    config.setdefault("bc_teacher", None)
+    teacher = config["bc_teacher"]
+    if teacher is not None:  # an agent spec (e.g. lookahead on SteppingStones-v0), fed the env's own observation
+        from visuomotor_gym.agents import check_agent_family
+
+        if not isinstance(teacher, str) or not teacher:
+            raise TrainArgumentError(f"bc_teacher must be null or an agent spec (e.g. 'lookahead'), got {teacher!r}")
+        if config["belief"] or config["gaze_action"] != "free":
+            raise TrainArgumentError(f"bc_teacher={teacher!r} needs the env's own observation and action "
+                                     f"(belief: false, gaze_action: free)")
+        try:
+            check_agent_family(teacher, args.env)
+        except (ValueError, KeyError) as exc:
+            raise TrainArgumentError(f"bc_teacher={teacher!r}: {exc}".replace("\n", " ")) from None
+    elif config["bc_episodes"] and config["gaze_action"] != "free_belief":
+        raise TrainArgumentError(f"bc_episodes needs gaze_action=free_belief (the LookTeacher's inputs) or a "
+                                 f"bc_teacher agent spec, got gaze_action={config['gaze_action']}")
     for key, what in (("gaze_shaping", "reward per rad of the ball off the line of sight"),
                       ("vergence_shaping", "reward per unit of |ln(fixation / ball distance)|"),
                       ("eye_centre_shaping", "reward per rad of the eye's angle in the head")):
@@ -386,10 +400,19 @@ def behaviour_clone(model, train_env, env_fn, config: dict, seed: int, log: Path
 
     rng = np.random.default_rng(seed)
     env = env_fn()
-    inner = env
-    while not isinstance(inner, BeliefObservation):
-        inner = inner.env
-    teacher = LookTeacher(inner.features)
+    agent = None
+    if config.get("bc_teacher"):  # a registered agent on the env's own flat observation (stateful: it sees
+        from visuomotor_gym.agents import make_agent  # every observation of the episode, in order)
+
+        agent = make_agent(config["bc_teacher"], env.unwrapped.spec.id, int(env.action_space.shape[0]), seed=seed)
+
+        def teacher(x):
+            return np.asarray(agent.predict(x, deterministic=True)[0], np.float32)
+    else:
+        inner = env
+        while not isinstance(inner, BeliefObservation):
+            inner = inner.env
+        teacher = LookTeacher(inner.features)
     noise = float(config["bc_noise"])
     gamma = float(config["gamma"])
     policy = model.policy
@@ -401,6 +424,8 @@ def behaviour_clone(model, train_env, env_fn, config: dict, seed: int, log: Path
         xs, ys, rewards, dones, caught = [], [], [], [], 0
         for episode in range(n_episodes):
             x, _ = env.reset(seed=first_seed + episode)
+            if agent is not None and hasattr(agent, "reset"):
+                agent.reset()
             done = False
             while not done:
                 a = teacher(x)
@@ -430,6 +455,7 @@ def behaviour_clone(model, train_env, env_fn, config: dict, seed: int, log: Path
     env.close()
     info = {"episodes": int(config["bc_episodes"]), "dagger_rounds": int(config["bc_dagger_rounds"]),
             "rounds": rounds, "transitions": sum(r["transitions"] for r in rounds),
+            "teacher": config.get("bc_teacher") or "LookTeacher",
             "teacher_catches": rounds[0]["caught"], "noise": noise, "epochs": int(config["bc_epochs"]),
             "lr": float(config["bc_lr"]), "policy_mse_per_epoch": [round(v, 6) for v in losses]}
     log.write_text(json.dumps(info, indent=1))
