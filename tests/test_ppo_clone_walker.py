@@ -6,8 +6,9 @@ import json
 import gymnasium as gym
 import numpy as np
 import pytest
-from visuomotor_gym.agents import make_agent
 from visuomotor_gym.baselines.ppo import train
+
+from visuomotor_gym.agents import make_agent
 
 RECIPE = ["--env", "SteppingStones-v0", "--recipe", "free_clone_stones"]
 
