@@ -80,8 +80,8 @@ class DodgeBeliefMPCParams(FajenWarrenParams):
     # closest first). The candidates are the pedestrians fajen_warren would look at (approaching or ahead,
     # within its gaze bearing limit: relevant_only), closest first after dividing the distance by the
     # weight; a pedestrian whose predicted closest approach is within avoid_distance_m + 0.5 m has its
-    # uncertainty weighted by 1 + threat_weight * (1 + 2 / (1 + t_ca)) (fajen_warren's threat factor,
-    # growing as the closest approach nears). Modelling choice, on ObstacleDodge-v0 seeds 0-59:
+    # uncertainty weighted by 1 + threat_weight * (1 + 2 / (1 + t_ca)) (fajen_warren's threat urgency,
+    # FajenWarrenAgent._threat_urgency, growing as the closest approach nears). Modelling choice, on ObstacleDodge-v0 seeds 0-59:
     # threat_weight 0 43/60, 3 44/60, 3 with relevant_only 50/60, 10 with relevant_only 55/60; seeds 60-119:
     # 10 49/60, 30 47/60 (fajen_warren: 55 and 54).
     threat_weight: float = 10.0
@@ -190,8 +190,7 @@ class DodgeBeliefMPCAgent(FajenWarrenAgent):
             f = self.filters[k]
             if p.relevant_only and not (relevant and self._ahead(f)):
                 continue
-            weight[k] = 1.0 + (p.threat_weight * (1.0 + 2.0 / (1.0 + tca))
-                               if relevant and dmin < p.avoid_distance_m + 0.5 else 0.0)
+            weight[k] = 1.0 + p.threat_weight * self._threat_urgency(tca, dmin, relevant)
             P = f.P
             sig = np.array([(P[0, 0] + P[1, 1]) / 2, (P[2, 2] + P[3, 3]) / 2, (P[0, 2] + P[1, 3]) / 2])
             objs.append((float(np.hypot(f.x[0] - eye[0], f.x[1] - eye[1])) / weight[k], ("ped", k),
@@ -209,7 +208,7 @@ class DodgeBeliefMPCAgent(FajenWarrenAgent):
         pos0 = np.stack([o[2] for o in objs])
         vel = np.stack([o[3] for o in objs])
         sig0 = np.stack([o[4] for o in objs])
-        self._weights = np.array([weight.get(key[1], 1.0) if key[0] == "ped" else 1.0 for key in keys])
+        weights = np.array([weight.get(key[1], 1.0) if key[0] == "ped" else 1.0 for key in keys])
         # the object the line of sight is on now
         rel = pos0 - eye
         ang = np.arccos(np.clip(rel @ gaze / np.linalg.norm(rel, axis=1), -1.0, 1.0))
@@ -223,7 +222,7 @@ class DodgeBeliefMPCAgent(FajenWarrenAgent):
         if p.min_fixation_s > 0.0 and not self._in_saccade and self.choice in keys and t - self._landed < p.min_fixation_s:
             current = keys.index(self.choice)  # the fixation is held for its minimum duration
             hold = int(math.ceil((p.min_fixation_s - (t - self._landed)) / p.plan_dt_s - 1e-9))
-        best = self._plan(eye, gaze, pos0, vel, sig0, current, hold)
+        best = self._plan(eye, gaze, pos0, vel, sig0, weights, current, hold)
         self.choice = keys[best]
         self.choice_point = pos0[best]
         self.plan_log.append({"t": t, "target": self.choice, "candidates": keys})
@@ -246,7 +245,7 @@ class DodgeBeliefMPCAgent(FajenWarrenAgent):
         return look_action((ex, ey, ez), (tx, ty, tz), odo[2], rot, self.gaze_range, p.look_head_share,
                            verge=p.verge and self.vision.depth_pedestal_arcmin is not None)
 
-    def _plan(self, eye, gaze, pos0, vel, sig0, current: int, hold: int = 0) -> int:
+    def _plan(self, eye, gaze, pos0, vel, sig0, weights, current: int, hold: int = 0) -> int:
         p = self.params
         n, h, m = self.n_nodes, p.plan_dt_s, len(pos0)
         tk = (np.arange(n) + 0.5) * h
@@ -287,7 +286,7 @@ class DodgeBeliefMPCAgent(FajenWarrenAgent):
         q = p.alpha_per_s * h
         for k in range(n):
             sp, sv, spv = compact_step_information(sp, sv, spv, W[k], h, q)
-            cost += p.w_uct * np.sum(self._weights * (sp * sp + sv * sv + spv * spv), axis=1)
+            cost += p.w_uct * np.sum(weights * (sp * sp + sv * sv + spv * spv), axis=1)
         return int(S.targets[int(np.argmin(cost)), 0])
 
 

@@ -654,8 +654,9 @@ class FajenWarrenAgent:
                 continue
             age = min(t - f.t_seen, 3.0)
             w = 1.0 if relevant else 0.1
-            if relevant and dmin < p.avoid_distance_m + 0.5:
-                w *= 3.0 * (1.0 + 2.0 / (1.0 + tca))
+            urgency = self._threat_urgency(tca, dmin, relevant)
+            if urgency:
+                w *= 3.0 * urgency
             vel_std = math.sqrt(max(0.5 * (f.P[2, 2] + f.P[3, 3]), 0.0))
             u = age + 0.05 + p.vel_std_weight * vel_std
             if self.vision.periphery_on:  # the position too: depth from far in the periphery is poor
@@ -676,6 +677,14 @@ class FajenWarrenAgent:
                 self.scanned[best[1]] = t
                 self.search_turn[best[1]] += 1
         return self.target
+
+    def _threat_urgency(self, tca: float, dmin: float, relevant: bool) -> float:
+        """How urgent a pedestrian on a near collision course is: ``1 + 2 / (1 + t_ca)`` (growing as the
+        closest approach, ``tca`` s away, nears) when it is relevant and its predicted closest distance
+        ``dmin`` is within ``avoid_distance_m`` + 0.5 m; 0 otherwise (modelling choice)."""
+        if relevant and dmin < self.params.avoid_distance_m + 0.5:
+            return 1.0 + 2.0 / (1.0 + tca)
+        return 0.0
 
     def _ahead(self, f: PedestrianFilter) -> bool:
         """Whether the estimate of ``f`` lies within ``gaze_bearing_limit_deg`` of the walker's heading."""

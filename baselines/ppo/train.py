@@ -234,20 +234,7 @@ def load_config(args: Args) -> dict:
     config.setdefault("intercept_residual_m", 0.15)
     config.setdefault("gaze_action", "free")
     config.setdefault("gaze_residual_deg", 3.0)
-    config.setdefault("gaze_log_std_init", None)
-    config.setdefault("eye_head_log_std_init", None)
-    for key, default, low, high in (("bc_episodes", 0, 0, 100_000), ("bc_epochs", 20, 1, 10_000),
-                                    ("bc_dagger_rounds", 0, 0, 100)):
-        config.setdefault(key, default)
-        v = config[key]
-        if isinstance(v, bool) or not isinstance(v, int) or not low <= v <= high:
-            raise TrainArgumentError(f"{key} must be an integer in [{low}, {high}], got {v!r}")
-    for key, default, low, high in (("bc_noise", 0.02, 0.0, 1.0), ("bc_lr", 1e-3, 1e-6, 1.0),
-                                    ("bc_gaze_weight", 1.0, 0.0, 1000.0)):
-        config.setdefault(key, default)
-        v = config[key]
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not low <= v <= high:
-            raise TrainArgumentError(f"{key} must be a number in [{low}, {high}], got {v!r}")
+    _check_numbers(config)
     config.setdefault("bc_teacher", None)
     teacher = config["bc_teacher"]
     if teacher is not None:  # an agent spec (e.g. lookahead on SteppingStones-v0), fed the env's own observation
@@ -265,21 +252,9 @@ def load_config(args: Args) -> dict:
     elif config["bc_episodes"] and config["gaze_action"] != "free_belief":
         raise TrainArgumentError(f"bc_episodes needs gaze_action=free_belief (the LookTeacher's inputs) or a "
                                  f"bc_teacher agent spec, got gaze_action={config['gaze_action']}")
-    for key, what in (("gaze_shaping", "reward per rad of the ball off the line of sight"),
-                      ("vergence_shaping", "reward per unit of |ln(fixation / ball distance)|"),
-                      ("eye_centre_shaping", "reward per rad of the eye's angle in the head")):
-        config.setdefault(key, 0.0)
-        w = config[key]
-        if isinstance(w, bool) or not isinstance(w, (int, float)) or not 0.0 <= w <= 100.0:
-            raise TrainArgumentError(f"{key} must be a number in [0, 100] ({what}), got {w!r}")
     if config["gaze_action"] not in CHOICES["gaze_action"][1:]:
         raise TrainArgumentError(f"gaze_action must be one of {list(CHOICES['gaze_action'][1:])}, "
                                  f"got {config['gaze_action']!r}")
-    for key in ("gaze_log_std_init", "eye_head_log_std_init"):
-        g = config[key]
-        if g is not None and (isinstance(g, bool) or not isinstance(g, (int, float)) or not -10.0 <= g <= 2.0):
-            raise TrainArgumentError(f"{key} must be null or a number in [-10, 2] (log of the block's initial "
-                                     f"action std), got {g!r}")
     if config["gaze_action"] != "free" and config["hand_action"] != "intercept":
         raise TrainArgumentError(f"gaze_action={config['gaze_action']} needs hand_action=intercept (and the belief features)")
     if config["hand_action"] not in ("absolute", "intercept"):
@@ -288,6 +263,37 @@ def load_config(args: Args) -> dict:
         raise TrainArgumentError("hand_action=intercept needs the belief features (belief: true): the residual is "
                          "relative to the belief's interception point")
     return config
+
+
+# The recipes' numeric options: (key, default, (low, high), integer, null allowed, what it is), checked by
+# _check_numbers before anything is built.
+NUMERIC_OPTIONS = (
+    ("bc_episodes", 0, (0, 100_000), True, False, ""),
+    ("bc_epochs", 20, (1, 10_000), True, False, ""),
+    ("bc_dagger_rounds", 0, (0, 100), True, False, ""),
+    ("bc_noise", 0.02, (0.0, 1.0), False, False, ""),
+    ("bc_lr", 1e-3, (1e-6, 1.0), False, False, ""),
+    ("bc_gaze_weight", 1.0, (0.0, 1000.0), False, False, ""),
+    ("gaze_shaping", 0.0, (0, 100), False, False, "reward per rad of the ball off the line of sight"),
+    ("vergence_shaping", 0.0, (0, 100), False, False, "reward per unit of |ln(fixation / ball distance)|"),
+    ("eye_centre_shaping", 0.0, (0, 100), False, False, "reward per rad of the eye's angle in the head"),
+    ("gaze_log_std_init", None, (-10, 2), False, True, "log of the block's initial action std"),
+    ("eye_head_log_std_init", None, (-10, 2), False, True, "log of the block's initial action std"),
+)
+
+
+def _check_numbers(config: dict) -> None:
+    """Fill in the defaults of :data:`NUMERIC_OPTIONS` and refuse a value of the wrong kind or out of range,
+    naming the option."""
+    for key, default, (low, high), integer, nullable, what in NUMERIC_OPTIONS:
+        config.setdefault(key, default)
+        v = config[key]
+        if nullable and v is None:
+            continue
+        if isinstance(v, bool) or not isinstance(v, int if integer else (int, float)) or not low <= v <= high:
+            kind = ("null or " if nullable else "") + ("an integer" if integer else "a number")
+            note = f" ({what})" if what else ""
+            raise TrainArgumentError(f"{key} must be {kind} in [{low}, {high}]{note}, got {v!r}")
 
 
 class InterceptShaping:
@@ -388,8 +394,9 @@ def set_block_log_std(model, block: slice, value) -> None:
 
 
 def behaviour_clone(model, train_env, env_fn, config: dict, seed: int, log: Path) -> dict:
-    """Warm start (training only): play ``bc_episodes`` throws of the training env with the scripted
-    :class:`~visuomotor_gym.baselines.ppo.belief.LookTeacher` (its actions plus Gaussian noise of std
+    """Warm start (training only): play ``bc_episodes`` episodes of the training env with the teacher, the
+    scripted :class:`~visuomotor_gym.baselines.ppo.belief.LookTeacher` or, with ``bc_teacher``, that registered
+    agent fed the env's own observations in order (its actions plus Gaussian noise of std
     ``bc_noise`` for state coverage; labels are the teacher's clean actions), fold their observations and
     returns into the VecNormalize statistics, then fit the policy's mean action (MSE) and its value
     (discounted normalised shaped return, MSE) for ``bc_epochs`` epochs with Adam (lr ``bc_lr``). PPO then
