@@ -27,9 +27,10 @@ def _model():
     return mujoco.MjModel.from_xml_path(str(asset_path(sn.SCENE)))
 
 
-def _bare_stance(force_n: float, duration_s: float = pr.PUSH_DURATION_S, seconds: float = 3.0):
-    """The standing body with its leg and arm servos holding still, a push toward the wall (-y) on the
-    torso at t = 1 s: (fell, largest pelvis roll in rad)."""
+def _bare_stance(force_n: float, duration_s: float = pr.PUSH_DURATION_S, seconds: float = 3.0,
+                 direction: tuple = (0.0, -1.0)):
+    """The standing body with its leg and arm servos holding still, a push toward the wall (``direction``, -y by
+    default) on the torso at t = 1 s: (fell, largest pelvis roll in rad)."""
     m = _model()
     d = mujoco.MjData(m)
     body = sn.StandingBody(m, HandControlParams(), 0.02)
@@ -41,7 +42,8 @@ def _bare_stance(force_n: float, duration_s: float = pr.PUSH_DURATION_S, seconds
     while d.time < seconds:
         d.ctrl[body._leg_act] = sn.STANCE_RAD
         d.ctrl[body._act] = 0.0  # the arm and waist hold their setpoints
-        d.xfrc_applied[torso, :3] = (0.0, -force_n, 0.0) if 1.0 <= d.time < 1.0 + duration_s else (0.0, 0.0, 0.0)
+        push = (direction[0] * force_n, direction[1] * force_n, 0.0)
+        d.xfrc_applied[torso, :3] = push if 1.0 <= d.time < 1.0 + duration_s else (0.0, 0.0, 0.0)
         mujoco.mj_step(m, d)
         r = d.xmat[body.pelvis]
         roll = max(roll, math.atan2(float(r[7]), float(r[8])))
@@ -682,3 +684,54 @@ def test_no_observation_leak_of_the_wall_before_the_push(monkeypatch, vision):
     assert percepts_differ  # the two walls are seen differently (both rungs see them before the push)
     a.close()
     b.close()
+
+
+def test_a_wall_in_front_is_the_side_wall_turned_about_the_body_axis_and_drawn_last(monkeypatch):
+    """WALL_FRONT_P (opt-in, tenth pass): the same seed with the front draw forced is its side wall turned by
+    -side x 90 deg about the vertical through the stance origin (faces and push), every other draw unchanged;
+    off, the front draw is not made (the definition's scenes); at 1/3 about a third of the walls stand in front."""
+    env = gym.make(ENV)
+    task = env.unwrapped.task
+    monkeypatch.setattr(pr, "WALL_FRONT_P", 0.0)
+    env.reset(seed=3)
+    faces, push, side, t0 = task.block_faces.copy(), task.push_dir.copy(), task.wall_side, task.push_time
+    assert not task.wall_front
+    monkeypatch.setattr(pr, "WALL_FRONT_P", 1.0)
+    env.reset(seed=3)
+    assert task.wall_front and task.wall_side == side and task.push_time == t0
+    a = -side * 0.5 * math.pi
+    turn = np.array([[math.cos(a), -math.sin(a), 0.0], [math.sin(a), math.cos(a), 0.0], [0.0, 0.0, 1.0]])
+    np.testing.assert_allclose(task.block_faces, faces @ turn.T, atol=1e-12)
+    np.testing.assert_allclose(task.push_dir, turn @ push, atol=1e-12)
+    assert task.push_dir[0] > 0.8  # from behind, toward the wall ahead
+    monkeypatch.setattr(pr, "WALL_FRONT_P", 1.0 / 3.0)
+    fronts = 0
+    for s in range(60):
+        env.reset(seed=s)
+        fronts += task.wall_front
+    assert 10 <= fronts <= 30
+
+
+def test_the_forward_push_tips_the_bare_stance_over():
+    """The task's weakest push turned forward (a wall in front, tenth pass) tips the bare stance too, and a push
+    of half that force does not (the stance holds on its own: the fall is the push's)."""
+    assert _bare_stance(pr.PUSH_FORCE_N[0], direction=(1.0, 0.0))[0]
+    assert not _bare_stance(0.5 * pr.PUSH_FORCE_N[0], direction=(1.0, 0.0))[0]
+
+
+def test_eom_brace_reads_a_wall_in_front_from_the_cubes_lines_of_sight():
+    """front_wall: the line fitted through the cubes' lines of sight cut at the prior height: a row across the
+    body's path (normal ahead) is in front, a row along its side is not; off, never."""
+    from baselines.eom_brace.agent import PRIOR_FACE_Z_M, EomBraceAgent, EomBraceParams
+
+    eye = np.array([0.05, 0.0, 0.7])
+    for row, front in (([(0.7, y) for y in (-0.3, 0.1, 0.5, 0.9)], True),
+                       ([(x, -0.7) for x in (-0.2, 0.2, 0.6, 1.0)], False)):
+        for on in (True, False):
+            ag = EomBraceAgent(EomBraceParams(front_wall=on))
+            for i, (x, y) in enumerate(row):
+                u = np.array([x, y, PRIOR_FACE_Z_M]) - eye
+                ag._los[i] = u / np.linalg.norm(u)
+                ag._los_eye[i] = eye
+                ag._los_n[i] = 1
+            assert ag._front_from_lines() is (front and on)

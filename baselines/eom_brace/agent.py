@@ -73,6 +73,19 @@ SHOULDER = np.array([0.0, -0.2, 0.4])  # right shoulder, stance frame (envs_asse
 # (any sample, at any eccentricity: the human field reaches 100 deg to each side, Spector 1990); SIDE_SAMPLES
 # samples decide it (modelling choice); once the push is detected, the fall's direction (vestibular) decides.
 SIDE_SAMPLES = 2
+# A wall in front (PushRecovery's tenth pass: tasks.push_recovery.WALL_FRONT_P): the right-wall constants turned 90 deg
+# to the front (the scan's point, the expected normal; the shoulders and hands stay where they are). Before the push
+# the place is read from the cubes' lines of sight: once PLACE_CUBES cubes have been sampled (at any eccentricity),
+# each is put where its mean line of sight meets the height PRIOR_FACE_Z_M (stance frame: the middle of the task's
+# 1.00-1.35 m, a person standing by a wall knows roughly how high its cubes are), a line is fitted through them on
+# the floor plane, and the wall is in front when that line's normal lies within FRONT_AZIMUTH_DEG of straight ahead
+# (the scene's front normals lie within 30 deg of it, the side walls' 60-90 deg off; checked on 400 scenes with
+# the true lines of sight: 49 deg at most, 54 at least; modelling choices). Once the push is detected, the fall's
+# direction decides, by the same angle. In front the arm is the one whose shoulder's fall line passes nearest the
+# chosen cube.
+PLACE_CUBES = 3
+PRIOR_FACE_Z_M = 0.245  # 1.175 m above the floor, minus the stance origin's 0.93 m
+FRONT_AZIMUTH_DEG = 52.0
 FOOT_HALF_WIDTH_M = 0.045  # envs_assets/push.xml: the foot box's half width
 FOOT_HALF_LENGTH_M = 0.13  # ... and half length (the sole site is at the box's centre)
 SAMPLE_DISTANCE_RANGE_M = (0.2, 2.0)  # samples outside are rejected: the cubes are 0.5-1.5 m from the eye (modelling choice)
@@ -137,6 +150,17 @@ class EomBraceParams:
     fuse_max_ecc_deg: float = 40.0
     reset_ratio: float = 10.0  # a sample this much more precise restarts a cube's mean (modelling choice)
     cop_margin_m: float = 0.01  # CoP within 1 cm of the foot's outer edge: leaving the polygon (modelling choice)
+    # ... and for a fall straight ahead (within FRONT_AZIMUTH_DEG) toward a wall believed in front (tenth pass): CoP within this of
+    # the toes. The stance's forward margin is long (the soles reach 13 cm ahead of the ankles) and a forward push
+    # carries the trunk 0.3-0.5 m toward the wall before the CoP reaches the toes, into a cube at chest height
+    # (measured on the Oracle rung, docs/reproductions/eom.md, tenth pass): modelling choice.
+    front_cop_margin_m: float = 0.3
+    # front_wall (tenth pass, opt-in, with tasks.push_recovery.WALL_FRONT_P > 0): the wall may stand in front (see
+    # PLACE_CUBES); off, it is on a side, as in the registered scene.
+    front_wall: bool = False
+    # ... once the pelvis moves faster than this: the stance settling after the start reaches 0.15 m/s, a push
+    # 0.2-0.5 m/s within 0.1 s (measured; modelling choice).
+    front_fall_speed_m_s: float = 0.25
     unload_fraction: float = 0.05  # or a foot carrying < 5 % of body weight (modelling choice)
     # fall_direction: detect the push from the pelvis's velocity direction (vestibular; once faster than
     # fall_speed_m_s) and the CoP within cop_margin_m of the support polygon's extent along it, then choose the
@@ -218,7 +242,7 @@ class EomBraceParams:
             v = getattr(self, f.name)
             if f.name in ("foveated", "gaze_blind", "use_hand", "verge_on_sample", "fall_direction", "wall_normal",
                           "choose_by_ray", "drop_crowded", "verge_on_ray",
-                          "hand_on_cut", "verify_reach", "depth_search"):
+                          "hand_on_cut", "verify_reach", "depth_search", "front_wall"):
                 if not isinstance(v, bool):
                     raise ValueError(f"EomBraceParams.{f.name} must be true or false, got {v!r}")
             elif f.name == "depth_grid_m":
@@ -308,6 +332,10 @@ class EomBraceAgent:
         self._side_sum = 0.0  # the summed y of the cubes' unit lines of sight (stance frame)
         self._side_n = 0
         self._side_known = False
+        self.front = False  # the wall in front (tenth pass)
+        self._los = np.zeros((N, 3))  # summed unit lines of sight of every sample of each cube (stance frame)
+        self._los_eye = np.zeros((N, 3))  # ... and the eye positions they were seen from
+        self._los_n = np.zeros(N)
         self.shoulder = SHOULDER.copy()
         self.normal = np.array([0.0, -1.0, 0.0])
         self._scan_order = None
@@ -555,11 +583,15 @@ class EomBraceAgent:
                 for i in range(N):
                     if vis[i] > 0.5 and float(pos[i] @ pos[i]) > 0.0:
                         u = pos[i] if pos[i][0] > 0.0 else -pos[i]
-                        self._side_sum += float((r0 @ u)[1]) / max(float(np.linalg.norm(u)), 1e-12)
+                        w = r0 @ u / max(float(np.linalg.norm(u)), 1e-12)
+                        self._side_sum += float(w[1])
                         self._side_n += 1
+                        self._los[i] += w
+                        self._los_eye[i] += e0
+                        self._los_n[i] += 1
                 if self._side_n >= SIDE_SAMPLES and self._side_sum != 0.0:
                     self._side_known = True
-                    self._set_side(1 if self._side_sum > 0.0 else -1)
+                    self._set_side(1 if self._side_sum > 0.0 else -1, self._front_from_lines())
         self._post = {}
 
         # --- detection: the CoP at the support polygon's edge (or a foot unloaded) ---------------------
@@ -582,10 +614,13 @@ class EomBraceAgent:
                 u = vh / speed
                 ext = max(float(u[0] * (f[0] + sx * FOOT_HALF_LENGTH_M) + u[1] * (f[1] + sy * FOOT_HALF_WIDTH_M))
                           for f in feet for sx in (-1, 1) for sy in (-1, 1))
-                if float(u[0] * cop[0] + u[1] * cop[1]) > ext - p.cop_margin_m \
+                ahead = self.front and abs(math.degrees(math.atan2(u[1], u[0]))) < FRONT_AZIMUTH_DEG
+                margin = p.front_cop_margin_m if ahead and speed > p.front_fall_speed_m_s else p.cop_margin_m
+                if float(u[0] * cop[0] + u[1] * cop[1]) > ext - margin \
                         or min(cop[2], cop[3]) < p.unload_fraction:
                     self.detected_at = t
-                    self._set_side(1 if u[1] > 0.0 else -1)
+                    front = p.front_wall and abs(math.degrees(math.atan2(u[1], u[0]))) < FRONT_AZIMUTH_DEG
+                    self._set_side(self.side if front else (1 if u[1] > 0.0 else -1), front)
                     self.normal = u
                     self.events.append((t, "detect"))
         n = self.normal
@@ -666,6 +701,19 @@ class EomBraceAgent:
                             lateral[known.index(self.chosen)] = -1.0  # keep checking it
                 elif p.reach_max_m > 0 and np.any(depth <= p.reach_max_m):
                     lateral = np.where(depth <= p.reach_max_m, lateral, np.inf)
+                if self.front:
+                    # In front: the fall line through either shoulder; the chosen cube's nearer one braces.
+                    base = faces + self.shoulder
+                    other = self._mirror(self.shoulder)
+                    lat2 = np.linalg.norm((base - other) - np.outer((base - other) @ n, n), axis=1)
+                    lat2 = lat2 + (lateral - np.linalg.norm(faces - np.outer(faces @ n, n), axis=1))
+                    j = int(np.argmin(np.minimum(lateral, lat2)))
+                    if lat2[j] < lateral[j] and self.hold is None and self.approach_since is None:
+                        self._set_side(-self.side, True)
+                        left = self.side > 0
+                        hand = obs[_S["left_hand_pos" if left else "hand_pos"]].copy()
+                        hand_speed = float(np.linalg.norm(obs[_S["left_hand_vel" if left else "hand_vel"]]))
+                        lateral = lat2
                 previous = self.chosen
                 self.chosen = known[int(np.argmin(lateral))]
                 if self.chosen != previous:
@@ -758,16 +806,49 @@ class EomBraceAgent:
         return encode(target, brace, gaze, fixation, head, self.gaze_range, left=left)
 
     def _m(self, p: np.ndarray) -> np.ndarray:
-        """A point or direction given for the wall on the right, mirrored (y -> -y) when the wall is on the left."""
-        return p if self.side < 0 else np.array([p[0], -p[1], p[2]])
+        """A point or direction of the scene given for the wall on the right: mirrored (y -> -y) for the wall on the
+        left, turned 90 deg to the front (x, y -> -y, x) for the wall in front."""
+        if self.front:
+            return np.array([-p[1], p[0], p[2]])
+        return p if self.side < 0 else self._mirror(p)
 
-    def _set_side(self, side: int) -> None:
-        """The wall's side (-1 right, +1 left): the shoulder, the hand's ready point and the expected normal."""
-        if side == self.side and self.home is not None:
+    @staticmethod
+    def _mirror(p: np.ndarray) -> np.ndarray:
+        return np.array([p[0], -p[1], p[2]])
+
+    def _front_from_lines(self) -> bool:
+        """Whether the cubes' lines of sight put the wall in front (PLACE_CUBES cubes sampled; see FRONT_AZIMUTH_DEG)."""
+        seen = np.flatnonzero(self._los_n > 0)
+        if not self.params.front_wall or len(seen) < PLACE_CUBES:
+            return self.front
+        pts = []
+        for i in seen:
+            u = self._los[i] / self._los_n[i]
+            e = self._los_eye[i] / self._los_n[i]
+            if u[2] >= -1e-3:
+                continue  # level or above the eye: no cut with the cubes' height
+            pts.append((e + u * ((PRIOR_FACE_Z_M - e[2]) / u[2]))[:2])
+        if len(pts) < PLACE_CUBES:
+            return self.front
+        pts = np.array(pts)
+        c = pts - pts.mean(axis=0)
+        along = np.linalg.eigh(c.T @ c)[1][:, -1]
+        normal = np.array([-along[1], along[0]])
+        if normal @ pts.mean(axis=0) < 0:
+            normal = -normal
+        return abs(math.degrees(math.atan2(normal[1], normal[0]))) < FRONT_AZIMUTH_DEG
+
+    def _set_side(self, side: int, front: bool | None = None) -> None:
+        """The wall's side (-1 right, +1 left: the arm that braces) and whether it stands in front: the shoulder,
+        the hand's ready point and the expected normal."""
+        front = self.front if front is None else bool(front)
+        if side == self.side and front == self.front and self.home is not None:
             return
         self.side = side
-        self.shoulder = self._m(SHOULDER)
-        self.home = self._m(np.array(self.params.hand_ready, dtype=float))
+        self.front = front
+        self.shoulder = SHOULDER if side < 0 else self._mirror(SHOULDER)
+        ready = np.array(self.params.hand_ready, dtype=float)
+        self.home = ready if side < 0 else self._mirror(ready)
         if self.detected_at is None:
             self.normal = self._m(np.array([0.0, -1.0, 0.0]))
             self._look_normal = self.normal.copy()

@@ -5,7 +5,8 @@ The scene (``envs_assets/push.xml``): a pool of :data:`~visuomotor_gym.body.stan
 blocks on mocap bodies, placed and resized per episode in a row beside the body's right side, or with
 :data:`WALL_SIDE_RANDOM` on half the episodes mirrored to its left (the "wall of multiple cube blocks"): the wall's distance, each cube's size, the gaps between them, each
 cube's height and how far it stands out of the wall plane are drawn from the episode's generator.
-There is nothing behind or between the cubes: a hand that lands in a gap or misses an edge goes
+With :data:`WALL_FRONT_P` (opt-in, 0 in the definition) the side's wall is turned to stand in front of the
+body instead. There is nothing behind or between the cubes: a hand that lands in a gap or misses an edge goes
 through, and one that stops short touches nothing. Each cube is a
 :class:`~visuomotor_gym.core.retina.PointTarget` at the **centre of its face toward the body** (where a
 hand can push): the agent knows the blocks only through the eye's samples of these points.
@@ -101,6 +102,16 @@ WALL_YAW_DEG = (0.0, 30.0)
 # The two walls are 180 deg apart, so no one posture of the eye sees both within the foveated agents' trusted
 # eccentricity (modelling choice; docs/reproductions/eom.md, eighth pass).
 WALL_SIDE_RANDOM = True
+# A wall in front (PushRecovery's tenth pass, docs/reproductions/eom.md): with probability WALL_FRONT_P the side's
+# wall, its cubes and the push are turned 90 deg toward the front about the body's vertical axis, drawn after every
+# other draw: the wall's distance from the body's axis, the cubes and every other draw of the seed are the side
+# wall's; the push comes from behind, toward the wall, and the cubes nearest the fall's line stand straight ahead
+# (within ~25 deg of it, where the side walls' stand 60-100 deg to the side). With the side draw 50/50, 1/3 makes
+# the three places (left, right, front) equally likely, so that no one posture of the eye sees the cubes the hand
+# needs on more than one of them well (the ninth pass measured that two places, 180 deg apart, cap the gaze gain
+# near +40: a still eye on one side keeps that side's share). Modelling choice. Opt-in (0 in the definition: the
+# wall on a side only, the ninth pass's scene): the brace on a wall in front does not work yet (eom.md, tenth pass).
+WALL_FRONT_P = 0.0
 
 # --- the outcome -----------------------------------------------------------------------------------
 HOLD_S = 2.5  # upright this long after the push's onset: success (modelling choice; Eom's clip ~2-3 s)
@@ -205,6 +216,8 @@ class PushRecoveryTask(Task):
         yaw = float(rng.uniform(*WALL_YAW_DEG)) * DEG if WALL_YAW_DEG[1] > WALL_YAW_DEG[0] else WALL_YAW_DEG[0] * DEG
         # The side: -1 the right (y < 0), +1 the left, mirrored (drawn last, only with WALL_SIDE_RANDOM).
         self.wall_side = (1 if rng.random() < 0.5 else -1) if WALL_SIDE_RANDOM else -1
+        # The front (drawn last, only with WALL_FRONT_P): the side's scene turned toward the front.
+        self.wall_front = bool(WALL_FRONT_P > 0.0 and rng.random() < WALL_FRONT_P)
         mirror = self.wall_side > 0
         if mirror:
             yaw = -yaw  # the mirrored wall turns forward from the body's left
@@ -212,6 +225,15 @@ class PushRecoveryTask(Task):
         sgn = 1.0 if mirror else -1.0
         normal = np.array([-sgn * math.sin(yaw), sgn * math.cos(yaw), 0.0])  # from the body toward the wall
         along = np.array([math.cos(yaw), math.sin(yaw), 0.0])  # along the wall, forward at yaw 0
+        # The front wall: the side's scene turned by -side x 90 deg about the body's vertical axis (the right wall
+        # turns left, to the front; the left wall turns right).
+        if self.wall_front:
+            turn_by = -self.wall_side * 0.5 * math.pi
+            ct, st = math.cos(turn_by), math.sin(turn_by)
+            normal = np.array([ct * normal[0] - st * normal[1], st * normal[0] + ct * normal[1], 0.0])
+            along = np.array([ct * along[0] - st * along[1], st * along[0] + ct * along[1], 0.0])
+            yaw += turn_by
+            self.wall_yaw = yaw
         self.wall_normal = normal
         quat = (math.cos(0.5 * yaw), 0.0, 0.0, math.sin(0.5 * yaw))
         centres, faces, sizes = [], [], []
