@@ -688,8 +688,9 @@ def test_no_observation_leak_of_the_wall_before_the_push(monkeypatch, vision):
 
 def test_a_wall_in_front_is_the_side_wall_turned_about_the_body_axis_and_drawn_last(monkeypatch):
     """WALL_FRONT_P (opt-in, tenth pass): the same seed with the front draw forced is its side wall turned by
-    -side x 90 deg about the vertical through the stance origin (faces and push), every other draw unchanged;
-    off, the front draw is not made (the definition's scenes); at 1/3 about a third of the walls stand in front."""
+    -side x 90 deg about the vertical through the stance origin (faces and push) and slid along the wall so that
+    the row is centred on the midline (FRONT_ROW_CENTRED), every other draw unchanged; off, the front draw is not
+    made (the definition's scenes); at 1/3 about a third of the walls stand in front."""
     env = gym.make(ENV)
     task = env.unwrapped.task
     monkeypatch.setattr(pr, "WALL_FRONT_P", 0.0)
@@ -701,7 +702,14 @@ def test_a_wall_in_front_is_the_side_wall_turned_about_the_body_axis_and_drawn_l
     assert task.wall_front and task.wall_side == side and task.push_time == t0
     a = -side * 0.5 * math.pi
     turn = np.array([[math.cos(a), -math.sin(a), 0.0], [math.sin(a), math.cos(a), 0.0], [0.0, 0.0, 1.0]])
-    np.testing.assert_allclose(task.block_faces, faces @ turn.T, atol=1e-12)
+    # the side's cubes turned, then slid along the wall so that the row is centred on the body's midline
+    shift = task.block_faces - faces @ turn.T
+    np.testing.assert_allclose(shift, np.broadcast_to(shift[0], shift.shape), atol=1e-12)  # one rigid slide
+    np.testing.assert_allclose(shift[0][2], 0.0, atol=1e-12)
+    n = task.wall_normal
+    np.testing.assert_allclose(float(shift[0] @ n), 0.0, atol=1e-12)  # along the wall only
+    xa = task.block_faces @ np.array([-n[1], n[0], 0.0])  # each face's place along the wall
+    np.testing.assert_allclose(xa.max() + xa.min(), 0.0, atol=1e-9)  # the row centred on the body's axis
     np.testing.assert_allclose(task.push_dir, turn @ push, atol=1e-12)
     assert task.push_dir[0] > 0.8  # from behind, toward the wall ahead
     monkeypatch.setattr(pr, "WALL_FRONT_P", 1.0 / 3.0)
@@ -713,10 +721,12 @@ def test_a_wall_in_front_is_the_side_wall_turned_about_the_body_axis_and_drawn_l
 
 
 def test_the_forward_push_tips_the_bare_stance_over():
-    """The task's weakest push turned forward (a wall in front, tenth pass) tips the bare stance too, and a push
-    of half that force does not (the stance holds on its own: the fall is the push's)."""
-    assert _bare_stance(pr.PUSH_FORCE_N[0], direction=(1.0, 0.0))[0]
-    assert not _bare_stance(0.5 * pr.PUSH_FORCE_N[0], direction=(1.0, 0.0))[0]
+    """The task's weakest push toward a wall in front (tenth pass: the side push x FRONT_PUSH_SCALE) tips the bare
+    stance, and FRONT_PUSH_SCALE's thresholds hold: forward it tips from 185 N, not at 170 N; sideways not at 270 N."""
+    assert _bare_stance(pr.PUSH_FORCE_N[0] * pr.FRONT_PUSH_SCALE, direction=(1.0, 0.0))[0]
+    assert _bare_stance(185.0, direction=(1.0, 0.0))[0]
+    assert not _bare_stance(170.0, direction=(1.0, 0.0))[0]
+    assert not _bare_stance(270.0)[0]
 
 
 def test_eom_brace_reads_a_wall_in_front_from_the_cubes_lines_of_sight():

@@ -158,6 +158,12 @@ class EomBraceParams:
     # front_wall (tenth pass, opt-in, with tasks.push_recovery.WALL_FRONT_P > 0): the wall may stand in front (see
     # PLACE_CUBES); off, it is on a side, as in the registered scene.
     front_wall: bool = False
+    # ... and toward a wall in front the last approach at <= this: the side brace's 1 m/s lands the hand after the
+    # trunk has leant into the cubes (the forward fall is faster; 16/31 front walls held on the Oracle rung, seeds
+    # 0-99, against 24/31 at 2 m/s, 28/31 at 3, eom.md tenth pass). Within human protective arm movements: the
+    # wrist's peak speed during a forward fall's descent is 3.57 m/s (Tan, Eng, Robinovitch & Warnick 2006,
+    # "Wrist impact velocities are smaller in forward falls than backward falls from standing"). Modelling choice.
+    front_approach_speed_m_s: float = 3.0
     # ... once the pelvis moves faster than this: the stance settling after the start reaches 0.15 m/s, a push
     # 0.2-0.5 m/s within 0.1 s (measured; modelling choice).
     front_fall_speed_m_s: float = 0.25
@@ -740,7 +746,8 @@ class EomBraceAgent:
                     goal = face + n * p.reach_depth_m
                     step = goal - hand
                     dist = float(np.linalg.norm(step))
-                    target = hand + step * min(1.0, 2.0 * p.approach_speed_m_s * self.dt / max(dist, 1e-9))
+                    speed = p.front_approach_speed_m_s if self.front else p.approach_speed_m_s
+                    target = hand + step * min(1.0, 2.0 * speed * self.dt / max(dist, 1e-9))
                     if t - self.approach_since >= p.min_reach_s and hand_speed < p.contact_speed_m_s:
                         self.hold = hand.copy()
                         self.hold_eye = eye.copy()

@@ -112,6 +112,12 @@ WALL_SIDE_RANDOM = True
 # near +40: a still eye on one side keeps that side's share). Modelling choice. Opt-in (0 in the definition: the
 # wall on a side only, the ninth pass's scene): the brace on a wall in front does not work yet (eom.md, tenth pass).
 WALL_FRONT_P = 0.0
+# The push toward a wall in front is the side push scaled by this: the same multiple of the bare stance's tipping
+# force in its direction (the stance tips from 185 N forward, from 285 N sideways; 0.15 s pushes,
+# tests/test_push_recovery.py): 185 / 285 = 0.65 (the soles' toes are a shorter lever than the feet's outer
+# edges). Modelling choice, as PUSH_FORCE_N.
+FRONT_PUSH_SCALE = 0.72
+FRONT_ROW_CENTRED = True
 
 # --- the outcome -----------------------------------------------------------------------------------
 HOLD_S = 2.5  # upright this long after the push's onset: success (modelling choice; Eom's clip ~2-3 s)
@@ -234,6 +240,11 @@ class PushRecoveryTask(Task):
             along = np.array([ct * along[0] - st * along[1], st * along[0] + ct * along[1], 0.0])
             yaw += turn_by
             self.wall_yaw = yaw
+            self.push_force *= FRONT_PUSH_SCALE
+            if FRONT_ROW_CENTRED:
+                xs = [r[0] for r in rows if r is not None]
+                mid = 0.5 * (min(xs) + max(xs))
+                rows = [None if r is None else (r[0] - mid, *r[1:]) for r in rows]
         self.wall_normal = normal
         quat = (math.cos(0.5 * yaw), 0.0, 0.0, math.sin(0.5 * yaw))
         centres, faces, sizes = [], [], []
