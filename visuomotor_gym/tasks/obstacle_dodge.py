@@ -468,28 +468,29 @@ class ObstacleDodgeTask(Task):
         ``give_way_bearing_deg``; its facing ``yaw`` when the walker barely moves), the walker is ahead within
         its own frontal half-field (its course's direction within 90 deg of the walker) and its course
         predicts a closest approach under ``give_way_distance_m`` within ``give_way_horizon_s``
-        (:func:`min_predicted_distance`). While its course still does (and the walker is still ahead of it),
-        it walks at :func:`give_way_velocity`; then it takes up its course's velocity again."""
+        (:func:`min_predicted_distance`). While its course still does (wherever the walker is then: a
+        pedestrian that has come alongside or ahead while giving way still knows it is there), it walks at
+        :func:`give_way_velocity`; then it takes up its course's velocity again."""
         d = self.dist
         course = self.crowd.pedestrians[i, 3:5]
         cx, cy = float(course[0]), float(course[1])
-        ahead = -(rx * cx + ry * cy) > 0.0  # the walker within 90 deg of the pedestrian's course
         mpd, closing = min_predicted_distance(rx, ry, cx - ux, cy - uy, d.give_way_horizon_s)
-        threat = ahead and closing and mpd < d.give_way_distance_m
+        threat = closing and mpd < d.give_way_distance_m
+        speed = math.hypot(ux, uy)
+        hx, hy = (ux / speed, uy / speed) if speed > 0.1 else (math.cos(yaw), math.sin(yaw))
         if not self.giving_way[i]:
-            if not threat:
+            ahead = -(rx * cx + ry * cy) > 0.0  # the walker within 90 deg of the pedestrian's course
+            if not (threat and ahead):
                 return
-            speed = math.hypot(ux, uy)
-            hx, hy = (ux / speed, uy / speed) if speed > 0.1 else (math.cos(yaw), math.sin(yaw))
-            bearing = math.degrees(math.acos(max(-1.0, min(1.0, (rx * hx + ry * hy) / (math.hypot(rx, ry) or 1.0)))))
-            if bearing <= d.give_way_bearing_deg:
+            cos_bearing = (rx * hx + ry * hy) / (math.hypot(rx, ry) or 1.0)
+            if math.degrees(math.acos(max(-1.0, min(1.0, cos_bearing)))) <= d.give_way_bearing_deg:
                 return
             self.giving_way[i] = self.gave_way[i] = True
         elif not threat:
             self.giving_way[i] = False
             self.vel[i] = course
             return
-        self.vel[i] = give_way_velocity(rx, ry, cx, cy, ux, uy, d.give_way_distance_m, d.give_way_horizon_s)
+        self.vel[i] = give_way_velocity(rx, ry, cx, cy, ux, uy, hx, hy, d.give_way_distance_m, d.give_way_horizon_s)
 
     # --- observation --------------------------------------------------------------------------
     def observe_leading(self, values: list, samples: list) -> None:
@@ -612,30 +613,41 @@ def min_predicted_distance(rx, ry, vx, vy, horizon: float):
     return mpd, rv < 0.0
 
 
-def give_way_velocity(rx: float, ry: float, cx: float, cy: float, ux: float, uy: float, distance: float,
-                      horizon: float) -> np.ndarray:
-    """The velocity of a pedestrian giving way: of the course ``(cx, cy)`` turned by ``GIVE_WAY_TURNS_DEG``
-    and slowed by ``GIVE_WAY_SPEED_FRACTIONS``, the one nearest the course (the least change: Moussaid,
-    Helbing & Theraulaz 2011, PNAS 108:6884, pedestrians take the direction of least detour free of
-    collisions) whose minimal predicted distance from the walker (at ``-(rx, ry)`` from it, moving at
-    ``(ux, uy)``) over ``horizon`` is at least ``distance``; the one that keeps farthest when none does.
-    Deterministic (ties: the first of the grid, the turns from right to left, the faster first).
+def give_way_velocity(rx: float, ry: float, cx: float, cy: float, ux: float, uy: float, hx: float, hy: float,
+                      distance: float, horizon: float) -> np.ndarray:
+    """The velocity of a pedestrian giving way, at ``(rx, ry)`` from the walker, who moves at ``(ux, uy)``
+    in the direction ``(hx, hy)`` (a unit vector). Of its course ``(cx, cy)`` turned by
+    ``GIVE_WAY_TURNS_DEG`` and slowed by ``GIVE_WAY_SPEED_FRACTIONS``, the one nearest the course (the least
+    change: Moussaid, Helbing & Theraulaz 2011, PNAS 108:6884, pedestrians take the direction of least detour
+    free of collisions) whose minimal predicted distance from the walker over ``horizon`` is at least
+    ``distance`` and which **passes behind the walker** (at the closest approach, behind the walker's
+    frontal plane); without one that passes behind, the nearest the course that keeps the distance; without
+    any, the one that keeps farthest. Deterministic (ties: the first of the grid, the turns from right to
+    left, the faster first).
 
     Sources (module docstring of the crowd): in pedestrian pairs the walker who passes second, behind the
     other, contributes most to the avoidance, slowing down and deviating (Olivier, Marin, Cretual, Berthoz &
     Pettre 2013, Gait Posture 38:751; Knorr et al. 2016, J Exp Psychol Hum Percept Perform: the role-dependent
-    contribution of the one giving way matters most); walkers keep a minimal predicted distance of about 1 m
-    (Olivier et al. 2012); the adjustments combine path and speed at acute crossing angles (Huber et al.
-    2014, PLoS ONE 9:e89589)."""
+    contribution of the one giving way matters most): the overtaker, behind, takes that role; walkers keep a
+    minimal predicted distance of about 1 m (Olivier et al. 2012); the adjustments combine path and speed at
+    acute crossing angles (Huber et al. 2014, PLoS ONE 9:e89589)."""
     turns = np.radians(np.asarray(GIVE_WAY_TURNS_DEG, dtype=float))[:, None]
     frac = np.asarray(GIVE_WAY_SPEED_FRACTIONS, dtype=float)[None, :]
     c, s = np.cos(turns), np.sin(turns)
     vx = (c * cx - s * cy) * frac
     vy = (s * cx + c * cy) * frac
-    mpd, _ = min_predicted_distance(rx, ry, vx - ux, vy - uy, horizon)
+    wx, wy = vx - ux, vy - uy  # relative to the walker
+    mpd, _ = min_predicted_distance(rx, ry, wx, wy, horizon)
+    t = np.clip(-(rx * wx + ry * wy) / np.maximum(wx * wx + wy * wy, 1e-12), 0.0, horizon)
+    behind = (rx + wx * t) * hx + (ry + wy * t) * hy <= 0.0  # at the closest approach
     change = np.hypot(vx - cx, vy - cy)
     ok = mpd >= distance
-    k = int(np.argmin(np.where(ok, change, np.inf))) if ok.any() else int(np.argmax(mpd))
+    for keep in (ok & behind, ok):
+        if keep.any():
+            k = int(np.argmin(np.where(keep, change, np.inf)))
+            break
+    else:
+        k = int(np.argmax(mpd))
     return np.array([float(vx.flat[k]), float(vy.flat[k])])
 
 
