@@ -694,7 +694,9 @@ def test_fajen_warren_dodges_groups_its_held_twin_runs_into():
     """Development seeds (outside the pinned 0-199) where the moving eye reaches the goal and the held eye
     (gaze and head held level at the goal: the human field still sees every pedestrian, far in its
     periphery) collides: looking at the group members is what tells where they are."""
-    seeds = (203, 204, 205)  # the registered definition: the "wide" crowd, the one eye (disarray, angular draw)
+    # the registered definition: the "wide" crowd, the one eye (disarray, angular draw); since the give-way
+    # rule (fourth definition) the held twin reaches the goal on 205, so 207 (the next such seed) replaces it
+    seeds = (203, 204, 207)
     assert _bench("fajen_warren", seeds) == len(seeds)
     assert _bench("gaze_blind:fajen_warren", seeds) == 0
 

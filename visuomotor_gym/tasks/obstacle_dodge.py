@@ -23,6 +23,19 @@ definition). **The env's default crowd is the preset ``"wide"``** (``DEFAULT_CRO
 ``CROWD_PRESETS``): singles and pairs, a new party every 1-2 s, crossing up to 70 deg off the perpendicular
 from 3-8 m to the side, so that the threats come from bearings no single posture of the eye covers.
 
+**Give way** (``CrowdDistribution.give_way``, since ObstacleDodge-v0's fourth definition; on in ``"wide"``, off in
+``"groups"`` and ``"single"``): the pedestrians otherwise walk straight (and veer) whatever the walker does, so one
+overtaking the walker from behind, outside the human field for seconds, would walk into its back, which no eye
+looking ahead can prevent. In real crowds the one who sees the other and passes second, behind it, does most of
+the avoiding (Olivier et al. 2013; Knorr et al. 2016). A pedestrian behind the walker's frontal field (bearing from
+the walker's direction of travel beyond ``give_way_bearing_deg`` = 90 deg), with the walker ahead in its own frontal
+half-field and a minimal predicted distance (Olivier et al. 2012's MPD, axis to axis) under ``give_way_distance_m`` =
+1 m within ``give_way_horizon_s`` = 3 s (Karamouzas, Skinner & Guy 2014), walks at the velocity nearest its course,
+turned and/or slowed, that keeps 1 m and passes behind the walker (:func:`give_way_velocity`), until its course
+keeps 1 m again; then it takes up its course's velocity. It judges the walker's velocity over one step of the
+gait (``GIVE_WAY_WALKER_WINDOW_S``). No random draws: a seed's crowd is the same with the rule on or off and on
+every rung. A veering pedestrian never gives way during its veer.
+
 **Groups** (``CrowdDistribution.group_size`` = (2, 3) in the preset ``"groups"``, (1, 2) in ``"wide"``;
 ``"single"``, ``group_size=(1, 1)``, gives the first definition's crowds;
 :func:`sample_groups`): the same
