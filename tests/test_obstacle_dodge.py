@@ -28,7 +28,9 @@ from visuomotor_gym.tasks.obstacle_dodge import (
     WIDE_ANGLE_DEG,
     WIDE_SIDE_M,
     CrowdDistribution,
+    give_way_velocity,
     intercept_velocity,
+    min_predicted_distance,
     sample_crowd,
 )
 
@@ -445,7 +447,7 @@ def test_wide_preset_draws_its_angles_and_sides_and_one_seed_is_one_crowd_on_eve
     to the side."""
     wide = CROWD_PRESETS["wide"]
     assert wide == CrowdDistribution(angle_deg=WIDE_ANGLE_DEG, side_m=WIDE_SIDE_M, group_size=(1, 2),
-                                      onset_gap_s=(1.0, 2.0)) and wide.groups
+                                      onset_gap_s=(1.0, 2.0), give_way=True) and wide.groups
     assert CrowdDistribution().angle_deg < WIDE_ANGLE_DEG
     angles, sides, lateral, sizes, gaps = [], [], [], [], []
     for seed in range(300):
@@ -692,6 +694,133 @@ def test_fajen_warren_dodges_groups_its_held_twin_runs_into():
     """Development seeds (outside the pinned 0-199) where the moving eye reaches the goal and the held eye
     (gaze and head held level at the goal: the human field still sees every pedestrian, far in its
     periphery) collides: looking at the group members is what tells where they are."""
-    seeds = (203, 204, 205)  # the registered definition: the "wide" crowd, the one eye (disarray, angular draw)
+    # the registered definition: the "wide" crowd, the one eye (disarray, angular draw); since the give-way
+    # rule (fourth definition) the held twin reaches the goal on 205, so 207 (the next such seed) replaces it
+    seeds = (203, 204, 207)
     assert _bench("fajen_warren", seeds) == len(seeds)
     assert _bench("gaze_blind:fajen_warren", seeds) == 0
+
+
+# --- give way (CrowdDistribution.give_way, on in the "wide" preset since the fourth definition) -------------
+# Rows relative to the walker's start (the sampler's 9 columns; no veer). OVERTAKER: beside and behind the
+# walker (bearing 99 deg from its direction of travel), walking its way a little faster and converging: a
+# walker going straight at 1.3 m/s meets it about 3 s later. CROSSER: ahead (bearing 43 deg), crossing the
+# path where the walker arrives at the same time.
+OVERTAKER = (0.0, -0.3, 2.0, 1.4, -0.6, 0.0, 0.0, 0.0, 4.0)
+CROSSER = (0.0, 4.0, 3.7, 0.0, -1.2, 4.0, 0.0, 0.0, 4.0)
+
+
+def _walk_straight_among(row, give_way: bool, steps: int = 300):
+    """The walker going straight at the nominal speed (zero action) with ``row`` as its only pedestrian;
+    returns the pedestrian's positions, the smallest axis-to-axis distance, the last info and the task."""
+    env = ObstacleDodgeEnv(crowd_distribution={"group_size": (1, 1), "give_way": give_way})
+    env.reset(seed=0)
+    sx, sy = env.body.start_xy
+    _set_crowd(env, [(row[0], row[1] + sx, row[2] + sy, *row[3:])] + [LATER] * (N_PEDESTRIANS - 1))
+    task, track, closest, info = env.task, [], math.inf, {}
+    for _ in range(steps):
+        _, _, done, _, info = env.step(np.zeros(7, np.float32))
+        track.append(task.pos[0].copy())
+        closest = min(closest, math.hypot(task.pos[0, 0] - env.data.qpos[0], task.pos[0, 1] - env.data.qpos[1]))
+        if done:
+            break
+    return np.array(track), closest, info, task
+
+
+def test_min_predicted_distance_is_the_closest_approach_within_the_horizon():
+    """Hand-computed: 2 m behind and 1 m to the side, closing at 1 m/s along the path: closest (1 m) after
+    2 s; with a 1 s horizon the closest within it is (-1, 1), 1.414 m; moving apart it is not closing."""
+    assert min_predicted_distance(-2.0, 1.0, 1.0, 0.0, 3.0) == pytest.approx((1.0, True))
+    d, closing = min_predicted_distance(-2.0, 1.0, 1.0, 0.0, 1.0)
+    assert d == pytest.approx(math.sqrt(2.0)) and closing
+    assert min_predicted_distance(-2.0, 1.0, -1.0, 0.0, 3.0) == pytest.approx((math.hypot(2.0, 1.0), False))
+
+
+def test_give_way_velocity_is_the_least_change_that_keeps_the_comfortable_distance():
+    """A course already clear is kept; on a collision course the chosen velocity keeps the distance and
+    passes behind the walker, and no velocity of the grid nearer the course does both (checked against
+    every turn and slowing)."""
+    assert np.allclose(give_way_velocity(-0.3, 5.0, 1.4, 0.0, 1.3, 0.0, 1.0, 0.0, 1.0, 3.0), (1.4, 0.0))
+    rx, ry, cx, cy, ux, uy = -0.3, 2.0, 1.4, -0.6, 1.3, 0.0
+    assert min_predicted_distance(rx, ry, cx - ux, cy - uy, 3.0)[0] < 0.3  # a collision course
+
+    def keeps_and_passes_behind(vx, vy):
+        wx, wy = vx - ux, vy - uy
+        t = min(max(-(rx * wx + ry * wy) / (wx * wx + wy * wy), 0.0), 3.0)
+        return min_predicted_distance(rx, ry, wx, wy, 3.0)[0] >= 1.0 and rx + wx * t <= 0.0
+
+    v = give_way_velocity(rx, ry, cx, cy, ux, uy, 1.0, 0.0, 1.0, 3.0)
+    assert keeps_and_passes_behind(*v) and math.hypot(*v) < math.hypot(cx, cy)  # it slows (here)
+    change = math.hypot(v[0] - cx, v[1] - cy)
+    assert change > 0.1
+    for turn in range(-90, 91, 5):
+        c, s = math.cos(math.radians(turn)), math.sin(math.radians(turn))
+        for frac in np.arange(0.0, 1.01, 0.1):
+            wx, wy = (c * cx - s * cy) * frac, (s * cx + c * cy) * frac
+            if math.hypot(wx - cx, wy - cy) < change - 1e-9:
+                assert not keeps_and_passes_behind(wx, wy)
+
+
+def test_an_overtaking_pedestrian_gives_way_and_resumes_its_course():
+    """Without the rule the overtaker walks into the walker's side; with it, it passes behind the walker at
+    the comfortable distance (1 m axis to axis, Olivier et al. 2012; to 1 cm: the pelvis sways within a step,
+    the pedestrian predicts with the walker's step-averaged velocity) and then walks on at its course's
+    velocity."""
+    dist = CROWD_PRESETS["wide"]
+    assert dist.give_way and dist.give_way_distance_m == 1.0 and dist.give_way_horizon_s == 3.0
+    _, closest, info, task = _walk_straight_among(OVERTAKER, give_way=False)
+    assert info["collided"] and not task.gave_way[0]
+    _, closest, info, task = _walk_straight_among(OVERTAKER, give_way=True)
+    assert not info["collided"] and task.gave_way[0]
+    assert closest >= dist.give_way_distance_m - 0.01
+    assert not task.giving_way[0] and np.allclose(task.vel[0], OVERTAKER[3:5])  # its course again
+
+
+def test_a_pedestrian_crossing_in_front_does_not_give_way():
+    """The walker sees a crosser ahead (bearing 43 deg): the rule leaves it alone, its trajectory identical
+    with and without the rule (here it walks into the walker that neither looks nor steers)."""
+    without, _, info_a, _ = _walk_straight_among(CROSSER, give_way=False)
+    with_rule, _, info_b, task = _walk_straight_among(CROSSER, give_way=True)
+    assert info_a["collided"] and info_b["collided"] and not task.gave_way[0]
+    assert np.array_equal(without, with_rule)
+
+
+def test_a_veering_pedestrian_keeps_veering_with_the_rule_on():
+    """The veer is not a give-way: with ``give_way`` on, every veer of seed 0's crowds (all pedestrians
+    veering) turns onto the same intercept course for 1 s as without it."""
+    veers = []
+    for give_way in (False, True):
+        env = ObstacleDodgeEnv(crowd_distribution={"veer_p": 1.0, "group_size": (1, 1), "give_way": give_way})
+        env.reset(seed=0)
+        vels = []
+        for _ in range(600):
+            env.step(np.zeros(7, np.float32))
+            if env.task.veer_until[0] >= 0.0:
+                vels.append(env.task.vel[0].copy())
+        assert len(vels) > 40 and np.allclose(vels, vels[0])  # one intercept velocity for the whole veer
+        veers.append(np.array(vels))
+    assert veers[0].shape == veers[1].shape and np.allclose(veers[0], veers[1])
+
+
+def test_give_way_is_on_in_wide_only_and_draws_nothing():
+    """On in the env's default "wide", off in "groups" and "single" (their crowds and pedestrians as before);
+    the rule draws nothing: "wide" with and without it draws the same crowds."""
+    assert CROWD_PRESETS["wide"].give_way
+    assert not CROWD_PRESETS["groups"].give_way and not CROWD_PRESETS["single"].give_way
+    assert not CrowdDistribution().give_way
+    off = dataclasses.replace(CROWD_PRESETS["wide"], give_way=False)
+    for seed in range(5):
+        a = sample_crowd(np.random.default_rng(seed), CROWD_PRESETS["wide"])
+        b = sample_crowd(np.random.default_rng(seed), off)
+        assert a.goal == b.goal and np.array_equal(a.pedestrians, b.pedestrians)
+
+
+@pytest.mark.parametrize(("field", "bad"), [("give_way", "yes"), ("give_way", 1), ("give_way_bearing_deg", 200.0),
+                                            ("give_way_bearing_deg", math.nan), ("give_way_distance_m", 0.0),
+                                            ("give_way_distance_m", -1.0), ("give_way_horizon_s", 0.0),
+                                            ("give_way_horizon_s", math.inf)])
+def test_give_way_fields_refuse_bad_values_naming_the_field(field, bad):
+    with pytest.raises((ValueError, TypeError), match=f"CrowdDistribution.{field} must"):
+        CrowdDistribution(**{field: bad})
+    with pytest.raises((ValueError, TypeError), match=f"crowd_distribution.{field} must"):
+        ObstacleDodgeEnv(crowd_distribution={field: bad})

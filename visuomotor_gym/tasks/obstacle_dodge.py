@@ -23,6 +23,19 @@ definition). **The env's default crowd is the preset ``"wide"``** (``DEFAULT_CRO
 ``CROWD_PRESETS``): singles and pairs, a new party every 1-2 s, crossing up to 70 deg off the perpendicular
 from 3-8 m to the side, so that the threats come from bearings no single posture of the eye covers.
 
+**Give way** (``CrowdDistribution.give_way``, since ObstacleDodge-v0's fourth definition; on in ``"wide"``, off in
+``"groups"`` and ``"single"``): the pedestrians otherwise walk straight (and veer) whatever the walker does, so one
+overtaking the walker from behind, outside the human field for seconds, would walk into its back, which no eye
+looking ahead can prevent. In real crowds the one who sees the other and passes second, behind it, does most of
+the avoiding (Olivier et al. 2013; Knorr et al. 2016). A pedestrian behind the walker's frontal field (bearing from
+the walker's direction of travel beyond ``give_way_bearing_deg`` = 90 deg), with the walker ahead in its own frontal
+half-field and a minimal predicted distance (Olivier et al. 2012's MPD, axis to axis) under ``give_way_distance_m`` =
+1 m within ``give_way_horizon_s`` = 3 s (Karamouzas, Skinner & Guy 2014), walks at the velocity nearest its course,
+turned and/or slowed, that keeps 1 m and passes behind the walker (:func:`give_way_velocity`), until its course
+keeps 1 m again; then it takes up its course's velocity. It judges the walker's velocity over one step of the
+gait (``GIVE_WAY_WALKER_WINDOW_S``). No random draws: a seed's crowd is the same with the rule on or off and on
+every rung. A veering pedestrian never gives way during its veer.
+
 **Groups** (``CrowdDistribution.group_size`` = (2, 3) in the preset ``"groups"``, (1, 2) in ``"wide"``;
 ``"single"``, ``group_size=(1, 1)``, gives the first definition's crowds;
 :func:`sample_groups`): the same
@@ -77,6 +90,14 @@ WIDE_ANGLE_DEG = 70.0  # the "wide" preset's crossing angles off the perpendicul
 WIDE_SIDE_M = (3.0, 8.0)  # the "wide" preset's lateral start distances (modelling choice, CROWD_PRESETS)
 WIDE_GROUP_SIZE = (1.0, 2.0)  # the "wide" preset's groups: singles and pairs (CROWD_PRESETS)
 WIDE_ONSET_GAP_S = (1.0, 2.0)  # the "wide" preset's onset gaps (modelling choice, CROWD_PRESETS)
+# Give way (CrowdDistribution.give_way): the velocities a pedestrian giving way chooses from, its course turned by
+# up to 90 deg either way in 5 deg steps and slowed in tenths down to a stop (a turn, a slowing or both: the one
+# who gives way slows down and deviates, Olivier et al. 2013; both adjustments at acute crossing angles, Huber
+# et al. 2014; the grid: modelling choice), and the window over which it judges the walker's velocity (one step
+# of the gait, 0.5 s, so that the pelvis's sway within a step does not count: modelling choice).
+GIVE_WAY_TURNS_DEG = tuple(range(-90, 91, 5))
+GIVE_WAY_SPEED_FRACTIONS = tuple(k / 10.0 for k in range(10, -1, -1))
+GIVE_WAY_WALKER_WINDOW_S = 0.5
 REWARD_TERMS = ("goal", "collision", "progress")
 DEFAULT_REWARD_WEIGHTS = {"goal": 1.0, "collision": -1.0, "progress": 0.0}
 
@@ -102,6 +123,13 @@ CROWD_RULES = {
     # walking abreast, short of a street's width (modelling choice)
     "group_size": lambda v, name: _group_size(v, name),
     "group_spacing_m": Pair(Num(0.0, 5.0, low_open=True)),
+    # give way (since ObstacleDodge-v0's fourth definition): a switch; a bearing beyond which a pedestrian is
+    # behind the walker's frontal field (a half-turn at most); a comfortable distance and a prediction horizon
+    # short of a street's width and of an episode (modelling choices)
+    "give_way": args.Flag(),
+    "give_way_bearing_deg": Num(0.0, 180.0),
+    "give_way_distance_m": Num(0.0, 10.0, low_open=True),
+    "give_way_horizon_s": Num(0.0, 20.0, low_open=True),
 }
 
 
@@ -152,6 +180,23 @@ class CrowdDistribution:
     # modelling choice).
     group_size: tuple[float, float] = (2.0, 3.0)
     group_spacing_m: tuple[float, float] = (0.7, 0.9)
+    # Give way (since ObstacleDodge-v0's fourth definition; off here and in "groups"/"single", on in "wide"):
+    # a pedestrian overtaking the walker from behind its frontal field adapts its velocity to pass at a
+    # comfortable distance, then resumes its course (:func:`give_way_velocity`, sources there). Off: the
+    # pedestrians walk straight (and veer), whatever the walker does, as in the first three definitions.
+    give_way: bool = False
+    # The pedestrian is behind the walker's frontal field: its bearing from the walker's direction of travel
+    # beyond 90 deg, i.e. behind the walker's frontal plane, where it would pass second (behind the walker),
+    # the role that adapts most (Olivier et al. 2013), at the edge of or outside the human field (100 deg to
+    # the side, Spector 1990) and seen, if at all, in its far periphery (the 90 deg: modelling choice)
+    give_way_bearing_deg: float = 90.0
+    # Comfortable distance: walkers adapt only when the minimal predicted distance (MPD, axis to axis) is
+    # under about 1 m, and raise it to about 1 m (Olivier, Marin, Cretual & Pettre 2012, Gait Posture 36:399)
+    give_way_distance_m: float = 1.0
+    # Prediction horizon: pedestrians' interactions vanish beyond a time to collision of about 3 s
+    # (Karamouzas, Skinner & Guy 2014, Phys Rev Lett 113:238701, tau_0 ~ 3 s; "an interaction time
+    # horizon of 2-4 s")
+    give_way_horizon_s: float = 3.0
 
     def __post_init__(self) -> None:
         args.check_fields(self, CROWD_RULES)
@@ -182,7 +227,8 @@ class CrowdDistribution:
 DEFAULT_CROWD = "wide"  # the env's crowd when none is given (see CROWD_PRESETS)
 CROWD_PRESETS = {"groups": CrowdDistribution(), "single": CrowdDistribution(group_size=(1.0, 1.0)),
                  "wide": CrowdDistribution(angle_deg=WIDE_ANGLE_DEG, side_m=WIDE_SIDE_M,
-                                           group_size=WIDE_GROUP_SIZE, onset_gap_s=WIDE_ONSET_GAP_S)}
+                                           group_size=WIDE_GROUP_SIZE, onset_gap_s=WIDE_ONSET_GAP_S,
+                                           give_way=True)}
 
 
 @dataclass(frozen=True)
@@ -337,6 +383,9 @@ class ObstacleDodgeTask(Task):
         self.active = [False] * N_PEDESTRIANS
         self.veer_until = [-1.0] * N_PEDESTRIANS
         self.veered = [False] * N_PEDESTRIANS
+        self.giving_way = [False] * N_PEDESTRIANS  # giving way now (CrowdDistribution.give_way)
+        self.gave_way = [False] * N_PEDESTRIANS  # gave way at some time this episode
+        self._walker_track: list[tuple[float, float]] = []  # the walker's positions, one per control step
         self.seen = [False] * N_PEDESTRIANS
         # Groups: slot k holds the k-th pedestrian the eye has seen (-1: not seen yet), see observe_leading
         self.slot_of = [-1] * N_PEDESTRIANS
@@ -392,6 +441,8 @@ class ObstacleDodgeTask(Task):
         wx, wy = float(data.qpos[0]), float(data.qpos[1])
         wvx, wvy = float(data.qvel[0]), float(data.qvel[1])
         rows = self.crowd.pedestrians
+        if self.dist.give_way:
+            ux, uy = self._walker_velocity(wx, wy, wvx, wvy)
         for i in range(N_PEDESTRIANS):
             if not self.active[i]:
                 continue
@@ -401,12 +452,58 @@ class ObstacleDodgeTask(Task):
                 self.veered[i] = True
                 self.veer_until[i] = t_end + self.dist.veer_s
                 self.vel[i] = intercept_velocity(px, py, float(np.hypot(*row[3:5])), wx, wy, wvx, wvy)
+                self.giving_way[i] = False  # a veer overrides giving way
             elif self.veered[i] and 0.0 <= self.veer_until[i] <= t_end:
                 self.vel[i] = row[3:5]
                 self.veer_until[i] = -1.0
+            if self.dist.give_way and self.veer_until[i] < 0.0:  # never during a veer
+                self._give_way(i, px - wx, py - wy, ux, uy, float(data.qpos[3]))
             self.pos[i] += self.vel[i] * self.dt
             self._write(data, i)
         self._activate(data, t_end)
+
+    def _walker_velocity(self, wx: float, wy: float, wvx: float, wvy: float) -> tuple[float, float]:
+        """The walker's velocity as a pedestrian judges it: its displacement over the last
+        ``GIVE_WAY_WALKER_WINDOW_S`` (one step of the gait; the instantaneous velocity until then)."""
+        n = max(1, round(GIVE_WAY_WALKER_WINDOW_S / self.dt))
+        track = self._walker_track
+        track.append((wx, wy))
+        if len(track) > n + 1:
+            del track[0]
+        if len(track) < n + 1:
+            return wvx, wvy
+        (x0, y0) = track[0]
+        return (wx - x0) / (n * self.dt), (wy - y0) / (n * self.dt)
+
+    def _give_way(self, i: int, rx: float, ry: float, ux: float, uy: float, yaw: float) -> None:
+        """Pedestrian ``i`` (at ``(rx, ry)`` from the walker, who moves at ``(ux, uy)``) starts giving way when
+        it is behind the walker's frontal field (bearing from the walker's direction of travel beyond
+        ``give_way_bearing_deg``; its facing ``yaw`` when the walker barely moves), the walker is ahead within
+        its own frontal half-field (its course's direction within 90 deg of the walker) and its course
+        predicts a closest approach under ``give_way_distance_m`` within ``give_way_horizon_s``
+        (:func:`min_predicted_distance`). While its course still does (wherever the walker is then: a
+        pedestrian that has come alongside or ahead while giving way still knows it is there), it walks at
+        :func:`give_way_velocity`; then it takes up its course's velocity again."""
+        d = self.dist
+        course = self.crowd.pedestrians[i, 3:5]
+        cx, cy = float(course[0]), float(course[1])
+        mpd, closing = min_predicted_distance(rx, ry, cx - ux, cy - uy, d.give_way_horizon_s)
+        threat = closing and mpd < d.give_way_distance_m
+        speed = math.hypot(ux, uy)
+        hx, hy = (ux / speed, uy / speed) if speed > 0.1 else (math.cos(yaw), math.sin(yaw))
+        if not self.giving_way[i]:
+            ahead = -(rx * cx + ry * cy) > 0.0  # the walker within 90 deg of the pedestrian's course
+            if not (threat and ahead):
+                return
+            cos_bearing = (rx * hx + ry * hy) / (math.hypot(rx, ry) or 1.0)
+            if math.degrees(math.acos(max(-1.0, min(1.0, cos_bearing)))) <= d.give_way_bearing_deg:
+                return
+            self.giving_way[i] = self.gave_way[i] = True
+        elif not threat:
+            self.giving_way[i] = False
+            self.vel[i] = course
+            return
+        self.vel[i] = give_way_velocity(rx, ry, cx, cy, ux, uy, hx, hy, d.give_way_distance_m, d.give_way_horizon_s)
 
     # --- observation --------------------------------------------------------------------------
     def observe_leading(self, values: list, samples: list) -> None:
@@ -516,5 +613,57 @@ def intercept_velocity(px: float, py: float, speed: float, wx: float, wy: float,
     return np.array([speed * dx / n, speed * dy / n])
 
 
+def min_predicted_distance(rx, ry, vx, vy, horizon: float):
+    """The minimal predicted distance (Olivier et al. 2012's MPD) of a pedestrian at ``(rx, ry)`` from the
+    walker, moving at ``(vx, vy)`` relative to it, over the next ``horizon`` seconds if both keep their
+    velocities, and whether they are closing in (the distance falling now). Scalars or arrays of ``vx, vy``."""
+    vv = np.asarray(vx, dtype=float) ** 2 + np.asarray(vy, dtype=float) ** 2
+    rv = rx * np.asarray(vx, dtype=float) + ry * np.asarray(vy, dtype=float)
+    t = np.clip(-rv / np.maximum(vv, 1e-12), 0.0, horizon)
+    mpd = np.hypot(rx + vx * t, ry + vy * t)
+    if np.ndim(mpd) == 0:
+        return float(mpd), bool(rv < 0.0)
+    return mpd, rv < 0.0
+
+
+def give_way_velocity(rx: float, ry: float, cx: float, cy: float, ux: float, uy: float, hx: float, hy: float,
+                      distance: float, horizon: float) -> np.ndarray:
+    """The velocity of a pedestrian giving way, at ``(rx, ry)`` from the walker, who moves at ``(ux, uy)``
+    in the direction ``(hx, hy)`` (a unit vector). Of its course ``(cx, cy)`` turned by
+    ``GIVE_WAY_TURNS_DEG`` and slowed by ``GIVE_WAY_SPEED_FRACTIONS``, the one nearest the course (the least
+    change: Moussaid, Helbing & Theraulaz 2011, PNAS 108:6884, pedestrians take the direction of least detour
+    free of collisions) whose minimal predicted distance from the walker over ``horizon`` is at least
+    ``distance`` and which **passes behind the walker** (at the closest approach, behind the walker's
+    frontal plane); without one that passes behind, the nearest the course that keeps the distance; without
+    any, the one that keeps farthest. Deterministic (ties: the first of the grid, the turns from right to
+    left, the faster first).
+
+    Sources (module docstring of the crowd): in pedestrian pairs the walker who passes second, behind the
+    other, contributes most to the avoidance, slowing down and deviating (Olivier, Marin, Cretual, Berthoz &
+    Pettre 2013, Gait Posture 38:751; Knorr et al. 2016, J Exp Psychol Hum Percept Perform: the role-dependent
+    contribution of the one giving way matters most): the overtaker, behind, takes that role; walkers keep a
+    minimal predicted distance of about 1 m (Olivier et al. 2012); the adjustments combine path and speed at
+    acute crossing angles (Huber et al. 2014, PLoS ONE 9:e89589)."""
+    turns = np.radians(np.asarray(GIVE_WAY_TURNS_DEG, dtype=float))[:, None]
+    frac = np.asarray(GIVE_WAY_SPEED_FRACTIONS, dtype=float)[None, :]
+    c, s = np.cos(turns), np.sin(turns)
+    vx = (c * cx - s * cy) * frac
+    vy = (s * cx + c * cy) * frac
+    wx, wy = vx - ux, vy - uy  # relative to the walker
+    mpd, _ = min_predicted_distance(rx, ry, wx, wy, horizon)
+    t = np.clip(-(rx * wx + ry * wy) / np.maximum(wx * wx + wy * wy, 1e-12), 0.0, horizon)
+    behind = (rx + wx * t) * hx + (ry + wy * t) * hy <= 0.0  # at the closest approach
+    change = np.hypot(vx - cx, vy - cy)
+    ok = mpd >= distance
+    for keep in (ok & behind, ok):
+        if keep.any():
+            k = int(np.argmin(np.where(keep, change, np.inf)))
+            break
+    else:
+        k = int(np.argmax(mpd))
+    return np.array([float(vx.flat[k]), float(vy.flat[k])])
+
+
 __all__ = ["CROWD_PRESETS", "DEFAULT_CROWD", "K_SLOTS", "N_PEDESTRIANS", "Crowd", "CrowdDistribution", "ObstacleDodgeTask",
-           "PedestrianTarget", "crowd_preset", "intercept_velocity", "sample_crowd", "sample_groups"]
+           "PedestrianTarget", "crowd_preset", "give_way_velocity", "intercept_velocity", "min_predicted_distance",
+           "sample_crowd", "sample_groups"]
