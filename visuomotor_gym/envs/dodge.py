@@ -53,8 +53,7 @@ class ObstacleDodgeEnv(WalkerEnv):
     1.0-1.5 m/s from up to 70 deg off the perpendicular (nearly head-on, or overtaking obliquely),
     **alone or in pairs** walking abreast 0.7-0.9 m apart (Moussaid et al. 2010); 10 % of them **veer
     onto a collision course** when they come within 3-5 m (Jovancevic, Sullivan & Hayhoe), one member of
-    a pair alone; one **overtaking the walker** from behind its frontal field **gives way**, passing behind
-    it 1 m away (Olivier et al. 2012, 2013). Coming closer to a pedestrian than the two bodies' radii is a **collision** and
+    a pair alone. Coming closer to a pedestrian than the two bodies' radii is a **collision** and
     ends the episode. The pedestrians are seen **only through the eye**: the same oculomotor plant,
     foveated noise (Eyecatch Eq. 1-3), saccadic suppression and VOR as every family, with the **human
     periphery** (``DODGE_VISION``: ``vision.foveation.human_periphery()``): the human
@@ -136,15 +135,12 @@ class ObstacleDodgeEnv(WalkerEnv):
       walks, its held twin in 27.5 %, the best static posture known in 51.0 % (hand-picked among six; the
       search's choice reaches 39.5 %; docs/reproductions/data/terrain/dodge_groups.md). ``crowd_distribution="groups"`` gives back the
       second definition's crowd. Former entries are superseded.
-      Redefined in place a fourth time: overtaking pedestrians **give way** (``CrowdDistribution.give_way``,
-      on in ``"wide"``, off in ``"groups"`` and ``"single"``): one behind the walker's frontal field (beyond 90
-      deg of its direction of travel) whose course would come within 1 m of the walker in the next 3 s turns
-      and/or slows to pass behind it 1 m away, then resumes its course (Olivier et al. 2012, 2013; Karamouzas
-      et al. 2014); the crowds drawn are unchanged. Such overtakers, unseen for seconds, caused 10 of
-      fajen_warren's 19 collisions on the pinned seeds. On the pinned seeds 0-199 fajen_warren reaches the
-      goal in 96.0 % of the walks, its held twin in 37.0 %, the best static posture known in 62.0 % (the
-      same hand-picked posture); the gaze gain falls from +39.5 to +34.0 points
-      (docs/reproductions/data/terrain/dodge_groups.md). Former entries are superseded.
+      Not a redefinition: ``crowd_distribution="wide_give_way"`` (opt-in) makes overtaking pedestrians
+      give way (``CrowdDistribution.give_way``: one behind the walker's frontal field whose course would come
+      within 1 m of it in the next 3 s passes behind it 1 m away; Olivier et al. 2012, 2013). Measured on the
+      pinned seeds: fajen_warren 96.0 %, its held twin 37.0 %, the best static posture known 62.0 %, so the gaze
+      gain would fall from +39.5 to +34.0 points; ``"wide"`` keeps it off
+      (docs/reproductions/data/terrain/dodge_groups.md).
     """
 
     render_cameras: ClassVar[dict[str, tuple[str, ...]]] = {
@@ -163,7 +159,7 @@ class ObstacleDodgeEnv(WalkerEnv):
     argument_meanings = {  # noqa: RUF012  (read only: the generated Arguments table)
         "crowd_distribution": ('``CrowdDistribution``, a dict of its fields, or a preset name: ``"wide"`` (the '
                                'default: singles and pairs from up to 70 deg off the perpendicular, one party '
-                               'every 1-2 s, overtakers giving way), ``"groups"`` (pairs and triads from within 30 deg, the second '
+                               'every 1-2 s), ``"wide_give_way"`` (the same, overtakers giving way), ``"groups"`` (pairs and triads from within 30 deg, the second '
                                'definition) or ``"single"`` (every pedestrian alone, the first definition); '
                                '``CROWD_PRESETS`` and ``DEFAULT_CROWD`` in ``visuomotor_gym.tasks.obstacle_dodge``'),
         "render_camera": '``"both"`` (top view beside the eye view), ``"side"``, ``"follow"``, ``"top"``, ``"eye"``',

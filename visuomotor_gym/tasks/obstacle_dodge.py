@@ -23,8 +23,8 @@ definition). **The env's default crowd is the preset ``"wide"``** (``DEFAULT_CRO
 ``CROWD_PRESETS``): singles and pairs, a new party every 1-2 s, crossing up to 70 deg off the perpendicular
 from 3-8 m to the side, so that the threats come from bearings no single posture of the eye covers.
 
-**Give way** (``CrowdDistribution.give_way``, since ObstacleDodge-v0's fourth definition; on in ``"wide"``, off in
-``"groups"`` and ``"single"``): the pedestrians otherwise walk straight (and veer) whatever the walker does, so one
+**Give way** (``CrowdDistribution.give_way``, opt-in: on only in the preset ``"wide_give_way"``, off in ``"wide"``,
+the env's default, and in ``"groups"`` and ``"single"``): the pedestrians otherwise walk straight (and veer) whatever the walker does, so one
 overtaking the walker from behind, outside the human field for seconds, would walk into its back, which no eye
 looking ahead can prevent. In real crowds the one who sees the other and passes second, behind it, does most of
 the avoiding (Olivier et al. 2013; Knorr et al. 2016). A pedestrian behind the walker's frontal field (bearing from
@@ -34,7 +34,10 @@ half-field and a minimal predicted distance (Olivier et al. 2012's MPD, axis to 
 turned and/or slowed, that keeps 1 m and passes behind the walker (:func:`give_way_velocity`), until its course
 keeps 1 m again; then it takes up its course's velocity. It judges the walker's velocity over one step of the
 gait (``GIVE_WAY_WALKER_WINDOW_S``). No random draws: a seed's crowd is the same with the rule on or off and on
-every rung. A veering pedestrian never gives way during its veer.
+every rung. A veering pedestrian never gives way during its veer. Measured (docs/reproductions/data/terrain/
+dodge_groups.md, "Overtakers giving way"): on the 200 pinned seeds it fixes every overtaking collision of
+``fajen_warren`` (181 -> 192/200) but spares the still eye's walker more (its twin 102 -> 124/200), so the gaze gain
+falls from +39.5 to +34.0 points; the definition keeps it off.
 
 **Groups** (``CrowdDistribution.group_size`` = (2, 3) in the preset ``"groups"``, (1, 2) in ``"wide"``;
 ``"single"``, ``group_size=(1, 1)``, gives the first definition's crowds;
@@ -123,7 +126,7 @@ CROWD_RULES = {
     # walking abreast, short of a street's width (modelling choice)
     "group_size": lambda v, name: _group_size(v, name),
     "group_spacing_m": Pair(Num(0.0, 5.0, low_open=True)),
-    # give way (since ObstacleDodge-v0's fourth definition): a switch; a bearing beyond which a pedestrian is
+    # give way (opt-in, preset "wide_give_way"): a switch; a bearing beyond which a pedestrian is
     # behind the walker's frontal field (a half-turn at most); a comfortable distance and a prediction horizon
     # short of a street's width and of an episode (modelling choices)
     "give_way": args.Flag(),
@@ -180,10 +183,10 @@ class CrowdDistribution:
     # modelling choice).
     group_size: tuple[float, float] = (2.0, 3.0)
     group_spacing_m: tuple[float, float] = (0.7, 0.9)
-    # Give way (since ObstacleDodge-v0's fourth definition; off here and in "groups"/"single", on in "wide"):
+    # Give way (opt-in: on only in the preset "wide_give_way"; off here and in "wide", "groups" and "single"):
     # a pedestrian overtaking the walker from behind its frontal field adapts its velocity to pass at a
     # comfortable distance, then resumes its course (:func:`give_way_velocity`, sources there). Off: the
-    # pedestrians walk straight (and veer), whatever the walker does, as in the first three definitions.
+    # pedestrians walk straight (and veer), whatever the walker does, as in every definition so far.
     give_way: bool = False
     # The pedestrian is behind the walker's frontal field: its bearing from the walker's direction of travel
     # beyond 90 deg, i.e. behind the walker's frontal plane, where it would pass second (behind the walker),
@@ -227,8 +230,11 @@ class CrowdDistribution:
 DEFAULT_CROWD = "wide"  # the env's crowd when none is given (see CROWD_PRESETS)
 CROWD_PRESETS = {"groups": CrowdDistribution(), "single": CrowdDistribution(group_size=(1.0, 1.0)),
                  "wide": CrowdDistribution(angle_deg=WIDE_ANGLE_DEG, side_m=WIDE_SIDE_M,
-                                           group_size=WIDE_GROUP_SIZE, onset_gap_s=WIDE_ONSET_GAP_S,
-                                           give_way=True)}
+                                           group_size=WIDE_GROUP_SIZE, onset_gap_s=WIDE_ONSET_GAP_S),
+                 # "wide" with overtakers giving way (opt-in; measured: the gaze gain falls, dodge_groups.md)
+                 "wide_give_way": CrowdDistribution(angle_deg=WIDE_ANGLE_DEG, side_m=WIDE_SIDE_M,
+                                                    group_size=WIDE_GROUP_SIZE, onset_gap_s=WIDE_ONSET_GAP_S,
+                                                    give_way=True)}
 
 
 @dataclass(frozen=True)
