@@ -23,6 +23,8 @@ export MUJOCO_GL ?= egl
 # One OpenBLAS kernel family on every x86 CPU, so episodes are bit-identical across machines (golden
 # digests, leaderboard replays): see visuomotor_gym/_blas.py.
 export OPENBLAS_CORETYPE ?= Haswell
+# ... and one MKL code path for PyTorch (the ppo-npz policies' layers), the one an AMD CPU takes: visuomotor_gym/_blas.py.
+export MKL_ENABLE_INSTRUCTIONS ?= SSE4_2
 
 RAY_VENV ?= .venv-ray
 RAY_STAMP := $(RAY_VENV)/.installed

@@ -44,3 +44,15 @@ def test_numpy_imported_first_is_reported_not_overridden():
     coretype, core, pinned = _run({}, code)
     assert coretype == "None"  # too late to choose: the CPU's kernels stay, and pin_kernels says whether they match
     assert pinned == str(core in ("Haswell", "Zen"))
+
+
+def test_importing_the_package_before_torch_pins_mkl_and_a_users_choice_is_kept():
+    """MKL's code path (PyTorch's float32 layers of the ppo-npz policies) is pinned like OpenBLAS's: set when the
+    package is imported before torch, left alone when the user chose one."""
+    code = "import os, visuomotor_gym; print(os.environ.get('MKL_ENABLE_INSTRUCTIONS'))"
+    base = {k: v for k, v in os.environ.items() if k != "MKL_ENABLE_INSTRUCTIONS"}
+    for extra, want in (({}, "SSE4_2"), ({"MKL_ENABLE_INSTRUCTIONS": "AVX2"}, "AVX2")):
+        out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env={**base, **extra},
+                             timeout=120)
+        assert out.returncode == 0, out.stderr
+        assert out.stdout.split() == [want]

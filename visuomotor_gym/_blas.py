@@ -14,6 +14,15 @@ core type; importing ``visuomotor_gym`` calls it. If numpy was imported first, t
 CPU's: :func:`openblas_core` tells which one is in use, and the golden-digest test and the
 leaderboard check say so when it is not the pinned family. Set ``OPENBLAS_CORETYPE`` yourself
 (before anything imports numpy) to override; the Makefile and CI export it.
+
+The same holds for PyTorch's MKL, which runs the ``ppo-npz`` policies' layers (``baselines/ppo/agent.py``): MKL
+picks its code path from the CPU's vendor and features, so a policy's float32 actions differ in the last bits
+between an Intel CPU with AVX-512 and an AMD one (measured on an Intel Xeon with AVX-512: the leaderboard's
+``gaze-blind-recurrentppo-free-100k`` on EyeCatch-v0 seed 77 missed by 0.13071443 m instead of the recorded
+0.13071187 m, made on an AMD EPYC; with ``MKL_ENABLE_INSTRUCTIONS=SSE4_2`` the Intel machine gives the recorded
+values exactly, as it does with ``AVX``, which MKL maps to SSE4.2 with a deprecation warning). :func:`pin_kernels`
+therefore also sets ``MKL_ENABLE_INSTRUCTIONS=SSE4_2`` (:data:`PINNED_MKL`) when torch is not imported yet and the
+user has not chosen; MKL reads it when torch loads it.
 """
 
 from __future__ import annotations
@@ -27,16 +36,21 @@ import sys
 PINNED_CORETYPE = "Haswell"
 #: Core names that give the same results as the pinned one (checked: every golden digest matches).
 EQUIVALENT_CORES = ("Haswell", "Zen")
+#: MKL's instruction set for every reference number made with a torch policy (the leaderboard's ppo entries).
+PINNED_MKL = "SSE4_2"
 
 
 def pin_kernels() -> bool:
     """Choose :data:`PINNED_CORETYPE` for OpenBLAS if numpy is not imported yet, the machine is x86-64
-    and ``OPENBLAS_CORETYPE`` is unset. Returns whether the pinned family will be used (True also when
+    and ``OPENBLAS_CORETYPE`` is unset (and :data:`PINNED_MKL` for MKL if torch is not imported yet and
+    ``MKL_ENABLE_INSTRUCTIONS`` is unset). Returns whether the pinned family will be used (True also when
     the user set an equivalent core type)."""
     if platform.machine().lower() not in ("x86_64", "amd64"):
         return False
     if "numpy" not in sys.modules:
         os.environ.setdefault("OPENBLAS_CORETYPE", PINNED_CORETYPE)
+    if "torch" not in sys.modules:
+        os.environ.setdefault("MKL_ENABLE_INSTRUCTIONS", PINNED_MKL)
     core = openblas_core() if "numpy" in sys.modules else os.environ.get("OPENBLAS_CORETYPE")
     return core is not None and core.lower() in (c.lower() for c in EQUIVALENT_CORES)
 
