@@ -620,12 +620,13 @@ class EomBraceAgent:
                 u = vh / speed
                 ext = max(float(u[0] * (f[0] + sx * FOOT_HALF_LENGTH_M) + u[1] * (f[1] + sy * FOOT_HALF_WIDTH_M))
                           for f in feet for sx in (-1, 1) for sy in (-1, 1))
-                ahead = self.front and abs(math.degrees(math.atan2(u[1], u[0]))) < FRONT_AZIMUTH_DEG
+                forward = abs(math.degrees(math.atan2(u[1], u[0]))) < FRONT_AZIMUTH_DEG  # a fall straight ahead
+                ahead = self.front and forward
                 margin = p.front_cop_margin_m if ahead and speed > p.front_fall_speed_m_s else p.cop_margin_m
                 if float(u[0] * cop[0] + u[1] * cop[1]) > ext - margin \
                         or min(cop[2], cop[3]) < p.unload_fraction:
                     self.detected_at = t
-                    front = p.front_wall and abs(math.degrees(math.atan2(u[1], u[0]))) < FRONT_AZIMUTH_DEG
+                    front = p.front_wall and forward
                     self._set_side(self.side if front else (1 if u[1] > 0.0 else -1), front)
                     self.normal = u
                     self.events.append((t, "detect"))

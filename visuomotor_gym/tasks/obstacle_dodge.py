@@ -619,13 +619,19 @@ def intercept_velocity(px: float, py: float, speed: float, wx: float, wy: float,
     return np.array([speed * dx / n, speed * dy / n])
 
 
+def _closest_approach(rx, ry, vx, vy, horizon: float):
+    """The time within ``[0, horizon]`` at which a pedestrian at ``(rx, ry)`` from the walker, moving at ``(vx, vy)``
+    relative to it, comes closest; and ``r . v`` (negative: closing in). Scalars or arrays of ``vx, vy``."""
+    vv = np.asarray(vx, dtype=float) ** 2 + np.asarray(vy, dtype=float) ** 2
+    rv = rx * np.asarray(vx, dtype=float) + ry * np.asarray(vy, dtype=float)
+    return np.clip(-rv / np.maximum(vv, 1e-12), 0.0, horizon), rv
+
+
 def min_predicted_distance(rx, ry, vx, vy, horizon: float):
     """The minimal predicted distance (Olivier et al. 2012's MPD) of a pedestrian at ``(rx, ry)`` from the
     walker, moving at ``(vx, vy)`` relative to it, over the next ``horizon`` seconds if both keep their
     velocities, and whether they are closing in (the distance falling now). Scalars or arrays of ``vx, vy``."""
-    vv = np.asarray(vx, dtype=float) ** 2 + np.asarray(vy, dtype=float) ** 2
-    rv = rx * np.asarray(vx, dtype=float) + ry * np.asarray(vy, dtype=float)
-    t = np.clip(-rv / np.maximum(vv, 1e-12), 0.0, horizon)
+    t, rv = _closest_approach(rx, ry, vx, vy, horizon)
     mpd = np.hypot(rx + vx * t, ry + vy * t)
     if np.ndim(mpd) == 0:
         return float(mpd), bool(rv < 0.0)
@@ -656,8 +662,8 @@ def give_way_velocity(rx: float, ry: float, cx: float, cy: float, ux: float, uy:
     vx = (c * cx - s * cy) * frac
     vy = (s * cx + c * cy) * frac
     wx, wy = vx - ux, vy - uy  # relative to the walker
-    mpd, _ = min_predicted_distance(rx, ry, wx, wy, horizon)
-    t = np.clip(-(rx * wx + ry * wy) / np.maximum(wx * wx + wy * wy, 1e-12), 0.0, horizon)
+    t, _ = _closest_approach(rx, ry, wx, wy, horizon)
+    mpd = np.hypot(rx + wx * t, ry + wy * t)
     behind = (rx + wx * t) * hx + (ry + wy * t) * hy <= 0.0  # at the closest approach
     change = np.hypot(vx - cx, vy - cy)
     ok = mpd >= distance

@@ -110,13 +110,16 @@ WALL_SIDE_RANDOM = True
 # the three places (left, right, front) equally likely, so that no one posture of the eye sees the cubes the hand
 # needs on more than one of them well (the ninth pass measured that two places, 180 deg apart, cap the gaze gain
 # near +40: a still eye on one side keeps that side's share). Modelling choice. Opt-in (0 in the definition: the
-# wall on a side only, the ninth pass's scene): the brace on a wall in front does not work yet (eom.md, tenth pass).
+# wall on a side only, the ninth pass's scene): measured at 1/3 the gain stays +37.0, because a still eye turned
+# 40-60 deg sees a side wall and half the front one (eom.md, tenth pass).
 WALL_FRONT_P = 0.0
-# The push toward a wall in front is the side push scaled by this: the same multiple of the bare stance's tipping
-# force in its direction (the stance tips from 185 N forward, from 285 N sideways; 0.15 s pushes,
-# tests/test_push_recovery.py): 185 / 285 = 0.65 (the soles' toes are a shorter lever than the feet's outer
-# edges). Modelling choice, as PUSH_FORCE_N.
+# The push toward a wall in front is the side push scaled by this. The bare stance tips from 185 N forward and from
+# 285 N sideways (0.15 s pushes, tests/test_push_recovery.py: the soles' toes are a shorter lever than the feet's
+# outer edges), a ratio of 0.65; at 0.65 the legs alone kept 22 of 64 front walls (pinned seeds), at 0.72
+# (212-252 N) 4 of 64, as on the side walls (6 of 68). Modelling choice, as PUSH_FORCE_N.
 FRONT_PUSH_SCALE = 0.72
+# The front row slid along the wall so that it straddles the body's midline: turned from a side, it would run 2 m
+# across to the other side, into a side-looking eye's view (modelling choice; eom.md, tenth pass).
 FRONT_ROW_CENTRED = True
 
 # --- the outcome -----------------------------------------------------------------------------------
@@ -227,7 +230,6 @@ class PushRecoveryTask(Task):
         mirror = self.wall_side > 0
         if mirror:
             yaw = -yaw  # the mirrored wall turns forward from the body's left
-        self.wall_yaw = yaw
         sgn = 1.0 if mirror else -1.0
         normal = np.array([-sgn * math.sin(yaw), sgn * math.cos(yaw), 0.0])  # from the body toward the wall
         along = np.array([math.cos(yaw), math.sin(yaw), 0.0])  # along the wall, forward at yaw 0
@@ -236,15 +238,14 @@ class PushRecoveryTask(Task):
         if self.wall_front:
             turn_by = -self.wall_side * 0.5 * math.pi
             ct, st = math.cos(turn_by), math.sin(turn_by)
-            normal = np.array([ct * normal[0] - st * normal[1], st * normal[0] + ct * normal[1], 0.0])
-            along = np.array([ct * along[0] - st * along[1], st * along[0] + ct * along[1], 0.0])
+            normal, along = (np.array([ct * v[0] - st * v[1], st * v[0] + ct * v[1], 0.0]) for v in (normal, along))
             yaw += turn_by
-            self.wall_yaw = yaw
             self.push_force *= FRONT_PUSH_SCALE
             if FRONT_ROW_CENTRED:
                 xs = [r[0] for r in rows if r is not None]
                 mid = 0.5 * (min(xs) + max(xs))
                 rows = [None if r is None else (r[0] - mid, *r[1:]) for r in rows]
+        self.wall_yaw = yaw
         self.wall_normal = normal
         quat = (math.cos(0.5 * yaw), 0.0, 0.0, math.sin(0.5 * yaw))
         centres, faces, sizes = [], [], []
