@@ -177,8 +177,9 @@ def test_table_cell_trains_evaluates_and_collects(tmp_path, capsys):
     text = doc.read_text()
     assert "old" not in text and text.endswith("after\n")
     rows = [line for line in text.splitlines() if line.startswith("| stones | SteppingStonesOracle-v0")]
-    assert len(rows) == 2 and "RecurrentPPO (seed 0)" in rows[1] and "not run" in rows[0]
-    assert text.count("not run") == 19  # 5 families x 2 rungs x 2 algorithms, one filled
+    assert len(rows) == 3 and "RecurrentPPO (seed 0)" in rows[1] and "not run" in rows[0]
+    assert "| SAC | not run" in rows[2]
+    assert text.count("not run") == 29  # 5 families x 2 rungs x 3 algorithms, one filled
     assert "--env SteppingStones-v0 --algo ppo --timesteps 512" in text
     assert (tmp_path / "img" / "rl_curves_512.png").is_file()
 

@@ -68,6 +68,9 @@ NPZ_META_BOOLS = ("belief",)
 # RecurrentPPO (format "ppo-npz" with ``network.kind = "lstm_mlp"``): the actor's one-layer LSTM as four
 # arrays named in ``network.lstm`` (PyTorch's nn.LSTM layout: gates i, f, g, o stacked along rows).
 NPZ_LSTM_ARRAYS = ("weight_ih", "weight_hh", "bias_ih", "bias_hh")
+# SAC (format "ppo-npz" with ``network.squash = "tanh"``): the actor's mean goes through tanh and is rescaled
+# from [-1, 1] to [action_low, action_high] (SB3's squashed Gaussian mode and ``unscale_action``), not clipped.
+NPZ_SQUASH = (None, "tanh")
 NPZ_ACTIVATIONS = ("tanh", "relu", "elu", "leaky_relu", "silu", "gelu", "sigmoid")
 # Observations on which pack_npz proves the rebuilt actor equal to the SB3 model (modelling choice:
 # 2000 single-observation calls take well under a second and cover the clipped normalised range).
@@ -113,7 +116,11 @@ def _algo_class(algo: str):
         from stable_baselines3 import PPO
 
         return PPO
-    raise ValueError(f"unknown algo {algo!r} in {META_NAME} (PPO or RecurrentPPO)")
+    if algo == "SAC":
+        from stable_baselines3 import SAC
+
+        return SAC
+    raise ValueError(f"unknown algo {algo!r} in {META_NAME} (PPO, RecurrentPPO or SAC)")
 
 
 def pack_policy(path: str | Path) -> bytes:
@@ -379,10 +386,16 @@ def _check_record(record: dict, arrays: dict[str, np.ndarray]) -> None:
     net = need(record, "network", dict, "$")
     meta = need(record, "meta", dict, "$")
     recurrent = net.get("lstm") is not None
-    algo = "RecurrentPPO" if recurrent else "PPO"
+    squash = net.get("squash")
+    if squash not in NPZ_SQUASH:
+        raise PolicyFileError(f"$.network.squash must be one of {list(NPZ_SQUASH)}, got {squash!r}")
+    if squash is not None and recurrent:
+        raise PolicyFileError("$.network.squash (SAC) and $.network.lstm (RecurrentPPO) exclude each other")
+    algo = "SAC" if squash is not None else "RecurrentPPO" if recurrent else "PPO"
     if need(meta, "algo", str, "$.meta") != algo:
-        raise PolicyFileError(f"$.meta.algo must be {algo!r} for a network "
-                              f"{'with' if recurrent else 'without'} $.network.lstm, got {meta['algo']!r}")
+        what = ("with $.network.squash" if squash is not None else
+                f"{'with' if recurrent else 'without'} $.network.lstm")
+        raise PolicyFileError(f"$.meta.algo must be {algo!r} for a network {what}, got {meta['algo']!r}")
     network_budget(record, {k: v.shape for k, v in arrays.items()})
     obs_dim = need(net, "obs_dim", int, "$.network")
     action_dim = need(net, "action_dim", int, "$.network")
@@ -476,6 +489,7 @@ class NpzActor:
         for param in self.net.parameters():
             param.requires_grad_(False)
         self.obs_dim = int(net["obs_dim"])
+        self.squash = net.get("squash")
         self.low = np.asarray(net["action_low"], dtype=np.float32)
         self.high = np.asarray(net["action_high"], dtype=np.float32)
         self._torch = torch
@@ -501,7 +515,11 @@ class NpzActor:
                     self.state = (zeros, zeros.clone())
                 out, self.state = self.lstm(h.reshape(1, 1, self.obs_dim), self.state)
                 h = out.reshape(1, self.hidden_size)
-            out = self.net(h).numpy()
+            out = self.net(h)
+            if self.squash == "tanh":  # SB3 SAC: th.tanh of the mean, then unscale_action (numpy, float32)
+                a = torch.tanh(out).numpy().reshape(-1, self.low.shape[0])
+                return (self.low + (0.5 * (a + 1.0) * (self.high - self.low)))[0]
+            out = out.numpy()
         return np.clip(out.reshape(-1, self.low.shape[0]), self.low, self.high)[0]
 
 
@@ -513,9 +531,11 @@ def npz_from_model(model, meta: dict) -> bytes:
 
     policy = model.policy
     recurrent = type(model).__name__ == "RecurrentPPO"
-    if meta.get("algo") != type(model).__name__ or type(model).__name__ not in ("PPO", "RecurrentPPO"):
-        raise ValueError(f"only PPO (MlpPolicy) and RecurrentPPO (MlpLstmPolicy) policies have a pickle-free "
-                         f"form; this is a {type(model).__name__} whose meta says {meta.get('algo')!r}")
+    if meta.get("algo") != type(model).__name__ or type(model).__name__ not in ("PPO", "RecurrentPPO", "SAC"):
+        raise ValueError(f"only PPO (MlpPolicy), RecurrentPPO (MlpLstmPolicy) and SAC (MlpPolicy) policies have a "
+                         f"pickle-free form; this is a {type(model).__name__} whose meta says {meta.get('algo')!r}")
+    if type(model).__name__ == "SAC":
+        return _sac_npz(model, meta)
     if recurrent and policy.lstm_actor.num_layers != 1:
         raise ValueError(f"the pickle-free form holds a one-layer LSTM; this actor has {policy.lstm_actor.num_layers}")
     obs_space, act_space = model.observation_space, model.action_space
@@ -579,6 +599,59 @@ def npz_from_model(model, meta: dict) -> bytes:
         "network": network,
         "meta": keep,
         "source": source,
+    }
+    return _write_npz(record, arrays)
+
+
+def _sac_npz(model, meta: dict) -> bytes:
+    """The ``ppo-npz`` bytes of a loaded SB3 ``SAC`` model (MlpPolicy on a flat Box observation): the actor's
+    ``latent_pi`` layers and ``mu``, with ``network.squash = "tanh"`` (the deterministic action is
+    ``low + 0.5 (tanh(mu(x)) + 1) (high - low)``, as ``SAC.predict(obs, deterministic=True)``)."""
+    from gymnasium import spaces
+    from stable_baselines3.common.torch_layers import FlattenExtractor
+
+    actor = model.policy.actor
+    obs_space, act_space = model.observation_space, model.action_space
+    if not isinstance(obs_space, spaces.Box) or len(obs_space.shape) != 1:
+        raise ValueError(f"needs a flat Box observation space, got {obs_space}")
+    if not isinstance(act_space, spaces.Box) or len(act_space.shape) != 1:
+        raise ValueError(f"needs a flat Box action space, got {act_space}")
+    if actor.use_sde or not isinstance(actor.features_extractor, FlattenExtractor):
+        raise ValueError("needs SB3 SAC's MlpPolicy actor (FlattenExtractor, no gSDE)")
+    arrays, layers = {}, []
+    pending = None
+    for module in list(actor.latent_pi) + [actor.mu]:
+        if type(module).__name__ == "Linear":
+            name = "action" if module is actor.mu else f"pi.{len(layers)}"
+            arrays[f"{name}.weight"] = module.weight.detach().cpu().numpy().astype(np.float32)
+            arrays[f"{name}.bias"] = module.bias.detach().cpu().numpy().astype(np.float32)
+            layers.append({"weight": f"{name}.weight", "bias": f"{name}.bias", "activation": None})
+            pending = layers[-1]
+        else:
+            if pending is None or pending["activation"] is not None:
+                raise ValueError(f"unexpected module {module!r} in the actor network")
+            pending["activation"] = _activation_name(module)
+    import stable_baselines3
+
+    network = {
+        "kind": "mlp",
+        "squash": "tanh",
+        "description": "deterministic SB3 SAC actor: x = clip((obs - obs_mean) / sqrt(obs_var + epsilon), "
+                       "+-clip_obs) as float32, then Linear/activation layers in order (latent_pi, then mu), "
+                       "then a = tanh(.), then the action action_low + 0.5 (a + 1) (action_high - action_low) "
+                       "in float32 (SB3's unscale_action; no clipping)",
+        "obs_dim": int(obs_space.shape[0]),
+        "action_dim": int(act_space.shape[0]),
+        "layers": layers,
+        "action_low": [float(x) for x in act_space.low],
+        "action_high": [float(x) for x in act_space.high],
+    }
+    record = {
+        "format": NPZ_FORMAT,
+        "format_version": NPZ_FORMAT_VERSION,
+        "network": network,
+        "meta": {k: v for k, v in meta.items() if not str(k).startswith("_")},
+        "source": {"converted_from": "stable-baselines3 SAC", "stable_baselines3": stable_baselines3.__version__},
     }
     return _write_npz(record, arrays)
 

@@ -6,7 +6,8 @@
         --images docs/baselines/images
 
 A **cell** is one env id x one algorithm (``ppo``: SB3 PPO with an MLP; ``recurrentppo``: sb3-contrib
-RecurrentPPO with an LSTM) x one training seed at one budget of transitions. It
+RecurrentPPO with an LSTM; ``sac``: SB3 SAC with an MLP, ``hyperparams.yml`` ``sac:``) x one training seed at
+one budget of transitions. It
 
 1. trains with ``baselines/ppo/train.py`` on **free gaze**: the env's own action vector (``--belief no
    --hand-action absolute --gaze-action free``: no belief features, no look gate, no intercept hand), with
@@ -48,7 +49,7 @@ FAMILY_ROWS = (
     ("catch", "EyeCatch-v0", "EyeCatchOracle-v0"),
     ("walk", "ObstacleWalk-v0", "ObstacleWalkOracle-v0"),
 )
-ALGOS = {"ppo": "PPO", "recurrentppo": "RecurrentPPO"}
+ALGOS = {"ppo": "PPO", "recurrentppo": "RecurrentPPO", "sac": "SAC"}
 # Each family's share of steps with the eye on what the task is about (a component of its gaze-realism
 # table, metrics.realism / the family's reference): the ball, the stones, the pedestrians, the shelf object,
 # the obstacles.
@@ -222,8 +223,9 @@ def run_cell(args: argparse.Namespace, argv: list[str]) -> Path:
     if cell_path.exists():
         raise TableArgumentError(f"{cell_path} exists: cells are never overwritten (remove it to run again)")
     family = family_of(args.env)
-    config = train.load_config(train.parse_args(["--env", args.env, "--set", *args.set] if args.set else
-                                                ["--env", args.env]))
+    algo_flag = {"recurrentppo": ["--recurrent"], "sac": ["--sac"]}.get(args.algo, [])
+    config = train.load_config(train.parse_args(["--env", args.env, *algo_flag, "--set", *args.set] if args.set else
+                                                ["--env", args.env, *algo_flag]))
     eval_freq = max(1, args.timesteps // EVAL_POINTS)
     eval_episodes = min(int(config["eval_episodes"]), MAX_CURVE_EPISODES)
     train_argv = ["--env", args.env, "--timesteps", str(args.timesteps), "--seed", str(args.seed),
@@ -231,8 +233,7 @@ def run_cell(args: argparse.Namespace, argv: list[str]) -> Path:
                   "--belief", "no", "--hand-action", "absolute", "--gaze-action", "free",
                   "--set", f"eval_freq={eval_freq}", f"eval_episodes={eval_episodes}",
                   f"checkpoint_freq={max(args.timesteps, 1)}", *args.set]
-    if args.algo == "recurrentppo":
-        train_argv.append("--recurrent")
+    train_argv += algo_flag
     t0 = time.time()
     run_dir = train.main(train_argv)
     train_wall = time.time() - t0
@@ -358,6 +359,16 @@ def _twin_text(cell: dict) -> str:
     return f"{_pct(twin['success_rate'])} ({100 * twin['held_difference']:+.1f} pts)"
 
 
+def sac_env_ids() -> set[str]:
+    """The ids the hyperparameter file's ``sac`` section has (SAC cells run only for them)."""
+    from importlib import resources
+
+    import yaml
+
+    table = yaml.safe_load(resources.files("visuomotor_gym.baselines.ppo").joinpath("hyperparams.yml").read_text())
+    return {k for k in (table.get("sac") or {}) if k != "default"}
+
+
 def table_markdown(cells: list[dict], budget: int) -> str:
     """The table: one row per (family, rung, algorithm), the cells at ``budget`` (seeds pooled as rows)."""
     by_key: dict[tuple, list[dict]] = {}
@@ -372,12 +383,17 @@ def table_markdown(cells: list[dict], budget: int) -> str:
         "|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     not_run = []
+    sac_ids = sac_env_ids()
     for family, foveated, oracle in FAMILY_ROWS:
         for env_id in (foveated, oracle):
             for algo_key, algo in ALGOS.items():
                 group = sorted(by_key.get((env_id, algo), []), key=lambda c: c["seed"])
                 label = f"{env_id}" + (" (under the current definition)" if family in UNSETTLED else "")
                 if not group:
+                    if algo_key == "sac" and env_id not in sac_ids:  # no command would run
+                        lines.append(f"| {family} | {label} | {algo} | not run (no `sac:` hyperparameters "
+                                     f"for this id) | | | | | | | | |")
+                        continue
                     lines.append(f"| {family} | {label} | {algo} | not run | | | | | | | | |")
                     not_run.append(cell_command(env_id, algo_key, budget, 0))
                     continue
@@ -425,7 +441,7 @@ def plot_curves(cells: list[dict], budget: int, out_dir: Path) -> list[Path]:
             ws = [(p["wall_s"] or float("nan")) / 60 for p in curve]
             ys = [100 * p.get("success_rate", float("nan")) for p in curve]
             style = "-" if c["rung"] == "foveated" else "--"
-            marker = "o" if c["algo"] == "PPO" else "s"
+            marker = {"PPO": "o", "RecurrentPPO": "s"}.get(c["algo"], "^")
             label = f"{c['env_id']} {c['algo']} s{c['seed']}"
             ls = [p.get("mean_length", float("nan")) for p in curve]
             axes[row, 0].plot(xs, ys, style, marker=marker, label=label)
@@ -443,7 +459,7 @@ def plot_curves(cells: list[dict], budget: int, out_dir: Path) -> list[Path]:
     axes[-1, 1].set_xlabel("wall time (min, this machine, shared CPU)")
     axes[-1, 2].set_xlabel("transitions")
     axes[-1, 3].set_xlabel("transitions")
-    fig.suptitle(f"Free-gaze PPO / RecurrentPPO, EvalCallback held-out episodes (budget {budget_tag(budget)})",
+    fig.suptitle(f"Free-gaze PPO / RecurrentPPO / SAC, EvalCallback held-out episodes (budget {budget_tag(budget)})",
                  fontsize=10)
     fig.tight_layout()
     out_dir.mkdir(parents=True, exist_ok=True)

@@ -1,4 +1,4 @@
-"""Train PPO (or RecurrentPPO) on any registered env id with stable-baselines3, top to bottom.
+"""Train PPO (or RecurrentPPO, or SAC) on any registered env id with stable-baselines3, top to bottom.
 
     python -m visuomotor_gym.baselines.ppo.train --env EyeCatchOracle-v0 --timesteps 2000000
     vmgym train ppo --env EyeCatch-v0 --timesteps 3000000 --minutes 55
@@ -8,7 +8,9 @@
 Every registered id has hyperparameters in ``hyperparams.yml``: the catch ids default to the project's
 recipe (belief features, intercept hand action); every other family plays free gaze (the env's own
 actions) with its named training-only shaping term. ``--belief no --hand-action absolute`` gives the
-catch ids free gaze too (the RL baseline table, ``table.py``).
+catch ids free gaze too (the RL baseline table, ``table.py``). ``--sac`` trains SB3 SAC (MlpPolicy, one env)
+with the file's ``sac`` section for the id merged over its entry (same wrappers and shaping; only the ids
+listed there).
 
 Steps: read the hyperparameters for the env id (``hyperparams.yml``, a ``default`` plus per-id
 overrides, then command-line overrides), make the vectorised training env (shaped reward, optional
@@ -50,6 +52,10 @@ MAX_TIMESTEPS = 10**10
 MAX_MINUTES = 7 * 24 * 60.0
 MAX_SEED = 2**31 - 1
 MAX_N_ENVS = 256
+ALGOS = ("PPO", "RecurrentPPO", "SAC")
+# SB3 SAC's own keyword arguments that the hyperparameter file's `sac` section sets (the rest are PPO's).
+SAC_KEYS = ("learning_rate", "buffer_size", "learning_starts", "batch_size", "tau", "gamma", "train_freq",
+            "gradient_steps", "ent_coef", "target_update_interval", "target_entropy")
 CHOICES = {"belief": ("", "yes", "no", "true", "false", "1", "0"), "hand_action": ("", "absolute", "intercept"),
            "gaze_action": ("", "free", "gated", "frozen", "free_belief")}
 GAZE_BLOCK = slice(4, 6)  # the policy action's gaze block (retinal azimuth, elevation), for gaze_log_std_init
@@ -74,6 +80,8 @@ class Args:
     """folder name of the run (default: algo_seed_timestamp)"""
     recurrent: bool = False
     """RecurrentPPO (LSTM policy, sb3-contrib) instead of PPO"""
+    sac: bool = False
+    """SB3 SAC (MlpPolicy, off-policy) instead of PPO: the hyperparameter file's `sac` section for the id"""
     belief: str = ""
     """'yes'/'no' overrides the config's belief features"""
     hand_action: str = ""
@@ -174,8 +182,15 @@ def _check_config(config: dict) -> None:
     n_envs = config.get("n_envs")
     if isinstance(n_envs, bool) or not isinstance(n_envs, int) or not 1 <= n_envs <= MAX_N_ENVS:
         raise TrainArgumentError(f"n_envs must be an integer in [1, {MAX_N_ENVS}], got {n_envs!r}")
-    if config.get("algo") not in ("PPO", "RecurrentPPO"):
-        raise TrainArgumentError(f"algo must be PPO or RecurrentPPO, got {config.get('algo')!r}")
+    if config.get("algo") not in ALGOS:
+        raise TrainArgumentError(f"algo must be one of {list(ALGOS)}, got {config.get('algo')!r}")
+    if config["algo"] == "SAC":
+        if config.get("bc_episodes") or config.get("gaze_log_std_init") is not None or \
+                config.get("eye_head_log_std_init") is not None:
+            raise TrainArgumentError("SAC has no behaviour-cloning warm start and no per-block log std "
+                                     "(bc_episodes 0, gaze_log_std_init and eye_head_log_std_init null)")
+        if config.get("normalize_reward"):
+            raise TrainArgumentError("SAC trains on the raw (shaped) reward: normalize_reward must be false")
 
 
 def _merge(base: dict, over: dict) -> dict:
@@ -213,6 +228,15 @@ def load_config(args: Args) -> dict:
         if args.recipe not in recipes:
             raise TrainArgumentError(f"--recipe must be one of {sorted(recipes)}, got {args.recipe!r}")
         config = _merge(config, recipes[args.recipe] or {})
+    if args.sac:
+        if args.recurrent:
+            raise TrainArgumentError("--sac and --recurrent exclude each other")
+        section = table.get("sac") or {}
+        if args.env not in section:
+            raise TrainArgumentError(f"--sac: the hyperparameter file's `sac` section has no entry for {args.env} "
+                                     f"(it has {sorted(k for k in section if k != 'default')})")
+        config = _merge(_merge(config, section.get("default") or {}), section[args.env] or {})
+        config["algo"] = "SAC"
     for item in args.set:
         key, eq, value = item.partition("=")
         if not eq or key not in config:
@@ -527,6 +551,21 @@ def _fit(model, train_env, data, config: dict, seed: int, gamma: float, first: b
     return losses
 
 
+def _ppo_kwargs(config: dict, args: Args) -> dict:
+    """PPO's / RecurrentPPO's keyword arguments from the resolved hyperparameters."""
+    return {
+        "n_steps": int(config["n_steps"]), "batch_size": int(config["batch_size"]),
+        "n_epochs": int(config["n_epochs"]),
+        "learning_rate": float(config["learning_rate"]), "gamma": float(config["gamma"]),
+        "gae_lambda": float(config["gae_lambda"]), "clip_range": float(config["clip_range"]),
+        "ent_coef": float(config["ent_coef"]), "vf_coef": float(config["vf_coef"]),
+        "max_grad_norm": float(config["max_grad_norm"]), "seed": args.seed, "device": args.device,
+        "verbose": 0,
+        "policy_kwargs": {"net_arch": list(config["net_arch"]),
+                          "log_std_init": float(config["log_std_init"])},
+    }
+
+
 def run_meta(model, train_env, config: dict, args: Args, wall_s: float) -> dict:
     """What ``ppo:<path>`` needs besides the zip: algorithm, inputs, hand action, normalisation."""
     from stable_baselines3.common.vec_env import VecNormalize
@@ -596,17 +635,7 @@ def main(argv=None) -> Path:
         eval_env = VecNormalize(eval_env, norm_obs=config["normalize_obs"], norm_reward=False, training=False)
 
     # 2. The algorithm.
-    common = {
-        "n_steps": int(config["n_steps"]), "batch_size": int(config["batch_size"]),
-        "n_epochs": int(config["n_epochs"]),
-        "learning_rate": float(config["learning_rate"]), "gamma": float(config["gamma"]),
-        "gae_lambda": float(config["gae_lambda"]), "clip_range": float(config["clip_range"]),
-        "ent_coef": float(config["ent_coef"]), "vf_coef": float(config["vf_coef"]),
-        "max_grad_norm": float(config["max_grad_norm"]), "seed": args.seed, "device": args.device,
-        "verbose": 0,
-        "policy_kwargs": {"net_arch": list(config["net_arch"]),
-                          "log_std_init": float(config["log_std_init"])},
-    }
+    common = _ppo_kwargs(config, args) if config["algo"] != "SAC" else {}
     if config["algo"] == "RecurrentPPO":
         from sb3_contrib import RecurrentPPO
 
@@ -614,8 +643,18 @@ def main(argv=None) -> Path:
         model = RecurrentPPO("MlpLstmPolicy", train_env, **common)
     elif config["algo"] == "PPO":
         model = PPO("MlpPolicy", train_env, **common)
+    elif config["algo"] == "SAC":
+        from stable_baselines3 import SAC
+
+        sac = {k: config[k] for k in SAC_KEYS if k in config}
+        for k in ("learning_rate", "tau", "gamma"):
+            sac[k] = float(sac[k])
+        for k in ("buffer_size", "learning_starts", "batch_size", "train_freq", "gradient_steps"):
+            sac[k] = int(sac[k])
+        model = SAC("MlpPolicy", train_env, seed=args.seed, device=args.device, verbose=0,
+                    policy_kwargs={"net_arch": list(config["net_arch"])}, **sac)
     else:
-        raise SystemExit(f"algo must be PPO or RecurrentPPO, got {config['algo']!r}")
+        raise SystemExit(f"algo must be one of {list(ALGOS)}, got {config['algo']!r}")
     set_block_log_std(model, GAZE_BLOCK, config.get("gaze_log_std_init"))
     set_block_log_std(model, EYE_HEAD_BLOCK, config.get("eye_head_log_std_init"))
     if int(config.get("bc_episodes", 0)) > 0:
