@@ -259,5 +259,7 @@ def test_dodge_planner_looks_only_at_fajen_warrens_pedestrians_and_verges():
             if t - t0 >= agent.params.min_fixation_s - 1e-9 or in_sacc:
                 break
             assert key == key0 or key0 is None
-    _, seen_all = _dodge_choices("belief_mpc:relevant_only=false,threat_weight=0,min_fixation_s=0")
+    # seed 0: on seed 1 the plan without the rule happens to fixate only allowed pedestrians since fajen_warren's
+    # perception guards (min_depth_m, max_speed_m_s) changed its estimates
+    _, seen_all = _dodge_choices("belief_mpc:relevant_only=false,threat_weight=0,min_fixation_s=0", seed=0)
     assert any(key[1] not in allowed for key, allowed in seen_all if key is not None and key[0] == "ped")

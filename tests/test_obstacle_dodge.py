@@ -295,6 +295,50 @@ def test_a_near_pedestrian_placed_far_in_depth_is_a_threat_only_with_the_hypothe
     assert agent._evade((0.0, 0.0, 0.0), (1.3, 0.0)) != (0.0, 1.3)
 
 
+def test_an_estimate_faster_than_walking_is_cut_to_walking_speed_with_the_priors_velocity_variance():
+    """Hand-computed: an estimate moving (-6, 8) m/s (10 m/s) with a small, correlated covariance, limited to
+    2.5 m/s, becomes (-1.5, 2.0) m/s; its position block is kept, its velocity block is the prior's 1.5 m/s std
+    per axis and uncorrelated with the position. An estimate at 2 m/s is left as it is."""
+    from visuomotor_gym.baselines.fajen_warren.agent import PedestrianFilter
+
+    f = PedestrianFilter()
+    f.x = np.array([3.0, 4.0, -6.0, 8.0])
+    f.P = np.full((4, 4), 0.01) + np.eye(4) * 0.02
+    pos_block = f.P[:2, :2].copy()
+    f.limit_speed(2.5, 1.5)
+    np.testing.assert_allclose(f.x, [3.0, 4.0, -1.5, 2.0])
+    np.testing.assert_array_equal(f.P[:2, :2], pos_block)
+    np.testing.assert_array_equal(f.P[2:, 2:], np.eye(2) * 2.25)
+    assert not f.P[:2, 2:].any() and not f.P[2:, :2].any()
+    x, P = np.array([0.0, 0.0, 1.2, 1.6]), np.eye(4) * 0.3
+    f.x, f.P = x.copy(), P.copy()
+    f.limit_speed(2.5, 1.5)
+    np.testing.assert_array_equal(f.x, x)
+    np.testing.assert_array_equal(f.P, P)
+
+
+def test_a_sample_perceived_behind_the_eye_is_skipped_and_one_in_front_is_fused():
+    """The depth guard (``min_depth_m`` 0.5, the default): a pedestrian sample whose depth along the line of
+    sight is -3 m (behind the eye) or 0.4 m leaves the filter unknown; the same sample at 6 m starts it. With
+    the guard off (None) the -3 m sample is fused."""
+    from visuomotor_gym.baselines.fajen_warren import FajenWarrenAgent
+
+    def fuse(depth, **overrides):
+        agent = FajenWarrenAgent.for_env("ObstacleDodge-v0", **overrides)
+        ol = [0.0] * DODGE_LAYOUT.size
+        b = DODGE_LAYOUT.slices["pedestrian_0"].start
+        ol[b:b + 7] = [1.0, depth, 0.1, 0.0, 0.0, -1.0, 0.0]
+        r = DODGE_LAYOUT.slices["eye_rot"].start
+        ol[r:r + 9] = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]
+        ol[DODGE_LAYOUT.slices["fixation"].start] = 6.0
+        agent._perceive(ol, ([0.0, 0.0, 1.6], ol[r:r + 9], (0.0, 0.0, 0.0), 1.0, 0.5))
+        return agent.filters[0].known
+
+    assert FajenWarrenAgent.for_env("ObstacleDodge-v0").params.min_depth_m == 0.5
+    assert not fuse(-3.0) and not fuse(0.4) and fuse(6.0)
+    assert fuse(-3.0, min_depth_m=None)
+
+
 def test_speed_action_spans_the_gaits_steps_with_zero_at_the_nominal_speed():
     """[-1, 0, 1] -> 0.5, 1.3, 1.9 m/s: footsteps of 0.25 (the gait's shortest), 0.65 and 0.95 m per 0.5 s."""
     body = ObstacleDodgeEnv().body

@@ -72,7 +72,11 @@ after its first sight; a pedestrian first seen starts from a zero-mean velocity 
 (``velocity_prior_std``, walking speeds) instead of one far-peripheral velocity sample; with crowding, a
 sample that may be pooled with another pedestrian's is fused with the spread of its crowding zone
 (``baselines.crowding``, as iwao and lookahead); the gaze risk also counts the position estimate's std
-(``pos_std_weight``): depth far in the periphery is poor.
+(``pos_std_weight``): depth far in the periphery is poor. Two perception guards (on by default since
+fajen_warren-v6; None turns each off): a sample perceived at or behind the eye (``min_depth_m``) is skipped, and
+an estimate faster than anyone walks (``max_speed_m_s``) is cut to that speed with the velocity prior's variance,
+so that one wild depth sample right after a saccade (the vergence still far from the pedestrian) does not become
+a confident, wrong course that the filter then keeps.
 
 ``gaze_blind=True`` holds gaze and head (gaze action 0: gaze stays level at the goal; head straight):
 the gaze-blind twin (docs/gaze_gain.md), the same filter and steering.
@@ -180,6 +184,18 @@ class FajenWarrenParams:
     # without the search, the urgency of a look along the path ``search_distance_m`` ahead when no
     # pedestrian still ahead or approaching needs a look more (pedestrians that have passed are not looked at)
     velocity_prior_std: float = 1.5
+    # Two perception guards (since ObstacleDodge-v0's fourth entry of this agent; None: off, the earlier agent).
+    # ``max_speed_m_s``: walking speeds (the agent's prior): an estimate faster than this is wrong (a depth
+    # sample far off taken as motion); its velocity is cut to this speed and its velocity variance raised back
+    # to the prior's (velocity_prior_std), so that the next samples correct it. Adults' fastest walking is about
+    # 2.5 m/s (Bohannon 1997, maximum gait speeds 1.75-2.53 m/s); the crowds walk at 1.0-1.5 m/s.
+    max_speed_m_s: float | None = 2.5
+    # ``min_depth_m``: a sample perceived at or nearer than this along the line of sight (m; at or behind the
+    # eye) carries no usable depth and is skipped: right after a saccade onto a far pedestrian, the vergence
+    # still far from it, the one eye's depth samples spread over tens of metres either side (the depth law's
+    # disparity pedestal). A pedestrian that near is a collision already (contact at 0.55 m). Modelling choice;
+    # measured in docs/reproductions/data/terrain/dodge_groups.md ("Two perception guards").
+    min_depth_m: float | None = 0.5
     path_urgency: float = 0.2
     # ... and pedestrians further than this from the heading are passing beside or behind: not looked at
     gaze_bearing_limit_deg: float = 75.0
@@ -244,6 +260,17 @@ class PedestrianFilter:
     @property
     def known(self) -> bool:
         return self.t >= 0.0
+
+    def limit_speed(self, vmax: float, velocity_std: float) -> None:
+        """An estimate faster than ``vmax`` (m/s) is cut to that speed, and its velocity made as uncertain as
+        the prior (std ``velocity_std`` per axis, uncorrelated with the position), so the next samples set it."""
+        speed = math.hypot(self.x[2], self.x[3])
+        if speed <= vmax:
+            return
+        self.x[2:] *= vmax / speed
+        self.P[2:, :] = 0.0
+        self.P[:, 2:] = 0.0
+        self.P[2:, 2:] = np.eye(2) * velocity_std ** 2
 
     def predict_to(self, t: float, q: float) -> None:
         if not self.known or t <= self.t:
@@ -427,7 +454,7 @@ class FajenWarrenAgent:
             b = _S[f"pedestrian_{k}"].start
             pe, ve = ol[b + 1:b + 4], ol[b + 4:b + 7]
             d = math.sqrt(pe[0] ** 2 + pe[1] ** 2 + pe[2] ** 2)
-            if d <= 0.0:
+            if d <= 0.0 or (self.params.min_depth_m is not None and pe[0] <= self.params.min_depth_m):
                 continue
             ecc = math.acos(max(-1.0, min(1.0, pe[0] / d)))
             lateral_speed = math.sqrt(max(ve[0] ** 2 + ve[1] ** 2 + ve[2] ** 2 - (sum(a * b for a, b in zip(pe, ve)) / d) ** 2, 0.0))
@@ -460,6 +487,8 @@ class FajenWarrenAgent:
             R[2:, 2:] = cov_v[:2, :2]
             self.filters[k].update(t, z, R, self.params.accel_std,
                                    self.params.velocity_prior_std if self.vision.periphery_on else None)
+            if self.params.max_speed_m_s is not None:
+                self.filters[k].limit_speed(self.params.max_speed_m_s, self.params.velocity_prior_std)
 
     def _threats(self, odo, hypotheses: bool = True) -> list[tuple]:
         """Per known pedestrian: (slot, closest-approach time, predicted closest distance, its position
