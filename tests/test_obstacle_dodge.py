@@ -337,6 +337,11 @@ def test_a_sample_perceived_behind_the_eye_is_skipped_and_one_in_front_is_fused(
     assert FajenWarrenAgent.for_env("ObstacleDodge-v0").params.min_depth_m == 0.5
     assert not fuse(-3.0) and not fuse(0.4) and fuse(6.0)
     assert fuse(-3.0, min_depth_m=None)
+    off = make_agent("fajen_warren:min_depth_m=none,max_speed_m_s=none", "ObstacleDodge-v0", 7)
+    assert off.params.min_depth_m is None and off.params.max_speed_m_s is None  # "none" in a spec: the guard off
+    for bad in ("min_depth_m=-1", "max_speed_m_s=0", "max_speed_m_s=fast"):
+        with pytest.raises(ValueError, match=bad.split("=")[0]):
+            make_agent(f"fajen_warren:{bad}", "ObstacleDodge-v0", 7)
 
 
 def test_speed_action_spans_the_gaits_steps_with_zero_at_the_nominal_speed():

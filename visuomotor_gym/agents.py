@@ -152,6 +152,8 @@ def _parse_value(text: str) -> Any:
             pass
     if text.lower() in ("true", "false"):
         return text.lower() == "true"
+    if text.lower() == "none":  # "max_speed_m_s=none": an optional parameter turned off
+        return None
     return text
 
 

@@ -347,6 +347,12 @@ class FajenWarrenAgent:
         if not isinstance(p.los_hypotheses_std, tuple):
             raise ValueError(f"los_hypotheses_std must be a tuple of std multiples (in a spec: "
                              f"los_hypotheses_std=-1.5;-0.75, or -1; for one), got {p.los_hypotheses_std!r}")
+        for name in ("max_speed_m_s", "min_depth_m"):
+            v = getattr(p, name)
+            if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v)
+                                  or v <= 0.0):
+                raise ValueError(f"{name} must be a positive number of {'m/s' if 'speed' in name else 'm'} or None "
+                                 f"(none in a spec: the guard off), got {v!r}")
         self.params = p
         self.vision = VisionParams(noise_scale=p.vision_noise_scale, foveated=p.foveated)
         self.delay_steps = round(p.visual_delay_s / p.control_dt)
