@@ -523,6 +523,25 @@ class NpzActor:
         return np.clip(out.reshape(-1, self.low.shape[0]), self.low, self.high)[0]
 
 
+def _linear_layers(hidden: list, head, what: str) -> tuple[dict, list]:
+    """The float32 arrays and layer records of an SB3 actor: its hidden ``Linear``/activation modules in order,
+    then the ``head`` Linear (named ``action``; the hidden ones ``pi.<k>``)."""
+    arrays, layers = {}, []
+    pending = None
+    for module in hidden + [head]:
+        if type(module).__name__ == "Linear":
+            name = "action" if module is head else f"pi.{len(layers)}"
+            arrays[f"{name}.weight"] = module.weight.detach().cpu().numpy().astype(np.float32)
+            arrays[f"{name}.bias"] = module.bias.detach().cpu().numpy().astype(np.float32)
+            layers.append({"weight": f"{name}.weight", "bias": f"{name}.bias", "activation": None})
+            pending = layers[-1]
+        else:
+            if pending is None or pending["activation"] is not None:
+                raise ValueError(f"unexpected module {module!r} in the {what}")
+            pending["activation"] = _activation_name(module)
+    return arrays, layers
+
+
 def npz_from_model(model, meta: dict) -> bytes:
     """The ``ppo-npz`` bytes of a loaded SB3 ``PPO`` model (MlpPolicy on a flat Box observation)."""
     from gymnasium import spaces
@@ -549,20 +568,7 @@ def npz_from_model(model, meta: dict) -> bytes:
         not policy.share_features_extractor and not isinstance(policy.pi_features_extractor, FlattenExtractor)
     ):
         raise ValueError("needs SB3's FlattenExtractor (MlpPolicy)")
-    arrays, layers = {}, []
-    pending = None
-    for module in list(policy.mlp_extractor.policy_net) + [policy.action_net]:
-        if type(module).__name__ == "Linear":
-            k = len(layers)
-            name = "action" if module is policy.action_net else f"pi.{k}"
-            arrays[f"{name}.weight"] = module.weight.detach().cpu().numpy().astype(np.float32)
-            arrays[f"{name}.bias"] = module.bias.detach().cpu().numpy().astype(np.float32)
-            layers.append({"weight": f"{name}.weight", "bias": f"{name}.bias", "activation": None})
-            pending = layers[-1]
-        else:
-            if pending is None or pending["activation"] is not None:
-                raise ValueError(f"unexpected module {module!r} in the policy network")
-            pending["activation"] = _activation_name(module)
+    arrays, layers = _linear_layers(list(policy.mlp_extractor.policy_net), policy.action_net, "policy network")
     keep = {k: v for k, v in meta.items() if not str(k).startswith("_")}
     import stable_baselines3
 
@@ -618,19 +624,7 @@ def _sac_npz(model, meta: dict) -> bytes:
         raise ValueError(f"needs a flat Box action space, got {act_space}")
     if actor.use_sde or not isinstance(actor.features_extractor, FlattenExtractor):
         raise ValueError("needs SB3 SAC's MlpPolicy actor (FlattenExtractor, no gSDE)")
-    arrays, layers = {}, []
-    pending = None
-    for module in list(actor.latent_pi) + [actor.mu]:
-        if type(module).__name__ == "Linear":
-            name = "action" if module is actor.mu else f"pi.{len(layers)}"
-            arrays[f"{name}.weight"] = module.weight.detach().cpu().numpy().astype(np.float32)
-            arrays[f"{name}.bias"] = module.bias.detach().cpu().numpy().astype(np.float32)
-            layers.append({"weight": f"{name}.weight", "bias": f"{name}.bias", "activation": None})
-            pending = layers[-1]
-        else:
-            if pending is None or pending["activation"] is not None:
-                raise ValueError(f"unexpected module {module!r} in the actor network")
-            pending["activation"] = _activation_name(module)
+    arrays, layers = _linear_layers(list(actor.latent_pi), actor.mu, "actor network")
     import stable_baselines3
 
     network = {
