@@ -198,6 +198,10 @@ class PushRecoveryEnv(VisuomotorEnv):
         self.hand = body.hand
         return body, task
 
+    def _assemble(self, **kw) -> None:
+        super()._assemble(**kw)
+        self.task.attach_eye(self.eye, self.retina, self.vision, self.vision_params.crowding_bouma)
+
 
 def _action_table() -> str:
     (x0, x1), (y0, y1), (z0, z1) = sn.HAND_WORKSPACE.tolist()
