@@ -240,6 +240,19 @@ class EomBraceParams:
     still_s: float = 0.5  # ... for this long before looking away (modelling choice)
     head_dead_zone_deg: float = 20.0  # Eyecatch Sec. 4.2 Eq. 17
     gaze_blind: bool = False
+    # identify (PushRecovery's eleventh pass: loose cubes, tasks.push_recovery.LOOSE_CUBES): before the push, once the
+    # wall has been looked at for ident_wall_s, the eye fixates the cube nearest the shoulder (by the horizontal
+    # distance of its mean line of sight's cut with the expected wall plane), and the second nearest if the first is
+    # identified loose (Johansson et al. 2001: gaze goes to the contact points before the hand; Eom section 7: gaze
+    # on the block's centre); the identities (the block_firm percept) are remembered. The scene's rule (exactly one
+    # of the two cubes nearest the shoulder is loose) completes the pair's identities once one is identified. After
+    # the push the hand goes to the nearest cube believed firm; of the two nearest, an unidentified one counts as
+    # possibly firm (a gamble when none is identified), a cube beyond them only ident_other_m farther; a cube
+    # believed loose only when no other is believed. Modelling choices.
+    identify: bool = True
+    ident_wall_s: float = 0.2
+    ident_other_m: float = 0.25
+    ident_choose: bool = True  # off: the looks only, the choice as without identities (a diagnostic)
     # The legs-only reference: the same agent with its hand kept at the ready point (no brace).
     use_hand: bool = True
 
@@ -248,7 +261,7 @@ class EomBraceParams:
             v = getattr(self, f.name)
             if f.name in ("foveated", "gaze_blind", "use_hand", "verge_on_sample", "fall_direction", "wall_normal",
                           "choose_by_ray", "drop_crowded", "verge_on_ray",
-                          "hand_on_cut", "verify_reach", "depth_search", "front_wall"):
+                          "hand_on_cut", "verify_reach", "depth_search", "front_wall", "identify", "ident_choose"):
                 if not isinstance(v, bool):
                     raise ValueError(f"EomBraceParams.{f.name} must be true or false, got {v!r}")
             elif f.name == "depth_grid_m":
@@ -358,6 +371,7 @@ class EomBraceAgent:
         self.still_since: float | None = None
         self.looked_away = False
         self.events: list[tuple[float, str]] = []
+        self.firm = np.zeros(N)  # identify: each cube's remembered identity, +1 firm, -1 loose, 0 unknown
 
     # --- belief -----------------------------------------------------------------------------------
     def estimate(self, i: int) -> np.ndarray:
@@ -564,6 +578,13 @@ class EomBraceAgent:
             self.started = True
         self.poses.append((rot.copy(), eye.copy(), float(obs[_S["fixation"]][0])))
         self._pose_pairs.append((rot.copy(), eye.copy()))
+        if "block_firm" in _S:
+            fr = obs[_S["block_firm"]]
+            for i in range(N):
+                if fr[i] != 0.0:
+                    if self.firm[i] == 0.0:
+                        self.events.append((t, f"identified {i} {'firm' if fr[i] > 0 else 'loose'}"))
+                    self.firm[i] = 1.0 if fr[i] > 0 else -1.0
         if len(self.poses) == self.delay_steps + 1:
             r0, e0, f0 = self.poses[0]
             self._slip_pose = self._pose_pairs[0] if len(self._pose_pairs) == self.delay_steps + 2 else None
@@ -646,6 +667,13 @@ class EomBraceAgent:
             if p.depth_search and known and k >= len(p.scan_x_m) and self.detected_at is None:
                 look_at, look_block = self._search_look(known, t)
                 search_look = True
+            elif p.identify and known \
+                    and t >= p.look_latency_s + p.ident_wall_s - 1e-9:
+                # Fixate the nearest cube to the shoulder not believed loose (its identity, then its place).
+                pair, belief = self._pair_beliefs(known, self._look_normal)
+                tgt = next((i for i in pair if belief[i] >= 0.0), pair[0])
+                look_at = self._direction_cut(tgt, self._look_normal)
+                look_block = tgt
             elif p.scan_blocks <= 0:
                 look_at = self._m(np.array([p.scan_x_m[k % len(p.scan_x_m)], p.scan_y_m, p.scan_z_m]))
             elif k < len(p.scan_x_m) or not known:
@@ -721,6 +749,11 @@ class EomBraceAgent:
                         hand = obs[_S["left_hand_pos" if left else "hand_pos"]].copy()
                         hand_speed = float(np.linalg.norm(obs[_S["left_hand_vel" if left else "hand_vel"]]))
                         lateral = lat2
+                if p.identify and p.ident_choose:
+                    pair, belief = self._pair_beliefs(known, n)
+                    pen = np.array([10.0 if belief[i] < 0 else (0.0 if (i in pair or belief[i] > 0) else p.ident_other_m)
+                                    for i in known])
+                    lateral = lateral + pen
                 previous = self.chosen
                 self.chosen = known[int(np.argmin(lateral))]
                 if self.chosen != previous:
@@ -812,6 +845,22 @@ class EomBraceAgent:
                 if sample[0] > 0 and foveation.eccentricity(sample) < p.verge_ecc_deg * DEG:
                     fixation = float(np.linalg.norm(sample))
         return encode(target, brace, gaze, fixation, head, self.gaze_range, left=left)
+
+    def _pair_beliefs(self, known: list, n: np.ndarray) -> tuple[list, dict]:
+        """identify: the two cubes nearest the shoulder (horizontal distance of their mean lines of sight's cuts with
+        the plane along ``n``) and every known cube's believed identity (+1 firm, -1 loose, 0 unknown): the
+        remembered one, the pair's completed by the scene's rule (exactly one of the two is loose)."""
+        cuts = np.array([self._direction_cut(i, n) for i in known]) - self.shoulder
+        order = [known[j] for j in np.argsort(np.linalg.norm(cuts[:, :2], axis=1), kind="stable")]
+        pair = order[:2]
+        belief = {i: float(self.firm[i]) for i in known}
+        if len(pair) == 2:
+            a, b = pair
+            if belief[a] != 0.0 and belief[b] == 0.0:
+                belief[b] = -belief[a]
+            elif belief[b] != 0.0 and belief[a] == 0.0:
+                belief[a] = -belief[b]
+        return pair, belief
 
     def _m(self, p: np.ndarray) -> np.ndarray:
         """A point or direction of the scene given for the wall on the right: mirrored (y -> -y) for the wall on the
