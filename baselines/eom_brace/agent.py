@@ -132,13 +132,13 @@ class EomBraceParams:
     ray_plane_m: float = 0.7
     # ... and the chosen cube is looked at on its mean line of sight at that plane until its belief's best
     # sample weight reaches cut_until_w (1/m^2: a depth std of 1/sqrt(w), 400 = 5 cm; modelling choice)
-    cut_until_w: float = 400.0
+    cut_until_w: float = 25.0  # 400 before the eleventh pass (the looks before the push now measure the cubes)
     hand_on_cut: bool = True  # ... and the hand aims there too until then (modelling choice; on since the fourth pass)
     # verge_on_ray: the vergence distance of a look at a cube is its line of sight's cut with that plane, not
     # the belief's distance (a belief from peripheral samples is wrong mostly along the line of sight, and a
     # fixation verged at the wrong distance keeps the depth coarse: the depth pedestal; modelling choice).
     verge_on_ray: bool = True  # on since the fourth pass
-    verge_on_sample: bool = False
+    verge_on_sample: bool = True  # on since the eleventh pass (the looks at the cubes before the push)
     verge_ecc_deg: float = 5.0
     hand_ready: tuple = (0.1, -0.4, 0.27)  # stance frame: the hand waits beside the hip, toward the wall (modelling choice)
     # The reaction: saccade and hand start this long after the detection. Arm reactions to a perturbation
@@ -195,7 +195,7 @@ class EomBraceParams:
     # et al. 1989; Collewijn et al. 1995), until it is known within reach or beyond (posterior probability
     # search_sure, or search_max_s on one cube); after the push the brace chooses among the cubes believed within
     # reach (probability >= 0.5) and aims at the believed face given that it is within reach (modelling choices).
-    depth_search: bool = False
+    depth_search: bool = True  # on since the eleventh pass (with identify: the looks at the cubes verge on them)
     depth_grid_m: tuple = (0.3, 2.0)
     depth_grid_step_m: float = 0.02
     search_blocks: int = 3
@@ -250,8 +250,10 @@ class EomBraceParams:
     # possibly firm (a gamble when none is identified), a cube beyond them only ident_other_m farther; a cube
     # believed loose only when no other is believed. Modelling choices.
     identify: bool = True
-    ident_wall_s: float = 0.2
+    ident_wall_s: float = 0.35
     ident_other_m: float = 0.25
+    ident_scan: int = 2  # ... the cubes looked at before the push (modelling choice)
+    ident_measured_w: float = 25.0  # ... a cube placed by its fused estimate once a sample this precise came (1/m^2)
     ident_choose: bool = True  # off: the looks only, the choice as without identities (a diagnostic)
     # The legs-only reference: the same agent with its hand kept at the ready point (no brace).
     use_hand: bool = True
@@ -375,6 +377,8 @@ class EomBraceAgent:
 
     # --- belief -----------------------------------------------------------------------------------
     def estimate(self, i: int) -> np.ndarray:
+        if self.w[i] <= 0.0:  # identify with depth_search: only lines of sight recorded so far
+            return self._direction_cut(i, self.normal)
         return self.sum[i] / self.w[i]
 
     def _fuse(self, i: int, pos_eye: np.ndarray, rot: np.ndarray, eye: np.ndarray, fixation: float) -> None:
@@ -660,19 +664,36 @@ class EomBraceAgent:
         brace = 1.0
         look_at = None
         look_block = None
-        known = [i for i in range(N) if self.w[i] > 0]
+        known = [i for i in range(N) if self.w[i] > 0
+                 or (p.identify and p.depth_search and self.dir_n[i] > 0)]  # identify: a recorded line of sight
         search_look = False
         if t >= p.look_latency_s - 1e-9 and self._side_known:
             k = int((t - p.look_latency_s + 1e-9) // p.scan_dwell_s)
-            if p.depth_search and known and k >= len(p.scan_x_m) and self.detected_at is None:
+            if p.depth_search and known and k >= len(p.scan_x_m) and self.detected_at is None and not p.identify:
                 look_at, look_block = self._search_look(known, t)
                 search_look = True
             elif p.identify and known \
                     and t >= p.look_latency_s + p.ident_wall_s - 1e-9:
-                # Fixate the nearest cube to the shoulder not believed loose (its identity, then its place).
-                pair, belief = self._pair_beliefs(known, self._look_normal)
-                tgt = next((i for i in pair if belief[i] >= 0.0), pair[0])
-                look_at = self._direction_cut(tgt, self._look_normal)
+                # Fixate, nearest first, the ident_scan cubes nearest the shoulder that are not yet identified (or
+                # measured: a fixated sample of weight >= ident_measured_w); then rest on the nearest believed firm.
+                yaw = p.search_yaw_deg * DEG
+                n0 = self._m(np.array([math.sin(yaw), -math.cos(yaw), 0.0])) if p.depth_search else self._look_normal
+                if self.detected_at is not None:
+                    n0 = n
+                order, belief = self._pair_beliefs(known, n0, full=True)
+                cand = order[:p.ident_scan]
+                todo = [i for i in cand if self.firm[i] == 0.0
+                        or (not p.depth_search and self.best_w[i] < p.ident_measured_w)]
+                if belief.get(order[0], 0.0) != 0.0 and len(order) > 1 and belief.get(order[1], 0.0) != 0.0:
+                    todo = [i for i in todo if i not in order[:2]]  # the pair known: look at nothing farther
+                    todo = []
+                firm = [i for i in order[:2] if belief[i] > 0.0]
+                tgt = todo[0] if todo else (firm[0] if firm else order[0])
+                if p.depth_search:  # along its line of sight, verged at its most probable distance
+                    look_at = self._depth_mode(tgt, n0)
+                    search_look = True
+                else:
+                    look_at = self._direction_cut(tgt, n0)
                 look_block = tgt
             elif p.scan_blocks <= 0:
                 look_at = self._m(np.array([p.scan_x_m[k % len(p.scan_x_m)], p.scan_y_m, p.scan_z_m]))
@@ -706,6 +727,8 @@ class EomBraceAgent:
                 depth = faces @ n
                 if p.choose_by_ray:
                     faces = np.array([self._direction_cut(i, n) for i in known]) - self.shoulder
+                if p.identify and p.depth_search:
+                    faces = np.array([self._depth_point(i, n) for i in known]) - self.shoulder
                 lateral = np.linalg.norm(faces - np.outer(faces @ n, n), axis=1)
                 if p.depth_search and p.reach_max_m > 0:
                     # The cubes believed within reach (the vergence search's posterior), the nearest to the
@@ -846,11 +869,16 @@ class EomBraceAgent:
                     fixation = float(np.linalg.norm(sample))
         return encode(target, brace, gaze, fixation, head, self.gaze_range, left=left)
 
-    def _pair_beliefs(self, known: list, n: np.ndarray) -> tuple[list, dict]:
+    def _pair_beliefs(self, known: list, n: np.ndarray, full: bool = False) -> tuple[list, dict]:
         """identify: the two cubes nearest the shoulder (horizontal distance of their mean lines of sight's cuts with
         the plane along ``n``) and every known cube's believed identity (+1 firm, -1 loose, 0 unknown): the
         remembered one, the pair's completed by the scene's rule (exactly one of the two is loose)."""
-        cuts = np.array([self._direction_cut(i, n) for i in known]) - self.shoulder
+        w = self.params.ident_measured_w
+        if self.params.depth_search:
+            cuts = np.array([self._depth_point(i, n) for i in known]) - self.shoulder
+        else:
+            cuts = np.array([self.estimate(i) if self.best_w[i] >= w else self._direction_cut(i, n) for i in known]) \
+                - self.shoulder
         order = [known[j] for j in np.argsort(np.linalg.norm(cuts[:, :2], axis=1), kind="stable")]
         pair = order[:2]
         belief = {i: float(self.firm[i]) for i in known}
@@ -860,7 +888,7 @@ class EomBraceAgent:
                 belief[b] = -belief[a]
             elif belief[b] != 0.0 and belief[a] == 0.0:
                 belief[a] = -belief[b]
-        return pair, belief
+        return (order if full else pair), belief
 
     def _m(self, p: np.ndarray) -> np.ndarray:
         """A point or direction of the scene given for the wall on the right: mirrored (y -> -y) for the wall on the
