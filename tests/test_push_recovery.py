@@ -638,7 +638,7 @@ def test_eom_brace_finds_the_wall_s_side_before_the_push(monkeypatch):
 
 
 # --- no hidden truth: the wall's side is seen, not given ---------------------------------------------------
-PERCEPT_KEYS = ("block_pos", "block_visible", "block_age")
+PERCEPT_KEYS = ("block_pos", "block_visible", "block_firm", "block_age")
 
 
 def _first_left_seed():
@@ -745,3 +745,221 @@ def test_eom_brace_reads_a_wall_in_front_from_the_cubes_lines_of_sight():
                 ag._los_eye[i] = eye
                 ag._los_n[i] = 1
             assert ag._front_from_lines() is (front and on)
+
+
+# --- the eleventh pass: loose cubes and the foveal identity percept ----------------------------------------
+def _drive_hand_into(cube_loose: bool, seed: int = 4):
+    """The hand driven (true geometry, Oracle rung) onto the face of the cube nearest x = 0.05 m, 2 cm beyond it,
+    after the push, with that cube made loose or firm: (fell, first contact time)."""
+    env = gym.make(ENV, vision="oracle")
+    _obs, info = env.reset(seed=seed)
+    u = env.unwrapped
+    faces = info["block_faces"]
+    i = int(np.argmin(np.abs(faces[:, 0] - 0.05)))
+    mask = np.zeros(sn.N_BLOCKS, dtype=bool)
+    mask[i] = cube_loose
+    u.task.set_loose(mask)
+    point = faces[i].copy()
+    a = np.zeros(env.action_space.shape, np.float32)
+    a[3] = 1.0
+    while True:
+        pushed = u.data.time >= info["push_time"]
+        target = point + (0.0, -0.02, 0.0) if pushed else np.array([point[0], -0.4, point[2]])
+        a[:3] = sn.hand_target_action(target)
+        _obs, _r, terminated, truncated, step_info = env.step(a)
+        if terminated or truncated:
+            break
+    env.close()
+    return step_info["fallen"], step_info["first_contact_time"], i
+
+
+def test_a_loose_cube_lets_the_hand_through_where_a_firm_one_holds_it(monkeypatch):
+    """The same hand path onto the same cube (the wall beside the body, on the right): firm, the palm touches it;
+    loose, the palm never touches a cube and the body falls (through it: a loose cube collides with nothing)."""
+    monkeypatch.setattr(pr, "WALL_YAW_DEG", (0.0, 0.0))
+    monkeypatch.setattr(pr, "WALL_SIDE_RANDOM", False)
+    _fell, firm_contact, i = _drive_hand_into(False)
+    fell, loose_contact, j = _drive_hand_into(True)
+    assert i == j
+    assert firm_contact > 0
+    assert loose_contact < 0 and fell
+
+
+def test_a_loose_cube_makes_no_contact_with_a_body_inside_it_where_a_firm_one_does():
+    """Physics alone: a pool cube moved into the standing body's head has contacts with it over 20 physics steps when
+    firm and none when loose (the collision bits the task sets)."""
+    env = gym.make(ENV, vision="oracle")
+    u = env.unwrapped
+    task = u.task
+    contacts = {}
+    for loose in (False, True):
+        env.reset(seed=0)
+        task.set_loose(np.full(sn.N_BLOCKS, loose))
+        d = u.data
+        head = d.xpos[mujoco.mj_name2id(u.model, mujoco.mjtObj.mjOBJ_BODY, "head")].copy()
+        d.mocap_pos[task._mocap[0]] = head + (0.0, 0.0, -0.05)
+        mujoco.mj_forward(u.model, d)
+        n = 0
+        for _ in range(20):
+            mujoco.mj_step(u.model, d)
+            n += sum(1 for g1, g2 in d.contact.geom.tolist() if task._block_geom[0] in (g1, g2))
+        contacts[loose] = n
+    assert contacts[False] > 0 and contacts[True] == 0, contacts
+    env.close()
+
+
+class _Eye:
+    def __init__(self):
+        self.pos = np.zeros(3)
+        self.rot = np.eye(3)  # column 0: the line of sight, +x
+
+
+@pytest.mark.parametrize("distance", [0.6, 0.8])
+def test_the_identity_percept_is_given_only_within_the_texture_s_crowding_limit(distance):
+    """A cube face of half-size 0.1 m at ``distance`` on a line of sight theta off the eye's: identified (its truth)
+    when theta - atan(0.1 / d) <= 2 atan(0.01 / d) (Bouma's 0.5 and the 1 cm texture, computed by hand here), not
+    beyond; and never on a step without a sample (a saccade, outside the field)."""
+    env = gym.make(ENV)
+    env.reset(seed=0)
+    task = env.unwrapped.task
+    task.attach_eye(_Eye(), env.unwrapped.retina, "foveated", 0.5)
+    limit = math.atan(0.1 / distance) + 2.0 * math.atan(0.01 / distance)
+    assert abs(pr.ident_eccentricity(distance) - 2.0 * math.atan(0.01 / distance)) < 1e-12
+    assert math.radians(1.3) < pr.ident_eccentricity(distance) < math.radians(2.0)
+    task._half[:] = 0.0
+    task._half[2] = 0.1
+    for loose, truth in ((True, -1.0), (False, 1.0)):
+        mask = np.zeros(sn.N_BLOCKS, dtype=bool)
+        mask[2] = loose
+        task.set_loose(mask)
+        for theta, expected in ((limit - 0.002, truth), (limit + 0.002, 0.0), (0.0, truth), (0.5, 0.0)):
+            task.targets[2].place(distance * math.cos(theta), distance * math.sin(theta), 0.0)
+            seen = [([0.0] * 3, [0.0] * 3, True)] * sn.N_BLOCKS
+            assert task._identify(seen)[2] == expected, (theta, limit)
+            unseen = [([0.0] * 3, [0.0] * 3, False)] * sn.N_BLOCKS
+            assert task._identify(unseen)[2] == 0.0  # no sample this step (saccadic suppression, field)
+    env.close()
+
+
+def test_no_identity_during_a_saccade_and_the_truth_on_the_oracle_and_full_view_rungs():
+    """On the foveated rung block_firm is 0 on every step whose observation was taken during a saccade (no
+    sample); the Oracle rung gives every placed cube's truth, the full-view rung every sampled cube's."""
+    env = gym.make(ENV, obs_mode="dict")
+    obs, _ = env.reset(seed=1)
+    loose = env.unwrapped.task.loose.copy()
+    a = np.zeros(env.action_space.shape, np.float32)
+    saccades = 0
+    for k in range(40):
+        a[5] = -1.0 if k % 8 == 0 else 0.0  # a 60 deg saccade to the right every 8 steps
+        obs, *_ = env.step(a)
+        if not np.any(obs["block_visible"]):
+            saccades += 1
+            assert not np.any(obs["block_firm"])
+        assert np.all(obs["block_firm"][obs["block_visible"] < 0.5] == 0.0)
+    assert saccades > 0
+    env.close()
+    n = len(env.unwrapped.task.block_faces)
+    for vision in ("oracle", "full_view"):
+        e = gym.make(ENV, vision=vision, obs_mode="dict")
+        o, _ = e.reset(seed=1)
+        np.testing.assert_array_equal(e.unwrapped.task.loose, loose)  # one seed, one scenario on every rung
+        np.testing.assert_array_equal(o["block_firm"][:n], np.where(loose[:n], -1.0, 1.0))
+        e.close()
+
+
+def test_exactly_one_of_the_two_cubes_nearest_the_shoulder_is_loose_and_the_geometry_is_unchanged(monkeypatch):
+    """Over 200 seeds: of the two cubes nearest the bracing shoulder (horizontal distance to the face centre)
+    exactly one is loose, and each of the others about half the time. The draws take nothing from the episode's
+    generator: with LOOSE_CUBES off, the same seed gives the same wall, push, side and (20 steps of a held pose)
+    every observation but the identity percept."""
+    others, n_others = 0, 0
+    for seed in range(200):
+        env = gym.make(ENV)
+        env.reset(seed=seed)
+        t = env.unwrapped.task
+        d = np.linalg.norm(t.block_faces[:, :2] - t.shoulder_world()[:2], axis=1)
+        order = np.argsort(d)
+        assert int(t.loose[order[:2]].sum()) == 1, seed
+        others += int(t.loose[order[2:]].sum())
+        n_others += len(order) - 2
+        env.close()
+    assert 0.4 < others / n_others < 0.6
+    zero = None
+    for seed in (0, 7):
+        runs = []
+        for on in (True, False):
+            monkeypatch.setattr(pr, "LOOSE_CUBES", on)
+            env = gym.make(ENV, obs_mode="dict")
+            obs, info = env.reset(seed=seed)
+            zero = np.zeros(env.action_space.shape, np.float32)
+            seq = [obs]
+            for _ in range(20):
+                seq.append(env.step(zero)[0])
+            t = env.unwrapped.task
+            runs.append((info, seq, t.loose.copy()))
+            env.close()
+        (ia, sa, la), (ib, sb, lb) = runs
+        assert la.any() and not lb.any()
+        for key in ("block_faces", "block_half_sizes", "push_time", "push_force", "push_dir", "wall_distance",
+                    "wall_side"):
+            np.testing.assert_array_equal(ia[key], ib[key], err_msg=key)
+        for oa, ob in zip(sa, sb):
+            for key in oa:
+                if key != "block_firm":
+                    np.testing.assert_array_equal(oa[key], ob[key], err_msg=key)
+
+
+def _lockstep(env_id: str, seed: int, flip: int, steps: int = 80):
+    """eom_brace plays ``seed``; a second env of the same seed with cube ``flip``'s identity flipped gets the same
+    actions. Returns the dict observations of both and the first step at which the played env's block_firm of that
+    cube is non-zero (None if never)."""
+    a = gym.make(env_id, obs_mode="dict")
+    b = gym.make(env_id, obs_mode="dict")
+    oa, _ = a.reset(seed=seed)
+    ob, _ = b.reset(seed=seed)
+    mask = b.unwrapped.task.loose.copy()
+    mask[flip] = not mask[flip]
+    b.unwrapped.task.set_loose(mask)
+    agent = make_agent("eom_brace", env_id, a.action_space.shape[0], seed=seed)
+    flat = a.unwrapped.layout
+    seq, first = [], None
+    for k in range(steps):
+        seq.append((oa, ob))
+        if first is None and oa["block_firm"][flip] != 0.0:
+            first = k
+            break
+        vec = np.concatenate([np.asarray(oa[blk.name], dtype=np.float32).reshape(-1) for blk in flat.blocks])
+        act, _ = agent.predict(vec)
+        oa, *_ = a.step(act)
+        ob, *_ = b.step(act)
+    a.close()
+    b.close()
+    return seq, first
+
+
+def test_no_observation_carries_a_cube_s_identity_until_it_is_fixated():
+    """The counterfactual scene: the same seed with the identity of the cube eom_brace looks at first flipped. Every
+    observation is identical until the step the eye identifies that cube (far outside the fovea before), and on
+    that step the identity percepts differ; on the Oracle rung they differ from the first observation."""
+    env = gym.make(ENV)
+    env.reset(seed=1)
+    t = env.unwrapped.task
+    cube = int(np.argmin(np.linalg.norm(t.block_faces[:, :2] - t.shoulder_world()[:2], axis=1)))
+    env.close()
+    seq, first = _lockstep(ENV, 1, cube)
+    assert first is not None and first > 5, first  # identified by a look, some steps in
+    for oa, ob in seq[:-1]:
+        for key in oa:
+            np.testing.assert_array_equal(oa[key], ob[key], err_msg=key)
+    oa, ob = seq[-1]
+    assert oa["block_firm"][cube] == -ob["block_firm"][cube] != 0.0
+    oracle, first_oracle = _lockstep("PushRecoveryOracle-v0", 1, cube, steps=2)
+    assert first_oracle == 0 and oracle[0][0]["block_firm"][cube] == -oracle[0][1]["block_firm"][cube]
+
+
+def test_eom_brace_chooses_the_firm_cube_of_the_pair_it_identified():
+    """On the Oracle rung (every identity known) eom_brace's chosen cube is firm on seeds 0-9 (whichever of the two
+    nearest it is)."""
+    for seed in range(10):
+        env, agent, _info = _play("eom_brace", seed, "PushRecoveryOracle-v0")
+        assert agent.chosen is not None and not env.unwrapped.task.loose[agent.chosen], seed

@@ -308,6 +308,10 @@ class EomBraceAgent:
 
     def __init__(self, params: EomBraceParams | None = None, dt: float = 0.02, vision: VisionParams | None = None):
         self.params = params or EomBraceParams()
+        if self.params.depth_search and self.params.identify and not self.params.foveated:
+            # The vergence search is for the foveated eye's depth law; an eye without a periphery (the Oracle and
+            # FullView rungs) places every cube by its fused samples (measured: the search cost the Oracle rung).
+            self.params = replace(self.params, depth_search=False)
         p = self.params
         self.dt = float(dt)
         base = vision if vision is not None else VisionParams()  # the env's eye (for_env: its vision defaults)

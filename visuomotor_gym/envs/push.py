@@ -54,7 +54,7 @@ class PushRecoveryEnv(VisuomotorEnv):
     floor through real foot contact, the seated body's waist, its 7-DOF right arm and that arm mirrored as
     the left, the shared head and cyclopean eye; ``envs_assets/push.xml``) stands beside a **wall of cube
     blocks** (Eom et al. 2019, section 7) on its right or its left (drawn per episode, 50/50), the wall
-    turned 0-30 deg forward per episode. Between 0.6 and 1.4 s after the start
+    turned 0-30 deg forward per episode. Between 1.0 and 2.0 s after the start
     a **push** (a 150 ms horizontal force of 300-350 N on the torso, along the wall's normal within +-10 deg)
     tips it toward the wall: the legs hold their stance through position servos with an automatic ankle
     response to the extrapolated centre of mass, but cannot stop the fall (a centre of mass carried past the
@@ -106,8 +106,8 @@ class PushRecoveryEnv(VisuomotorEnv):
     Terminated on **success** (``info["is_success"]``): upright 2.5 s after the push's onset; on a
     **fall** (``info["fallen"]``): a contact between the floor or a cube and any body geom other than
     the feet and the palm, or the head below 1.0 m (checked after every physics substep); or on a physics
-    divergence. Truncated by the registered ``max_episode_steps`` (200 steps = 4 s; never reached: the
-    push comes by 1.4 s and the episode ends 2.5 s later).
+    divergence. Truncated by the registered ``max_episode_steps`` (250 steps = 5 s; never reached: the
+    push comes by 2.0 s and the episode ends 2.5 s later).
 
     ## Arguments
 
@@ -229,7 +229,7 @@ if PushRecoveryEnv.__doc__:
 # ---------------------------------------------------------------- the family record (visuomotor_gym.family)
 from visuomotor_gym.family import Family, Viz
 
-PUSH_MAX_EPISODE_STEPS = 200  # 4 s at 50 Hz: the push by 1.4 s, then 2.5 s to stay upright (never reached)
+PUSH_MAX_EPISODE_STEPS = 250  # 5 s at 50 Hz: the push by 2.0 s, then 2.5 s to stay upright (never reached)
 
 FAMILY = Family(
     name="push",
