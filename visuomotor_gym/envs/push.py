@@ -60,7 +60,11 @@ class PushRecoveryEnv(VisuomotorEnv):
     response to the extrapolated centre of mass, but cannot stop the fall (a centre of mass carried past the
     feet's edge falls). It stays upright only if a hand lands on a cube and holds: **there is nothing
     behind or between the cubes**, so a hand that lands in a gap, slides off an edge or stops short of
-    the wall does not hold. The wall's distance (0.60-0.80 m from the body's midline), each cube's size
+    the wall does not hold. Some cubes are **loose** (they give way under a hand: modelled as cubes that collide
+    with nothing, a simplification): of the two cubes nearest the bracing shoulder exactly one, each other cube with
+    probability 1/2; whether a cube is firm is seen only by **central vision** (``block_firm``: a line of sight within
+    2 atan(1 cm / d) of the cube's face, 1.4-1.9 deg at 0.6-0.8 m, from Bouma's law on a 1 cm texture; not during a
+    saccade). The wall's distance (0.60-0.80 m from the body's midline), each cube's size
     (14-22 cm), the gaps (12-30 cm), the cubes' heights (1.00-1.35 m) and how far each stands out of the
     wall (0-10 cm)
     are drawn per episode and reach the agent only as the eye's samples of the cubes' faces (foveated
@@ -99,7 +103,8 @@ class PushRecoveryEnv(VisuomotorEnv):
     Standing still, legs straight, feet at shoulder width (sole centres 32 cm apart), the hand in front of the belly, looking straight
     ahead (3 m away at 1.3 m height, with a 2 deg Gaussian jitter); the right arm drives, the left hangs.
     ``info`` at reset: ``block_faces`` ((n, 3) true face centres), ``block_half_sizes``, ``push_time``,
-    ``push_force``, ``push_dir``, ``wall_distance``, ``wall_side`` (-1 right, +1 left) (scoring only). The same seed gives the same wall and push on every rung.
+    ``push_force``, ``push_dir``, ``wall_distance``, ``wall_side`` (-1 right, +1 left), ``block_loose`` (scoring
+    only). The same seed gives the same wall and push on every rung.
 
     ## Episode End
 
