@@ -143,6 +143,15 @@ class PushRecoveryEnv(VisuomotorEnv):
       angle (``human_periphery()``'s ``angular_lateral_noise``, on for every family): eom_brace 91.0 %, the
       held twin 23.5 %, the searched posture 46.0 %, the hand-picked posture toward the left wall 54.0 %, kept
       as the static twin (gaze gain +37.0; +45.0 against the searched posture).
+    * v0, redefined in place again (PushRecovery's eleventh pass): **loose cubes** (of the two cubes nearest the
+      bracing shoulder exactly one, each other cube with probability 1/2; a loose cube collides with nothing), seen
+      only by central vision: the observation gains ``block_firm`` (6 values, 119 in all; the action is unchanged);
+      the push comes 1.0-2.0 s after the start (0.6-1.4 s before) and episodes last 250 steps (200 before). The loose
+      draws take nothing from the episode's generator: every other draw of a seed is unchanged. On the pinned seeds
+      0-199 eom_brace (its new defaults: identification looks, the vergence search) keeps 90.0 % upright, the Oracle
+      rung 91.5 %; the best still posture found (the hand-picked one toward the left wall) 45.5 %, the static
+      search's posture 38.0 %, the held twin 16.0 %: gaze gain +44.5 (docs/reproductions/eom.md, eleventh pass).
+      Former leaderboard entries are superseded.
     """
 
     render_cameras: ClassVar[dict[str, tuple[str, ...]]] = {
