@@ -38,6 +38,11 @@ before the push (the human field reaches 100 deg to each side), then that of the
 that never sees a cube (a static posture turned away from the wall) has none to brace on: the hand stays at its
 ready point, as the legs-only reference.
 
+Since the eleventh pass (loose cubes, seen only by central vision: the ``block_firm`` percept) the agent identifies
+before the push the cube nearest the shoulder, and the second nearest if the first is loose (``identify``), each look
+verged by the vergence search (``depth_search``, on for a foveated eye), and braces on the nearest cube believed firm
+(docs/reproductions/eom.md, eleventh pass).
+
 ``gaze_blind`` is the twin with gaze, vergence and head held (zero actions); the registered
 ``gaze_blind:eom_brace`` wrapper gives the same. ``use_hand=false`` is the legs-only reference: the same
 agent whose hand stays at its ready point.
