@@ -224,11 +224,36 @@ def test_the_summary_and_realism_of_eom_brace_episodes():
     assert s["episodes"] == 3 and s["success"] == 3
     components = s["gaze_realism"]["components"]
     lead = components["gaze_hand_lead_s"]["value"]
-    # gaze reaches the cube before the hand (Land et al. 1999); since the eleventh pass it is on the cube from the
-    # identification look before the push (Johansson et al. 2001), 1-2 s before the hand
-    assert 0.0 < lead < 2.5, lead
+    # gaze reaches the cube before the hand (Land et al. 1999): the last stretch of gaze on it before the contact
+    # (the identification look before the push, broken off, does not count)
+    assert 0.0 < lead < 1.5, lead
     reaction = components["hand_reaction_s"]["value"]
     assert 0.0 < reaction < 0.4, reaction
+
+
+def test_the_gaze_hand_lead_counts_from_the_last_arrival_of_gaze_on_the_cube():
+    from types import SimpleNamespace
+
+    from visuomotor_gym.metrics.push_realism import push_measures
+
+    # 11 steps of 0.1 s; one cube face 1 m ahead of an eye at the origin; the hand touches it at step 9.
+    # Gaze: on it (0 deg) at steps 1-3, away (90 deg) at 4-5, on it again from step 6: the lead is 0.9 - 0.6 s.
+    n, dt = 11, 0.1
+    on = [False, True, True, True, False, False, True, True, True, True, True]
+    gaze = [[1.0, 0.0, 0.0] if o else [0.0, 1.0, 0.0] for o in on]
+    hand = [[0.5 + 0.05 * k, 0.0, 0.0] for k in range(n)]
+    touch = [k >= 9 for k in range(n)]
+    faces = [[1.0, 0.0, 0.0]] + [[1.0, 5.0, 0.0]] * 5
+    tr = SimpleNamespace(t=[dt * k for k in range(n)], dt=dt, hand_pos=hand, push_time=0.35,
+                         saccade_onset=[False] * n, hand_on_block=touch, block_faces=faces, gaze_dir=gaze,
+                         eye_pos=[[0.0, 0.0, 0.0]] * n)
+    assert push_measures(tr)["gaze_hand_lead_s"] == pytest.approx(0.9 - 0.6)
+    # the same episode without the break: gaze on the cube from step 1, a lead of 0.8 s
+    tr.gaze_dir = [[1.0, 0.0, 0.0] if k >= 1 else [0.0, 1.0, 0.0] for k in range(n)]
+    assert push_measures(tr)["gaze_hand_lead_s"] == pytest.approx(0.8)
+    # gaze only after the contact: undefined
+    tr.gaze_dir = [[1.0, 0.0, 0.0] if k >= 10 else [0.0, 1.0, 0.0] for k in range(n)]
+    assert math.isnan(push_measures(tr)["gaze_hand_lead_s"])
 
 
 # --- robustness ----------------------------------------------------------------------------------
