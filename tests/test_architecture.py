@@ -272,11 +272,12 @@ REGISTERED_BEFORE_THE_RECORDS = (
     ('SteppingStonesDelayed-v0', 'stones:SteppingStonesEnv', {'visual_delay_s': 0.1}, 1000, 'stones'),
     ('SteppingStonesPoorVision-v0', 'stones:SteppingStonesEnv', {'vision_noise_scale': 2.0}, 1000, 'stones'),
     # The first family added on the records: its ids follow from its record alone.
-    ('PushRecoveryOracle-v0', 'push:PushRecoveryEnv', {'vision': 'oracle'}, 200, 'push'),
-    ('PushRecoveryFullView-v0', 'push:PushRecoveryEnv', {'vision': 'full_view'}, 200, 'push'),
-    ('PushRecovery-v0', 'push:PushRecoveryEnv', {}, 200, 'push'),
-    ('PushRecoveryDelayed-v0', 'push:PushRecoveryEnv', {'visual_delay_s': 0.1}, 200, 'push'),
-    ('PushRecoveryPoorVision-v0', 'push:PushRecoveryEnv', {'vision_noise_scale': 2.0}, 200, 'push'),
+    # PushRecovery's eleventh pass (the push at 1.0-2.0 s): 250 steps, 200 before.
+    ('PushRecoveryOracle-v0', 'push:PushRecoveryEnv', {'vision': 'oracle'}, 250, 'push'),
+    ('PushRecoveryFullView-v0', 'push:PushRecoveryEnv', {'vision': 'full_view'}, 250, 'push'),
+    ('PushRecovery-v0', 'push:PushRecoveryEnv', {}, 250, 'push'),
+    ('PushRecoveryDelayed-v0', 'push:PushRecoveryEnv', {'visual_delay_s': 0.1}, 250, 'push'),
+    ('PushRecoveryPoorVision-v0', 'push:PushRecoveryEnv', {'vision_noise_scale': 2.0}, 250, 'push'),
 )
 
 

@@ -63,6 +63,9 @@ DOCUMENTED_CONSTANTS: tuple[tuple[str, str, tuple[str, ...] | None, str], ...] =
       "(tests/test_stepping_stones.py steps on stones)")),
     ("push", r"block_age\[0\]", None, "the age of the visual samples is the rung's visual latency"),
     ("push", r"block_visible\[\d\]", ("oracle", "full_view"), "every cube is seen without a field-of-view limit"),
+    ("push", r"block_firm\[\d\]", ("foveated",),
+     ("a cube is identified only within ~2 deg of its face (central vision, tests/test_push_recovery.py); a random "
+      "gaze seldom lands there")),
     ("catch", r"balls_caught\[[01]\]|holding\[0\]", None,
      "touch blocks change only on a catch, which random actions do not make (tests/test_two_balls.py)"),
 )

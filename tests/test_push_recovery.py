@@ -56,6 +56,25 @@ THIRD_PASS = ("fall_direction=false,hold_lean_gain=0,hold_lean_damp=0,drop_crowd
               "choose_by_ray=false,verge_on_ray=false,hand_on_cut=false")
 
 
+# The scene and agent before PushRecovery's eleventh pass (no loose cubes, the push at 0.6-1.4 s; eom_brace without
+# the identification looks and the vergence search): tests of the brace's physics measured there pin them.
+TENTH_AGENT = {"identify": "false", "depth_search": "false", "verge_on_sample": "false", "cut_until_w": "400"}
+
+
+def _tenth(spec: str) -> str:
+    """An eom_brace spec with the tenth pass's defaults for every option it does not set."""
+    name, _, opts = spec.partition(":")
+    given = {kv.split("=")[0] for kv in opts.split(",") if kv}
+    extra = ",".join(f"{k}={v}" for k, v in TENTH_AGENT.items() if k not in given)
+    return f"{name}:{opts + ',' if opts else ''}{extra}"
+
+
+@pytest.fixture
+def tenth_pass(monkeypatch):
+    monkeypatch.setattr(pr, "LOOSE_CUBES", False)
+    monkeypatch.setattr(pr, "PUSH_TIME_S", (0.6, 1.4))
+
+
 def _play(agent_spec: str, seed: int, env_id: str = ENV, **env_kwargs):
     env = gym.make(env_id, **env_kwargs)
     agent = make_agent(agent_spec, env_id, env.action_space.shape[0], seed=seed)
@@ -132,7 +151,7 @@ def test_the_body_falls_without_bracing(seed):
     assert env.unwrapped.task.fall_geoms is not None
 
 
-def test_a_hand_in_a_gap_does_not_hold(monkeypatch):
+def test_a_hand_in_a_gap_does_not_hold(monkeypatch, tenth_pass):
     """The hand driven (true geometry) to the middle of the gap beside the cube nearest the shoulder: it
     passes between the cubes and the body falls; the same hand on that cube's face holds it. (The wall beside
     the body, yaw 0: the target's geometry below assumes it.)"""
@@ -166,19 +185,19 @@ def test_eom_brace_keeps_the_body_upright_on_a_few_seeds():
     for seed in (1, 2, 4):
         env, agent, info = _play("eom_brace", seed)
         assert info["is_success"] and not info["fallen"], (seed, env.unwrapped.task.fall_geoms)
-        kinds = [e for _t, e in agent.events]
+        kinds = [e for _t, e in agent.events if not e.startswith(("identified", "search"))]
         assert kinds[:1] == ["detect"] and "hold" in kinds, kinds
         assert info["first_contact_time"] > env.unwrapped.task.push_time
 
 
-def test_a_brace_that_keeps_pushing_throws_the_body_over_its_other_foot(monkeypatch):
+def test_a_brace_that_keeps_pushing_throws_the_body_over_its_other_foot(monkeypatch, tenth_pass):
     """Seed 8, the wall beside the body (yaw 0), the third pass's brace (a strut, no ankle response): the hand
     strikes the cube; an arm that keeps pushing as the body moves back (yield off) throws it away from the
     wall, over its left foot; the arm that yields keeps it upright."""
     monkeypatch.setattr(pr, "WALL_YAW_DEG", (0.0, 0.0))
     monkeypatch.setattr(pr, "WALL_SIDE_RANDOM", False)  # the wall on the right, as when measured
     monkeypatch.setattr(sn, "ANKLE_STRATEGY_GAIN", 0.0)
-    third = "eom_brace:" + THIRD_PASS
+    third = _tenth("eom_brace:" + THIRD_PASS)
     _env, _agent, info = _play(third, 8)
     assert info["is_success"], info
     _env, _agent, info = _play(third + ",yield_speed_m_s=-1", 8)
@@ -197,17 +216,44 @@ def test_the_gaze_blind_twin_falls_where_eom_brace_stands():
 def test_the_summary_and_realism_of_eom_brace_episodes():
     from visuomotor_gym.bench.evaluate import evaluate
 
-    # Seeds 15-17: upright, gaze on the face centre before the hand. (Not on every seed under the human
+    # Seeds 16-18: upright, gaze on the face centre before the hand. (Not on every seed under the human
     # periphery: on seeds 3-5 gaze gets there after the contact on the mean; docs/reproductions/eom.md, the
     # median over 200 seeds is +0.08 s.)
-    result = evaluate("eom_brace", ENV, episodes=3, seed=15, workers=1, keep_traces=True)
+    result = evaluate("eom_brace", ENV, episodes=3, seed=16, workers=1, keep_traces=True)
     s = result.summary
     assert s["episodes"] == 3 and s["success"] == 3
     components = s["gaze_realism"]["components"]
     lead = components["gaze_hand_lead_s"]["value"]
-    assert 0.0 < lead < 1.0, lead  # gaze reaches the cube before the hand (Land et al. 1999)
+    # gaze reaches the cube before the hand (Land et al. 1999): the last stretch of gaze on it before the contact
+    # (the identification look before the push, broken off, does not count)
+    assert 0.0 < lead < 1.5, lead
     reaction = components["hand_reaction_s"]["value"]
     assert 0.0 < reaction < 0.4, reaction
+
+
+def test_the_gaze_hand_lead_counts_from_the_last_arrival_of_gaze_on_the_cube():
+    from types import SimpleNamespace
+
+    from visuomotor_gym.metrics.push_realism import push_measures
+
+    # 11 steps of 0.1 s; one cube face 1 m ahead of an eye at the origin; the hand touches it at step 9.
+    # Gaze: on it (0 deg) at steps 1-3, away (90 deg) at 4-5, on it again from step 6: the lead is 0.9 - 0.6 s.
+    n, dt = 11, 0.1
+    on = [False, True, True, True, False, False, True, True, True, True, True]
+    gaze = [[1.0, 0.0, 0.0] if o else [0.0, 1.0, 0.0] for o in on]
+    hand = [[0.5 + 0.05 * k, 0.0, 0.0] for k in range(n)]
+    touch = [k >= 9 for k in range(n)]
+    faces = [[1.0, 0.0, 0.0]] + [[1.0, 5.0, 0.0]] * 5
+    tr = SimpleNamespace(t=[dt * k for k in range(n)], dt=dt, hand_pos=hand, push_time=0.35,
+                         saccade_onset=[False] * n, hand_on_block=touch, block_faces=faces, gaze_dir=gaze,
+                         eye_pos=[[0.0, 0.0, 0.0]] * n)
+    assert push_measures(tr)["gaze_hand_lead_s"] == pytest.approx(0.9 - 0.6)
+    # the same episode without the break: gaze on the cube from step 1, a lead of 0.8 s
+    tr.gaze_dir = [[1.0, 0.0, 0.0] if k >= 1 else [0.0, 1.0, 0.0] for k in range(n)]
+    assert push_measures(tr)["gaze_hand_lead_s"] == pytest.approx(0.8)
+    # gaze only after the contact: undefined
+    tr.gaze_dir = [[1.0, 0.0, 0.0] if k >= 10 else [0.0, 1.0, 0.0] for k in range(n)]
+    assert math.isnan(push_measures(tr)["gaze_hand_lead_s"])
 
 
 # --- robustness ----------------------------------------------------------------------------------
@@ -309,7 +355,7 @@ def test_the_new_options_refuse_bad_values(spec):
 
 
 # --- fourth pass: the active hold, crowded samples, choosing by the line of sight ----------
-def test_the_active_hold_keeps_a_body_upright_that_the_strut_lets_lean_over(monkeypatch):
+def test_the_active_hold_keeps_a_body_upright_that_the_strut_lets_lean_over(monkeypatch, tenth_pass):
     """Oracle rung, seed 6, the third pass's scene (wall beside the body, no ankle response) and agent: with
     the plain strut the hand rests on the cube's edge while the body leans on its right foot's outer edge and
     slowly tips into the wall (upper arm on a cube); the arm that pushes with the trunk's lean
@@ -317,10 +363,10 @@ def test_the_active_hold_keeps_a_body_upright_that_the_strut_lets_lean_over(monk
     monkeypatch.setattr(pr, "WALL_YAW_DEG", (0.0, 0.0))
     monkeypatch.setattr(pr, "WALL_SIDE_RANDOM", False)  # the wall on the right, as when measured
     monkeypatch.setattr(sn, "ANKLE_STRATEGY_GAIN", 0.0)
-    _env, _agent, info = _play("eom_brace:" + THIRD_PASS, 6, env_id="PushRecoveryOracle-v0")
+    _env, _agent, info = _play(_tenth("eom_brace:" + THIRD_PASS), 6, env_id="PushRecoveryOracle-v0")
     assert info["fallen"] and not info["is_success"]
     active = THIRD_PASS.replace("hold_lean_gain=0,hold_lean_damp=0", "hold_lean_gain=2,hold_lean_damp=0.1")
-    env, _agent, info = _play("eom_brace:" + active, 6, env_id="PushRecoveryOracle-v0")
+    env, _agent, info = _play(_tenth("eom_brace:" + active), 6, env_id="PushRecoveryOracle-v0")
     assert info["is_success"] and env.unwrapped.task.first_contact_time is not None
 
 
@@ -399,7 +445,7 @@ def test_a_back_row_sets_the_odd_cubes_behind_the_wall_plane(monkeypatch):
     np.testing.assert_allclose(moved[1::2], np.outer(np.ones(len(moved[1::2])), 0.4 * task.wall_normal), atol=1e-12)
 
 
-def test_reach_max_keeps_the_oracle_s_brace_off_a_back_cube(monkeypatch):
+def test_reach_max_keeps_the_oracle_s_brace_off_a_back_cube(monkeypatch, tenth_pass):
     """On the fifth pass's crowded row with a back row (seed 5), the brace that picks the cube nearest the fall
     line goes for back cube 1 and falls; with reach_max_m it holds on front cube 0."""
     for name, value in (("BACK_ROW_M", 0.4), ("BLOCK_HALF_SIZE_M", (0.04, 0.05)), ("GAP_M", (0.05, 0.08)),
@@ -408,7 +454,7 @@ def test_reach_max_keeps_the_oracle_s_brace_off_a_back_cube(monkeypatch):
     monkeypatch.setattr(sn, "ANKLE_STRATEGY_GAIN", 1.0)
     brace = "eom_brace:fall_direction=true,hold_lean_gain=2,hold_lean_damp=0.1"
     outcomes = {}
-    for spec in (brace, brace + ",reach_max_m=0.7"):
+    for spec in (_tenth(brace), _tenth(brace + ",reach_max_m=0.7")):
         env = gym.make("PushRecoveryOracle-v0")
         agent = make_agent(spec, "PushRecoveryOracle-v0", env.action_space.shape[0], seed=5)
         obs, info = env.reset(seed=5)
@@ -421,8 +467,8 @@ def test_reach_max_keeps_the_oracle_s_brace_off_a_back_cube(monkeypatch):
             if terminated or truncated:
                 break
         outcomes[spec] = (info["fallen"], touched)
-    assert outcomes[brace] == (True, {1})
-    assert outcomes[brace + ",reach_max_m=0.7"] == (False, {0})
+    assert outcomes[_tenth(brace)] == (True, {1})
+    assert outcomes[_tenth(brace + ",reach_max_m=0.7")] == (False, {0})
 
 
 # --- the sixth pass: the vergence search (depth_search, opt-in) ----------------------------------------------
@@ -474,7 +520,7 @@ def test_a_sample_put_behind_the_eye_is_kept_as_a_negative_distance():
 SEED_BACK = 2  # seeds 2 and 5 of 0-5 show it under the one eye (angular lateral noise); 3 did before
 
 
-def test_the_vergence_search_holds_on_a_back_row_where_the_fifth_pass_agent_falls(monkeypatch):
+def test_the_vergence_search_holds_on_a_back_row_where_the_fifth_pass_agent_falls(monkeypatch, tenth_pass):
     """The fifth pass's back row (odd cubes 0.4 m behind the wall plane, crowded row, wall 0..30 deg), seed
     SEED_BACK: the agent whose fixations are verged at the expected wall falls; with the vergence search it
     fixates the cubes nearest the fall line before the push, knows which are out of reach, and stands."""
@@ -482,9 +528,9 @@ def test_the_vergence_search_holds_on_a_back_row_where_the_fifth_pass_agent_fall
                         ("WALL_YAW_DEG", (0.0, 30.0)), ("ROW_HEIGHT_JITTER_M", 0.02)):
         monkeypatch.setattr(pr, name, value)
     monkeypatch.setattr(sn, "ANKLE_STRATEGY_GAIN", 1.0)
-    _env, _agent, info = _play("eom_brace:reach_max_m=0.7", SEED_BACK)
+    _env, _agent, info = _play(_tenth("eom_brace:reach_max_m=0.7"), SEED_BACK)
     assert info["fallen"]
-    _env, agent, info = _play("eom_brace:reach_max_m=0.7,depth_search=true", SEED_BACK)
+    _env, agent, info = _play(_tenth("eom_brace:reach_max_m=0.7,depth_search=true"), SEED_BACK)
     assert not info["fallen"]
     assert any(name.startswith("search") for _t, name in agent.events)
     n = agent.normal
@@ -638,7 +684,7 @@ def test_eom_brace_finds_the_wall_s_side_before_the_push(monkeypatch):
 
 
 # --- no hidden truth: the wall's side is seen, not given ---------------------------------------------------
-PERCEPT_KEYS = ("block_pos", "block_visible", "block_age")
+PERCEPT_KEYS = ("block_pos", "block_visible", "block_firm", "block_age")
 
 
 def _first_left_seed():
@@ -745,3 +791,229 @@ def test_eom_brace_reads_a_wall_in_front_from_the_cubes_lines_of_sight():
                 ag._los_eye[i] = eye
                 ag._los_n[i] = 1
             assert ag._front_from_lines() is (front and on)
+
+
+# --- the eleventh pass: loose cubes and the foveal identity percept ----------------------------------------
+def _drive_hand_into(cube_loose: bool, seed: int = 4):
+    """The hand driven (true geometry, Oracle rung) onto the face of the cube nearest x = 0.05 m, 2 cm beyond it,
+    after the push, with that cube made loose or firm: (fell, first contact time)."""
+    env = gym.make(ENV, vision="oracle")
+    _obs, info = env.reset(seed=seed)
+    u = env.unwrapped
+    faces = info["block_faces"]
+    i = int(np.argmin(np.abs(faces[:, 0] - 0.05)))
+    mask = np.zeros(sn.N_BLOCKS, dtype=bool)
+    mask[i] = cube_loose
+    u.task.set_loose(mask)
+    point = faces[i].copy()
+    a = np.zeros(env.action_space.shape, np.float32)
+    a[3] = 1.0
+    while True:
+        pushed = u.data.time >= info["push_time"]
+        target = point + (0.0, -0.02, 0.0) if pushed else np.array([point[0], -0.4, point[2]])
+        a[:3] = sn.hand_target_action(target)
+        _obs, _r, terminated, truncated, step_info = env.step(a)
+        if terminated or truncated:
+            break
+    env.close()
+    return step_info["fallen"], step_info["first_contact_time"], i
+
+
+def test_a_loose_cube_lets_the_hand_through_where_a_firm_one_holds_it(monkeypatch):
+    """The same hand path onto the same cube (the wall beside the body, on the right): firm, the palm touches it;
+    loose, the palm never touches a cube and the body falls (through it: a loose cube collides with nothing)."""
+    monkeypatch.setattr(pr, "WALL_YAW_DEG", (0.0, 0.0))
+    monkeypatch.setattr(pr, "WALL_SIDE_RANDOM", False)
+    _fell, firm_contact, i = _drive_hand_into(False)
+    fell, loose_contact, j = _drive_hand_into(True)
+    assert i == j
+    assert firm_contact > 0
+    assert loose_contact < 0 and fell
+
+
+def test_a_loose_cube_makes_no_contact_with_a_body_inside_it_where_a_firm_one_does():
+    """Physics alone: a pool cube moved into the standing body's head has contacts with it over 20 physics steps when
+    firm and none when loose (the collision bits the task sets)."""
+    env = gym.make(ENV, vision="oracle")
+    u = env.unwrapped
+    task = u.task
+    contacts = {}
+    for loose in (False, True):
+        env.reset(seed=0)
+        task.set_loose(np.full(sn.N_BLOCKS, loose))
+        d = u.data
+        head = d.xpos[mujoco.mj_name2id(u.model, mujoco.mjtObj.mjOBJ_BODY, "head")].copy()
+        d.mocap_pos[task._mocap[0]] = head + (0.0, 0.0, -0.05)
+        mujoco.mj_forward(u.model, d)
+        n = 0
+        for _ in range(20):
+            mujoco.mj_step(u.model, d)
+            n += sum(1 for g1, g2 in d.contact.geom.tolist() if task._block_geom[0] in (g1, g2))
+        contacts[loose] = n
+    assert contacts[False] > 0 and contacts[True] == 0, contacts
+    env.close()
+
+
+class _Eye:
+    def __init__(self):
+        self.pos = np.zeros(3)
+        self.rot = np.eye(3)  # column 0: the line of sight, +x
+
+
+@pytest.mark.parametrize("distance", [0.6, 0.8])
+def test_the_identity_percept_is_given_only_within_the_texture_s_crowding_limit(distance):
+    """A cube face of half-size 0.1 m at ``distance`` on a line of sight theta off the eye's: identified (its truth)
+    when theta - atan(0.1 / d) <= 2 atan(0.01 / d) (Bouma's 0.5 and the 1 cm texture, computed by hand here), not
+    beyond; and never on a step without a sample (a saccade, outside the field)."""
+    env = gym.make(ENV)
+    env.reset(seed=0)
+    task = env.unwrapped.task
+    task.attach_eye(_Eye(), env.unwrapped.retina, "foveated", 0.5)
+    limit = math.atan(0.1 / distance) + 2.0 * math.atan(0.01 / distance)
+    assert abs(pr.ident_eccentricity(distance) - 2.0 * math.atan(0.01 / distance)) < 1e-12
+    assert math.radians(1.3) < pr.ident_eccentricity(distance) < math.radians(2.0)
+    task._half[:] = 0.0
+    task._half[2] = 0.1
+    for loose, truth in ((True, -1.0), (False, 1.0)):
+        mask = np.zeros(sn.N_BLOCKS, dtype=bool)
+        mask[2] = loose
+        task.set_loose(mask)
+        for theta, expected in ((limit - 0.002, truth), (limit + 0.002, 0.0), (0.0, truth), (0.5, 0.0)):
+            task.targets[2].place(distance * math.cos(theta), distance * math.sin(theta), 0.0)
+            seen = [([0.0] * 3, [0.0] * 3, True)] * sn.N_BLOCKS
+            assert task._identify(seen)[2] == expected, (theta, limit)
+            unseen = [([0.0] * 3, [0.0] * 3, False)] * sn.N_BLOCKS
+            assert task._identify(unseen)[2] == 0.0  # no sample this step (saccadic suppression, field)
+    env.close()
+
+
+def test_no_identity_during_a_saccade_and_the_truth_on_the_oracle_and_full_view_rungs():
+    """On the foveated rung block_firm is 0 on every step whose observation was taken during a saccade (no
+    sample); the Oracle rung gives every placed cube's truth, the full-view rung every sampled cube's."""
+    env = gym.make(ENV, obs_mode="dict")
+    obs, _ = env.reset(seed=1)
+    loose = env.unwrapped.task.loose.copy()
+    a = np.zeros(env.action_space.shape, np.float32)
+    saccades = 0
+    for k in range(40):
+        a[5] = -1.0 if k % 8 == 0 else 0.0  # a 60 deg saccade to the right every 8 steps
+        obs, *_ = env.step(a)
+        if not np.any(obs["block_visible"]):
+            saccades += 1
+            assert not np.any(obs["block_firm"])
+        assert np.all(obs["block_firm"][obs["block_visible"] < 0.5] == 0.0)
+    assert saccades > 0
+    env.close()
+    n = len(env.unwrapped.task.block_faces)
+    for vision in ("oracle", "full_view"):
+        e = gym.make(ENV, vision=vision, obs_mode="dict")
+        o, _ = e.reset(seed=1)
+        np.testing.assert_array_equal(e.unwrapped.task.loose, loose)  # one seed, one scenario on every rung
+        np.testing.assert_array_equal(o["block_firm"][:n], np.where(loose[:n], -1.0, 1.0))
+        e.close()
+
+
+def test_exactly_one_of_the_two_cubes_nearest_the_shoulder_is_loose_and_the_geometry_is_unchanged(monkeypatch):
+    """Over 200 seeds: of the two cubes nearest the bracing shoulder (horizontal distance to the face centre)
+    exactly one is loose, and each of the others about half the time. The draws take nothing from the episode's
+    generator: with LOOSE_CUBES off, the same seed gives the same wall, push, side and (20 steps of a held pose)
+    every observation but the identity percept."""
+    others, n_others = 0, 0
+    for seed in range(200):
+        env = gym.make(ENV)
+        env.reset(seed=seed)
+        t = env.unwrapped.task
+        d = np.linalg.norm(t.block_faces[:, :2] - t.shoulder_world()[:2], axis=1)
+        order = np.argsort(d)
+        assert int(t.loose[order[:2]].sum()) == 1, seed
+        others += int(t.loose[order[2:]].sum())
+        n_others += len(order) - 2
+        env.close()
+    assert 0.4 < others / n_others < 0.6
+    zero = None
+    for seed in (0, 7):
+        runs = []
+        for on in (True, False):
+            monkeypatch.setattr(pr, "LOOSE_CUBES", on)
+            env = gym.make(ENV, obs_mode="dict")
+            obs, info = env.reset(seed=seed)
+            zero = np.zeros(env.action_space.shape, np.float32)
+            seq = [obs]
+            for _ in range(20):
+                seq.append(env.step(zero)[0])
+            t = env.unwrapped.task
+            runs.append((info, seq, t.loose.copy()))
+            env.close()
+        (ia, sa, la), (ib, sb, lb) = runs
+        assert la.any() and not lb.any()
+        for key in ("block_faces", "block_half_sizes", "push_time", "push_force", "push_dir", "wall_distance",
+                    "wall_side"):
+            np.testing.assert_array_equal(ia[key], ib[key], err_msg=key)
+        for oa, ob in zip(sa, sb):
+            for key in oa:
+                if key != "block_firm":
+                    np.testing.assert_array_equal(oa[key], ob[key], err_msg=key)
+
+
+def _lockstep(env_id: str, seed: int, flip: int, steps: int = 80):
+    """eom_brace plays ``seed``; a second env of the same seed with cube ``flip``'s identity flipped gets the same
+    actions. Returns the dict observations of both and the first step at which the played env's block_firm of that
+    cube is non-zero (None if never)."""
+    a = gym.make(env_id, obs_mode="dict")
+    b = gym.make(env_id, obs_mode="dict")
+    oa, _ = a.reset(seed=seed)
+    ob, _ = b.reset(seed=seed)
+    mask = b.unwrapped.task.loose.copy()
+    mask[flip] = not mask[flip]
+    b.unwrapped.task.set_loose(mask)
+    agent = make_agent("eom_brace", env_id, a.action_space.shape[0], seed=seed)
+    flat = a.unwrapped.layout
+    seq, first = [], None
+    for k in range(steps):
+        seq.append((oa, ob))
+        if first is None and oa["block_firm"][flip] != 0.0:
+            first = k
+            break
+        vec = np.concatenate([np.asarray(oa[blk.name], dtype=np.float32).reshape(-1) for blk in flat.blocks])
+        act, _ = agent.predict(vec)
+        oa, *_ = a.step(act)
+        ob, *_ = b.step(act)
+    a.close()
+    b.close()
+    return seq, first
+
+
+def test_no_observation_carries_a_cube_s_identity_until_it_is_fixated():
+    """The counterfactual scene: the same seed with the identity of the cube eom_brace looks at first flipped. Every
+    observation is identical until the step the eye identifies that cube (far outside the fovea before), and on
+    that step the identity percepts differ; on the Oracle rung they differ from the first observation."""
+    env = gym.make(ENV)
+    env.reset(seed=1)
+    t = env.unwrapped.task
+    cube = int(np.argmin(np.linalg.norm(t.block_faces[:, :2] - t.shoulder_world()[:2], axis=1)))
+    env.close()
+    seq, first = _lockstep(ENV, 1, cube)
+    assert first is not None and first > 5, first  # identified by a look, some steps in
+    for oa, ob in seq[:-1]:
+        for key in oa:
+            np.testing.assert_array_equal(oa[key], ob[key], err_msg=key)
+    oa, ob = seq[-1]
+    assert oa["block_firm"][cube] == -ob["block_firm"][cube] != 0.0
+    # The Oracle rung sees the flip on the first step after it (the flip is made after reset's observation).
+    a_, b_ = gym.make("PushRecoveryOracle-v0", obs_mode="dict"), gym.make("PushRecoveryOracle-v0", obs_mode="dict")
+    a_.reset(seed=1)
+    b_.reset(seed=1)
+    mask = b_.unwrapped.task.loose.copy()
+    mask[cube] = not mask[cube]
+    b_.unwrapped.task.set_loose(mask)
+    zero = np.zeros(a_.action_space.shape, np.float32)
+    oa, ob = a_.step(zero)[0], b_.step(zero)[0]
+    assert oa["block_firm"][cube] == -ob["block_firm"][cube] != 0.0
+
+
+def test_eom_brace_chooses_the_firm_cube_of_the_pair_it_identified():
+    """On the Oracle rung (every identity known) eom_brace's chosen cube is firm on seeds 0-9 (whichever of the two
+    nearest it is)."""
+    for seed in range(10):
+        env, agent, _info = _play("eom_brace", seed, "PushRecoveryOracle-v0")
+        assert agent.chosen is not None and not env.unwrapped.task.loose[agent.chosen], seed

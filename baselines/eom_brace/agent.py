@@ -38,6 +38,11 @@ before the push (the human field reaches 100 deg to each side), then that of the
 that never sees a cube (a static posture turned away from the wall) has none to brace on: the hand stays at its
 ready point, as the legs-only reference.
 
+Since the eleventh pass (loose cubes, seen only by central vision: the ``block_firm`` percept) the agent identifies
+before the push the cube nearest the shoulder, and the second nearest if the first is loose (``identify``), each look
+verged by the vergence search (``depth_search``, on for a foveated eye), and braces on the nearest cube believed firm
+(docs/reproductions/eom.md, eleventh pass).
+
 ``gaze_blind`` is the twin with gaze, vergence and head held (zero actions); the registered
 ``gaze_blind:eom_brace`` wrapper gives the same. ``use_hand=false`` is the legs-only reference: the same
 agent whose hand stays at its ready point.
@@ -132,13 +137,13 @@ class EomBraceParams:
     ray_plane_m: float = 0.7
     # ... and the chosen cube is looked at on its mean line of sight at that plane until its belief's best
     # sample weight reaches cut_until_w (1/m^2: a depth std of 1/sqrt(w), 400 = 5 cm; modelling choice)
-    cut_until_w: float = 400.0
+    cut_until_w: float = 25.0  # 400 before the eleventh pass (the looks before the push now measure the cubes)
     hand_on_cut: bool = True  # ... and the hand aims there too until then (modelling choice; on since the fourth pass)
     # verge_on_ray: the vergence distance of a look at a cube is its line of sight's cut with that plane, not
     # the belief's distance (a belief from peripheral samples is wrong mostly along the line of sight, and a
     # fixation verged at the wrong distance keeps the depth coarse: the depth pedestal; modelling choice).
     verge_on_ray: bool = True  # on since the fourth pass
-    verge_on_sample: bool = False
+    verge_on_sample: bool = True  # on since the eleventh pass (the looks at the cubes before the push)
     verge_ecc_deg: float = 5.0
     hand_ready: tuple = (0.1, -0.4, 0.27)  # stance frame: the hand waits beside the hip, toward the wall (modelling choice)
     # The reaction: saccade and hand start this long after the detection. Arm reactions to a perturbation
@@ -195,7 +200,7 @@ class EomBraceParams:
     # et al. 1989; Collewijn et al. 1995), until it is known within reach or beyond (posterior probability
     # search_sure, or search_max_s on one cube); after the push the brace chooses among the cubes believed within
     # reach (probability >= 0.5) and aims at the believed face given that it is within reach (modelling choices).
-    depth_search: bool = False
+    depth_search: bool = True  # on since the eleventh pass (with identify: the looks at the cubes verge on them)
     depth_grid_m: tuple = (0.3, 2.0)
     depth_grid_step_m: float = 0.02
     search_blocks: int = 3
@@ -240,6 +245,21 @@ class EomBraceParams:
     still_s: float = 0.5  # ... for this long before looking away (modelling choice)
     head_dead_zone_deg: float = 20.0  # Eyecatch Sec. 4.2 Eq. 17
     gaze_blind: bool = False
+    # identify (PushRecovery's eleventh pass: loose cubes, tasks.push_recovery.LOOSE_CUBES): before the push, once the
+    # wall has been looked at for ident_wall_s, the eye fixates the cube nearest the shoulder (by the horizontal
+    # distance of its mean line of sight's cut with the expected wall plane), and the second nearest if the first is
+    # identified loose (Johansson et al. 2001: gaze goes to the contact points before the hand; Eom section 7: gaze
+    # on the block's centre); the identities (the block_firm percept) are remembered. The scene's rule (exactly one
+    # of the two cubes nearest the shoulder is loose) completes the pair's identities once one is identified. After
+    # the push the hand goes to the nearest cube believed firm; of the two nearest, an unidentified one counts as
+    # possibly firm (a gamble when none is identified), a cube beyond them only ident_other_m farther; a cube
+    # believed loose only when no other is believed. Modelling choices.
+    identify: bool = True
+    ident_wall_s: float = 0.35
+    ident_other_m: float = 0.25
+    ident_scan: int = 2  # ... the cubes looked at before the push (modelling choice)
+    ident_measured_w: float = 25.0  # ... a cube placed by its fused estimate once a sample this precise came (1/m^2)
+    ident_choose: bool = True  # off: the looks only, the choice as without identities (a diagnostic)
     # The legs-only reference: the same agent with its hand kept at the ready point (no brace).
     use_hand: bool = True
 
@@ -248,7 +268,7 @@ class EomBraceParams:
             v = getattr(self, f.name)
             if f.name in ("foveated", "gaze_blind", "use_hand", "verge_on_sample", "fall_direction", "wall_normal",
                           "choose_by_ray", "drop_crowded", "verge_on_ray",
-                          "hand_on_cut", "verify_reach", "depth_search", "front_wall"):
+                          "hand_on_cut", "verify_reach", "depth_search", "front_wall", "identify", "ident_choose"):
                 if not isinstance(v, bool):
                     raise ValueError(f"EomBraceParams.{f.name} must be true or false, got {v!r}")
             elif f.name == "depth_grid_m":
@@ -293,6 +313,10 @@ class EomBraceAgent:
 
     def __init__(self, params: EomBraceParams | None = None, dt: float = 0.02, vision: VisionParams | None = None):
         self.params = params or EomBraceParams()
+        if self.params.depth_search and self.params.identify and not self.params.foveated:
+            # The vergence search is for the foveated eye's depth law; an eye without a periphery (the Oracle and
+            # FullView rungs) places every cube by its fused samples (measured: the search cost the Oracle rung).
+            self.params = replace(self.params, depth_search=False)
         p = self.params
         self.dt = float(dt)
         base = vision if vision is not None else VisionParams()  # the env's eye (for_env: its vision defaults)
@@ -358,9 +382,12 @@ class EomBraceAgent:
         self.still_since: float | None = None
         self.looked_away = False
         self.events: list[tuple[float, str]] = []
+        self.firm = np.zeros(N)  # identify: each cube's remembered identity, +1 firm, -1 loose, 0 unknown
 
     # --- belief -----------------------------------------------------------------------------------
     def estimate(self, i: int) -> np.ndarray:
+        if self.w[i] <= 0.0:  # identify with depth_search: only lines of sight recorded so far
+            return self._direction_cut(i, self.normal)
         return self.sum[i] / self.w[i]
 
     def _fuse(self, i: int, pos_eye: np.ndarray, rot: np.ndarray, eye: np.ndarray, fixation: float) -> None:
@@ -564,6 +591,13 @@ class EomBraceAgent:
             self.started = True
         self.poses.append((rot.copy(), eye.copy(), float(obs[_S["fixation"]][0])))
         self._pose_pairs.append((rot.copy(), eye.copy()))
+        if "block_firm" in _S:
+            fr = obs[_S["block_firm"]]
+            for i in range(N):
+                if fr[i] != 0.0:
+                    if self.firm[i] == 0.0:
+                        self.events.append((t, f"identified {i} {'firm' if fr[i] > 0 else 'loose'}"))
+                    self.firm[i] = 1.0 if fr[i] > 0 else -1.0
         if len(self.poses) == self.delay_steps + 1:
             r0, e0, f0 = self.poses[0]
             self._slip_pose = self._pose_pairs[0] if len(self._pose_pairs) == self.delay_steps + 2 else None
@@ -639,13 +673,37 @@ class EomBraceAgent:
         brace = 1.0
         look_at = None
         look_block = None
-        known = [i for i in range(N) if self.w[i] > 0]
+        known = [i for i in range(N) if self.w[i] > 0
+                 or (p.identify and p.depth_search and self.dir_n[i] > 0)]  # identify: a recorded line of sight
         search_look = False
         if t >= p.look_latency_s - 1e-9 and self._side_known:
             k = int((t - p.look_latency_s + 1e-9) // p.scan_dwell_s)
-            if p.depth_search and known and k >= len(p.scan_x_m) and self.detected_at is None:
+            if p.depth_search and known and k >= len(p.scan_x_m) and self.detected_at is None and not p.identify:
                 look_at, look_block = self._search_look(known, t)
                 search_look = True
+            elif p.identify and known \
+                    and t >= p.look_latency_s + p.ident_wall_s - 1e-9:
+                # Fixate, nearest first, the ident_scan cubes nearest the shoulder that are not yet identified (or
+                # measured: a fixated sample of weight >= ident_measured_w); then rest on the nearest believed firm.
+                yaw = p.search_yaw_deg * DEG
+                n0 = self._m(np.array([math.sin(yaw), -math.cos(yaw), 0.0])) if p.depth_search else self._look_normal
+                if self.detected_at is not None:
+                    n0 = n
+                order, belief = self._pair_beliefs(known, n0, full=True)
+                cand = order[:p.ident_scan]
+                todo = [i for i in cand if self.firm[i] == 0.0
+                        or (not p.depth_search and self.best_w[i] < p.ident_measured_w)]
+                if belief.get(order[0], 0.0) != 0.0 and len(order) > 1 and belief.get(order[1], 0.0) != 0.0:
+                    todo = [i for i in todo if i not in order[:2]]  # the pair known: look at nothing farther
+                    todo = []
+                firm = [i for i in order[:2] if belief[i] > 0.0]
+                tgt = todo[0] if todo else (firm[0] if firm else order[0])
+                if p.depth_search:  # along its line of sight, verged at its most probable distance
+                    look_at = self._depth_mode(tgt, n0)
+                    search_look = True
+                else:
+                    look_at = self._direction_cut(tgt, n0)
+                look_block = tgt
             elif p.scan_blocks <= 0:
                 look_at = self._m(np.array([p.scan_x_m[k % len(p.scan_x_m)], p.scan_y_m, p.scan_z_m]))
             elif k < len(p.scan_x_m) or not known:
@@ -678,6 +736,8 @@ class EomBraceAgent:
                 depth = faces @ n
                 if p.choose_by_ray:
                     faces = np.array([self._direction_cut(i, n) for i in known]) - self.shoulder
+                if p.identify and p.depth_search:
+                    faces = np.array([self._depth_point(i, n) for i in known]) - self.shoulder
                 lateral = np.linalg.norm(faces - np.outer(faces @ n, n), axis=1)
                 if p.depth_search and p.reach_max_m > 0:
                     # The cubes believed within reach (the vergence search's posterior), the nearest to the
@@ -721,6 +781,11 @@ class EomBraceAgent:
                         hand = obs[_S["left_hand_pos" if left else "hand_pos"]].copy()
                         hand_speed = float(np.linalg.norm(obs[_S["left_hand_vel" if left else "hand_vel"]]))
                         lateral = lat2
+                if p.identify and p.ident_choose:
+                    pair, belief = self._pair_beliefs(known, n)
+                    pen = np.array([10.0 if belief[i] < 0 else (0.0 if (i in pair or belief[i] > 0) else p.ident_other_m)
+                                    for i in known])
+                    lateral = lateral + pen
                 previous = self.chosen
                 self.chosen = known[int(np.argmin(lateral))]
                 if self.chosen != previous:
@@ -812,6 +877,27 @@ class EomBraceAgent:
                 if sample[0] > 0 and foveation.eccentricity(sample) < p.verge_ecc_deg * DEG:
                     fixation = float(np.linalg.norm(sample))
         return encode(target, brace, gaze, fixation, head, self.gaze_range, left=left)
+
+    def _pair_beliefs(self, known: list, n: np.ndarray, full: bool = False) -> tuple[list, dict]:
+        """identify: the two cubes nearest the shoulder (horizontal distance of their mean lines of sight's cuts with
+        the plane along ``n``) and every known cube's believed identity (+1 firm, -1 loose, 0 unknown): the
+        remembered one, the pair's completed by the scene's rule (exactly one of the two is loose)."""
+        w = self.params.ident_measured_w
+        if self.params.depth_search:
+            cuts = np.array([self._depth_point(i, n) for i in known]) - self.shoulder
+        else:
+            cuts = np.array([self.estimate(i) if self.best_w[i] >= w else self._direction_cut(i, n) for i in known]) \
+                - self.shoulder
+        order = [known[j] for j in np.argsort(np.linalg.norm(cuts[:, :2], axis=1), kind="stable")]
+        pair = order[:2]
+        belief = {i: float(self.firm[i]) for i in known}
+        if len(pair) == 2:
+            a, b = pair
+            if belief[a] != 0.0 and belief[b] == 0.0:
+                belief[b] = -belief[a]
+            elif belief[b] != 0.0 and belief[a] == 0.0:
+                belief[a] = -belief[b]
+        return (order if full else pair), belief
 
     def _m(self, p: np.ndarray) -> np.ndarray:
         """A point or direction of the scene given for the wall on the right: mirrored (y -> -y) for the wall on the

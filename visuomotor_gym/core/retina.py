@@ -145,6 +145,7 @@ class Retina:
     def __setstate__(self, state: dict) -> None:
         self.__dict__.update(state)
         self.__dict__.setdefault("_disarray", None)  # pickled before the positional disarray existed
+        self.__dict__.setdefault("last_samples", None)
         self._native = self._native and _native.enabled()  # unpickled where the extension is missing
         if "_periphery_constants" not in state:  # pickled before the compiled periphery existed
             self._periphery_constants = periphery_constants(self.params)
@@ -152,6 +153,7 @@ class Retina:
     def reset(self) -> None:
         self._delay: deque = deque(maxlen=self.delay_steps + 1)
         self._disarray = None
+        self.last_samples = None
 
     def draw_field(self, rng: np.random.Generator) -> None:
         """Draw this episode's positional-disarray field from ``rng``
@@ -169,6 +171,7 @@ class Retina:
             samples = [nothing() for _ in targets]
         else:
             samples = self._see_all(data, targets, eye, rng)
+        self.last_samples = samples  # this step's samples before the delay line (a task's percept of its time)
         if self.delay_steps:
             self._delay.append(samples)
             if len(self._delay) <= self.delay_steps:  # nothing has reached the brain yet

@@ -54,13 +54,17 @@ class PushRecoveryEnv(VisuomotorEnv):
     floor through real foot contact, the seated body's waist, its 7-DOF right arm and that arm mirrored as
     the left, the shared head and cyclopean eye; ``envs_assets/push.xml``) stands beside a **wall of cube
     blocks** (Eom et al. 2019, section 7) on its right or its left (drawn per episode, 50/50), the wall
-    turned 0-30 deg forward per episode. Between 0.6 and 1.4 s after the start
+    turned 0-30 deg forward per episode. Between 1.0 and 2.0 s after the start
     a **push** (a 150 ms horizontal force of 300-350 N on the torso, along the wall's normal within +-10 deg)
     tips it toward the wall: the legs hold their stance through position servos with an automatic ankle
     response to the extrapolated centre of mass, but cannot stop the fall (a centre of mass carried past the
     feet's edge falls). It stays upright only if a hand lands on a cube and holds: **there is nothing
     behind or between the cubes**, so a hand that lands in a gap, slides off an edge or stops short of
-    the wall does not hold. The wall's distance (0.60-0.80 m from the body's midline), each cube's size
+    the wall does not hold. Some cubes are **loose** (they give way under a hand: modelled as cubes that collide
+    with nothing, a simplification): of the two cubes nearest the bracing shoulder exactly one, each other cube with
+    probability 1/2; whether a cube is firm is seen only by **central vision** (``block_firm``: a line of sight within
+    2 atan(1 cm / d) of the cube's face, 1.4-1.9 deg at 0.6-0.8 m, from Bouma's law on a 1 cm texture; not during a
+    saccade). The wall's distance (0.60-0.80 m from the body's midline), each cube's size
     (14-22 cm), the gaps (12-30 cm), the cubes' heights (1.00-1.35 m) and how far each stands out of the
     wall (0-10 cm)
     are drawn per episode and reach the agent only as the eye's samples of the cubes' faces (foveated
@@ -99,15 +103,16 @@ class PushRecoveryEnv(VisuomotorEnv):
     Standing still, legs straight, feet at shoulder width (sole centres 32 cm apart), the hand in front of the belly, looking straight
     ahead (3 m away at 1.3 m height, with a 2 deg Gaussian jitter); the right arm drives, the left hangs.
     ``info`` at reset: ``block_faces`` ((n, 3) true face centres), ``block_half_sizes``, ``push_time``,
-    ``push_force``, ``push_dir``, ``wall_distance``, ``wall_side`` (-1 right, +1 left) (scoring only). The same seed gives the same wall and push on every rung.
+    ``push_force``, ``push_dir``, ``wall_distance``, ``wall_side`` (-1 right, +1 left), ``block_loose`` (scoring
+    only). The same seed gives the same wall and push on every rung.
 
     ## Episode End
 
     Terminated on **success** (``info["is_success"]``): upright 2.5 s after the push's onset; on a
     **fall** (``info["fallen"]``): a contact between the floor or a cube and any body geom other than
     the feet and the palm, or the head below 1.0 m (checked after every physics substep); or on a physics
-    divergence. Truncated by the registered ``max_episode_steps`` (200 steps = 4 s; never reached: the
-    push comes by 1.4 s and the episode ends 2.5 s later).
+    divergence. Truncated by the registered ``max_episode_steps`` (250 steps = 5 s; never reached: the
+    push comes by 2.0 s and the episode ends 2.5 s later).
 
     ## Arguments
 
@@ -138,6 +143,15 @@ class PushRecoveryEnv(VisuomotorEnv):
       angle (``human_periphery()``'s ``angular_lateral_noise``, on for every family): eom_brace 91.0 %, the
       held twin 23.5 %, the searched posture 46.0 %, the hand-picked posture toward the left wall 54.0 %, kept
       as the static twin (gaze gain +37.0; +45.0 against the searched posture).
+    * v0, redefined in place again (PushRecovery's eleventh pass): **loose cubes** (of the two cubes nearest the
+      bracing shoulder exactly one, each other cube with probability 1/2; a loose cube collides with nothing), seen
+      only by central vision: the observation gains ``block_firm`` (6 values, 119 in all; the action is unchanged);
+      the push comes 1.0-2.0 s after the start (0.6-1.4 s before) and episodes last 250 steps (200 before). The loose
+      draws take nothing from the episode's generator: every other draw of a seed is unchanged. On the pinned seeds
+      0-199 eom_brace (its new defaults: identification looks, the vergence search) keeps 90.0 % upright, the Oracle
+      rung 91.5 %; the best still posture found (the hand-picked one toward the left wall) 45.5 %, the static
+      search's posture 38.0 %, the held twin 16.0 %: gaze gain +44.5 (docs/reproductions/eom.md, eleventh pass).
+      Former leaderboard entries are superseded.
     """
 
     render_cameras: ClassVar[dict[str, tuple[str, ...]]] = {
@@ -198,6 +212,10 @@ class PushRecoveryEnv(VisuomotorEnv):
         self.hand = body.hand
         return body, task
 
+    def _assemble(self, **kw) -> None:
+        super()._assemble(**kw)
+        self.task.attach_eye(self.eye, self.retina, self.vision, self.vision_params.crowding_bouma)
+
 
 def _action_table() -> str:
     (x0, x1), (y0, y1), (z0, z1) = sn.HAND_WORKSPACE.tolist()
@@ -225,7 +243,7 @@ if PushRecoveryEnv.__doc__:
 # ---------------------------------------------------------------- the family record (visuomotor_gym.family)
 from visuomotor_gym.family import Family, Viz
 
-PUSH_MAX_EPISODE_STEPS = 200  # 4 s at 50 Hz: the push by 1.4 s, then 2.5 s to stay upright (never reached)
+PUSH_MAX_EPISODE_STEPS = 250  # 5 s at 50 Hz: the push by 2.0 s, then 2.5 s to stay upright (never reached)
 
 FAMILY = Family(
     name="push",

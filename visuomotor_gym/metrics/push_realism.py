@@ -2,8 +2,9 @@
 
 Per episode, from the trace (true scene, scoring only):
 
-* ``gaze_hand_lead_s``: the hand's first contact with a cube minus the first time gaze was within 5 deg
-  of that cube's face centre (Land, Mennie & Rusted 1999: gaze reaches an object ~0.56 s before the hand
+* ``gaze_hand_lead_s``: the hand's first contact with a cube minus the start of the last stretch of gaze
+  within 5 deg of that cube's face centre up to the contact (since PushRecovery's eleventh pass; before it,
+  the first time gaze was there: a look at the cube before the push, broken off, no longer counts) (Land, Mennie & Rusted 1999: gaze reaches an object ~0.56 s before the hand
   acts on it; Johansson et al. 2001: gaze leads the hand to contact points). Undefined without a contact.
 * ``hand_reaction_s``: the hand's movement onset after the push's onset (speed above 0.3 m/s); Maki &
   McIlroy's reviews put the onset of compensatory arm reactions ~100-150 ms after a perturbation
@@ -31,8 +32,8 @@ PUSH_REFERENCE = {
         "source": "Land, Mennie & Rusted 1999 (REFERENCES.md): gaze reaches an object ~0.56 s before the hand "
                   "acts on it; Johansson et al. 2001: gaze leads the hand to contact points. A push leaves less "
                   "time than a self-paced reach: the 0.1 s low bound is our choice.",
-        "notes": "Median over episodes with a hand contact of (first contact) - (first time gaze is within 5 deg "
-                 "of that cube's face centre); negative when the hand arrives first.",
+        "notes": "Median over episodes with a hand contact of (first contact) - (start of the last stretch of gaze "
+                 "within 5 deg of that cube's face centre up to the contact); negative when the hand arrives first.",
     },
     "hand_reaction_s": {
         "value": 0.15, "low": 0.1, "high": 0.25, "tolerance": 0.1, "unit": "s", "group": "hand",
@@ -70,9 +71,16 @@ def push_measures(trace) -> dict[str, float]:
         # the cube of the first contact: the face nearest the hand then
         block = int(np.argmin(np.linalg.norm(faces - hand[contact[0]], axis=1)))
         ecc = angles_deg(np.asarray(trace.gaze_dir, dtype=float), faces[block] - np.asarray(trace.eye_pos, dtype=float))
-        on = np.flatnonzero(ecc <= GAZE_ON_BLOCK_DEG)
-        if on.size:
-            out["gaze_hand_lead_s"] = float(t[contact[0]] - t[on[0]])
+        on = ecc[: contact[0] + 1] <= GAZE_ON_BLOCK_DEG
+        if on.any():
+            # the start of the last stretch of gaze on the cube up to the contact (the fixation that guides the
+            # hand, Land et al.'s lead); a look at it broken off earlier (a look-ahead fixation, Pelz & Canosa
+            # 2001) does not count
+            off = np.flatnonzero(~on)
+            last_on = int(np.flatnonzero(on)[-1])
+            before = off[off < last_on]
+            start = int(before[-1]) + 1 if before.size else 0
+            out["gaze_hand_lead_s"] = float(t[contact[0]] - t[start])
     return out
 
 

@@ -23,6 +23,7 @@ the palm, or the head below :data:`FALL_HEAD_HEIGHT_M` (checked after every phys
 from __future__ import annotations
 
 import math
+from collections import deque
 
 import mujoco
 import numpy as np
@@ -76,8 +77,12 @@ FIRST_BLOCK_X_M = (-0.35, -0.05)  # the row starts beside the body and runs forw
 PARKED = (-20.0, -20.0, -5.0)  # a parked block: 5 m under the floor, out of sight
 
 # --- the push --------------------------------------------------------------------------------------
-# Onset 0.6-1.4 s after the start (modelling choice: time to look around first, and unpredictable).
-PUSH_TIME_S = (0.6, 1.4)
+# Onset 1.0-2.0 s after the start (modelling choice: time to look around first, and unpredictable). 0.6-1.4 s before
+# PushRecovery's eleventh pass: with loose cubes the eye needs time to find the wall and fixate one or two cubes
+# (eom_brace identifies the first at ~0.4-0.5 s and the second at ~0.7 s, measured), and a push from 0.6 s cut that
+# scan short (eom_brace 177/200 at 0.6-1.4 s against 180/200 at 1.0-2.0 s on the pinned seeds; eom.md, eleventh
+# pass). The same uniform draw mapped onto the later range: every other draw of a seed is unchanged.
+PUSH_TIME_S = (1.0, 2.0)
 # A 150 ms shove: the duration of the waist-pull and shoulder-push perturbations of compensatory-reaction
 # studies is 100-300 ms (Maki & McIlroy 1997's reviews; REFERENCES.md marks their numbers unconfirmed):
 # modelling choice within that range.
@@ -122,6 +127,32 @@ FRONT_PUSH_SCALE = 0.72
 # across to the other side, into a side-looking eye's view (modelling choice; eom.md, tenth pass).
 FRONT_ROW_CENTRED = True
 
+# --- loose cubes and the foveal identity percept (PushRecovery's eleventh pass) --------------------------
+# Some cubes are LOOSE: they give way under a hand. Modelled in the simplest way: a loose cube's geom does not
+# collide (contype/conaffinity 0 for the episode), so a hand or a trunk goes through it as through a cube that
+# falls away (a modelling simplification: a real loose cube would be pushed off, not passed through). Whether a
+# cube is firm can be seen only with central vision (BLOCK_FIRM percept, below). Draw rule (modelling choice):
+# of the LOOSE_PAIR cubes nearest the bracing shoulder (horizontal distance from the shoulder to the face centre,
+# after the wall's side, yaw and front draws), exactly one is loose (a coin flip); every other cube is loose with
+# probability LOOSE_P. So a firm cube is always one of the nearest two, and an eye that picks the nearest by its
+# position alone picks a loose one half the time. The draws come from a generator of their own, jumped off the
+# episode's generator after every other draw of the task (``bit_generator.jumped()``: nothing is taken from the
+# episode's stream), so the wall, the push, the gaze jitter, the disarray field and every retinal noise draw of a
+# seed are those of the scene without loose cubes. False: every cube firm (the tenth pass's scene).
+LOOSE_CUBES = True
+LOOSE_PAIR = 2
+LOOSE_P = 0.5
+# The bracing shoulder (stance frame: the right shoulder, mirrored for a wall on the left; envs_assets/push.xml,
+# upper_arm; as baselines/eom_brace's SHOULDER). The stance origin is body.standing.STANCE_ORIGIN.
+BRACE_SHOULDER = (0.0, -0.2, 0.4)
+# The identity cue is a surface texture whose elements are TEXTURE_SPACING_M apart (modelling choice). By Bouma's
+# law (Bouma 1970: critical spacing = crowding_bouma x eccentricity, 0.5, the constant the vision model's crowding
+# uses, vision.foveation.VisionParams.crowding_bouma) an element among neighbours s deg apart is identified only
+# within s / 0.5 of the fovea: 2 x atan(0.01 m / d), 1.9 deg at 0.6 m, 1.4 deg at 0.8 m. A cube is identified on a
+# step when the eye is not in a saccade, the cube is sampled (visible) and the angular distance from the line of
+# sight to its face centre, minus the face's angular half-size (atan(half-size / d)), clamped at 0, is within that.
+TEXTURE_SPACING_M = 0.01
+
 # --- the outcome -----------------------------------------------------------------------------------
 HOLD_S = 2.5  # upright this long after the push's onset: success (modelling choice; Eom's clip ~2-3 s)
 FALL_HEAD_HEIGHT_M = 1.0  # the head body's origin (1.43 m standing) below this: fallen (modelling choice)
@@ -132,12 +163,21 @@ BLOCK_PERCEPT_BLOCKS = (
     Block("block_pos", 3 * sn.N_BLOCKS, "m",
           "perceived centre of each cube's face toward the body, eye frame at the sample (zeros when not seen)"),
     Block("block_visible", sn.N_BLOCKS, "0/1", "1 if this step produced a visual sample of the cube"),
+    Block("block_firm", sn.N_BLOCKS, "-1/0/1",
+          "the cube identified as firm (+1) or loose (-1) this step by central vision (its face within the "
+          "texture's crowding limit of the line of sight); 0 not identified"),
     Block("block_age", 1, "s", "age of the visual samples (the visual latency; 0 without delay)"),
 )
 TIME_BLOCK = Block("time", 1, "s", "time since the episode started")
 REWARD_TERMS = ("upright", "fall", "effort")
 SPARSE_WEIGHTS = {"upright": 1.0}
 SHAPED_WEIGHTS = {"upright": 1.0, "fall": -1.0, "effort": -0.001}
+
+
+def ident_eccentricity(distance_m: float, bouma: float = 0.5) -> float:
+    """The eccentricity (rad) within which a cube's texture is identified at ``distance_m``: the angular spacing of
+    its elements (:data:`TEXTURE_SPACING_M`) over Bouma's constant (Bouma 1970)."""
+    return math.atan(TEXTURE_SPACING_M / max(distance_m, 1e-9)) / bouma
 
 
 class PushRecoveryTask(Task):
@@ -163,6 +203,18 @@ class PushRecoveryTask(Task):
         self._post_mocap = [int(model.body_mocapid[b]) for b in posts]
         self._block_geom = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, n) for n in sn.BLOCKS]
         self._block_geoms = set(self._block_geom)
+        # The cubes' collision bits as the model has them (a firm cube's); a loose cube's are 0 for its episode.
+        self._contype = [int(model.geom_contype[g]) for g in self._block_geom]
+        self._conaffinity = [int(model.geom_conaffinity[g]) for g in self._block_geom]
+        self.loose = np.zeros(sn.N_BLOCKS, dtype=bool)
+        self._half = np.zeros(sn.N_BLOCKS)  # each pool cube's half-size this episode (0: parked)
+        # The eye, the retina and the rung (the env attaches them once assembled: attach_eye); the identity
+        # percept needs the eye's true line of sight and the retina's undelayed samples of this step.
+        self.eye = None
+        self.retina = None
+        self.vision_mode = "foveated"
+        self.bouma = 0.5
+        self.delay_steps = 0
         self._torso = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, names.TORSO)
         self._allowed = set(body.feet_geoms) | set(body.hand_geoms)
         self._hand = set(body.hand_geoms)
@@ -193,6 +245,13 @@ class PushRecoveryTask(Task):
         self.hand_block = -1
         self.first_contact_time: float | None = None
         self.visible = [False] * sn.N_BLOCKS
+        self._firm_line: deque = deque(maxlen=self.delay_steps + 1)  # the identity percepts' delay line
+
+    def attach_eye(self, eye, retina, vision_mode: str, bouma: float) -> None:
+        """The env's eye and retina (for the identity percept), its rung and the vision's Bouma constant."""
+        self.eye, self.retina, self.vision_mode, self.bouma = eye, retina, vision_mode, float(bouma)
+        self.delay_steps = int(retina.delay_steps)
+        self._firm_line = deque(maxlen=self.delay_steps + 1)
 
     def reset_episode(self, data: mujoco.MjData, rng: np.random.Generator) -> None:
         """Draw the wall (distance, then per cube: size, gap, height, offset), the push (time, force,
@@ -273,11 +332,78 @@ class PushRecoveryTask(Task):
         self.block_faces = np.array(faces)
         self.block_half_sizes = np.array(sizes)
         self.clutter_faces = self._place_clutter(rng, rows, wall, along, normal) if self.clutter else np.zeros((0, 3))
+        self._half[:] = [0.0 if r is None else r[1] for r in rows]
+        self._draw_loose(rng)
         if mirror:
             az = -az  # the push mirrored too: a seed's left wall is its right wall's mirror image
         c, sn_ = math.cos(az), math.sin(az)
         self.push_dir = np.array([c * normal[0] - sn_ * normal[1], sn_ * normal[0] + c * normal[1], 0.0])
         data.xfrc_applied[:] = 0.0
+
+    def shoulder_world(self) -> np.ndarray:
+        """The bracing shoulder (world) for this episode's wall side (:data:`BRACE_SHOULDER`)."""
+        s = np.array(BRACE_SHOULDER, dtype=float)
+        if self.wall_side > 0:
+            s[1] = -s[1]
+        return s + sn.STANCE_ORIGIN
+
+    def _draw_loose(self, rng: np.random.Generator) -> None:
+        """Which cubes are loose (:data:`LOOSE_CUBES`' rule), from a generator jumped off ``rng`` (nothing is
+        drawn from ``rng`` itself), and their collision bits."""
+        self.loose[:] = False
+        n = len(self.block_faces)
+        if LOOSE_CUBES and n:
+            bg = rng.bit_generator
+            g = np.random.Generator(bg.jumped()) if hasattr(bg, "jumped") else rng
+            d = np.linalg.norm(self.block_faces[:, :2] - self.shoulder_world()[:2], axis=1)
+            order = [int(i) for i in np.argsort(d, kind="stable")]  # active cubes are pool indices 0..n-1
+            pair = order[:LOOSE_PAIR]
+            self.loose[pair[int(g.integers(len(pair)))]] = True
+            for i in order[LOOSE_PAIR:]:
+                self.loose[i] = bool(g.random() < LOOSE_P)
+        self.set_loose(self.loose)
+
+    def set_loose(self, loose) -> None:
+        """Make the pool's cubes loose where ``loose`` is true (their geoms collide with nothing) and firm elsewhere
+        (the model's collision bits)."""
+        self.loose[:] = np.asarray(loose, dtype=bool)
+        m = self.model
+        for i, geom in enumerate(self._block_geom):
+            m.geom_contype[geom] = 0 if self.loose[i] else self._contype[i]
+            m.geom_conaffinity[geom] = 0 if self.loose[i] else self._conaffinity[i]
+
+    def _identify(self, raw: list) -> list:
+        """This step's identity percept (+1 firm, -1 loose, 0 not identified) of each pool cube, from the
+        retina's undelayed samples ``raw`` and the eye's true line of sight (see :data:`TEXTURE_SPACING_M`).
+        Oracle: every cube in the scene; full view (foveal vision everywhere): every sampled cube."""
+        out = [0.0] * sn.N_BLOCKS
+        mode = self.vision_mode
+        if mode != "oracle" and (self.eye is None or raw is None):
+            return out
+        if mode != "oracle":
+            e = self.eye.pos
+            axis = self.eye.rot[:, 0]
+        for i in range(sn.N_BLOCKS):
+            if self._half[i] <= 0.0 or self.targets[i].hidden:
+                continue
+            truth = -1.0 if self.loose[i] else 1.0
+            if mode == "oracle":
+                out[i] = truth
+                continue
+            if not raw[i][2]:
+                continue  # not sampled this step (outside the field, or a saccade in flight)
+            if mode == "full_view":
+                out[i] = truth
+                continue
+            r = self.targets[i].position - e
+            d = float(np.linalg.norm(r))
+            if d <= 0.0:
+                continue
+            ang = math.acos(max(-1.0, min(1.0, float(r @ axis) / d)))
+            ecc = max(0.0, ang - math.atan(self._half[i] / d))
+            if ecc <= ident_eccentricity(d, self.bouma):
+                out[i] = truth
+        return out
 
     def _place_clutter(self, rng: np.random.Generator, rows: list, wall: float, along: np.ndarray,
                        normal: np.ndarray) -> np.ndarray:
@@ -327,6 +453,7 @@ class PushRecoveryTask(Task):
 
     def trace_episode_fields(self) -> dict:
         return {"block_faces": self.block_faces.copy(), "block_half_sizes": self.block_half_sizes.copy(),
+                "block_loose": self.loose[: len(self.block_faces)].copy(),
                 "push_time": self.push_time, "push_force": self.push_force, "push_dir": self.push_dir.copy(),
                 "wall_distance": self.wall_distance, "wall_side": self.wall_side}
 
@@ -389,6 +516,9 @@ class PushRecoveryTask(Task):
             vis.append(1.0 if visible else 0.0)
         self.visible = [v > 0.5 for v in vis]
         values += vis
+        # The identity percept, computed at the sample's time and delayed as the retina delays the samples.
+        self._firm_line.append(self._identify(getattr(self.retina, "last_samples", None)))
+        values += self._firm_line[0] if len(self._firm_line) > self.delay_steps else [0.0] * sn.N_BLOCKS
         values.append(self.visual_delay_s)
 
     def observe_trailing(self, values: list, samples: list, data: mujoco.MjData) -> None:
