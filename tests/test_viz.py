@@ -270,6 +270,20 @@ def test_every_family_is_plotted_from_a_real_episode(family, tmp_path):
     assert np.mean(rgb.min(axis=2) < 200) > 0.03 and np.mean(np.ptp(rgb, axis=2) > 60) > 0.005
 
 
+def test_the_push_figure_hatches_exactly_the_loose_cubes():
+    from matplotlib.patches import Rectangle
+
+    trace = short_episode("PushRecovery-v0", "eom_brace", 30, seed=1)
+    loose = np.asarray(trace.task["block_loose"], dtype=bool)
+    assert loose.any() and (~loose).any()  # seed 1: cubes 0, 2, 4 and 5 loose (one of the nearest two always is)
+    wall = plots.episode_figure(trace).axes[0]
+    cubes = [p for p in wall.patches if isinstance(p, Rectangle)]
+    assert len(cubes) == len(loose)
+    assert [bool(p.get_hatch()) for p in cubes] == loose.tolist()
+    labels = [t.get_text() for t in wall.get_legend().get_texts()]
+    assert "loose cube (gives way)" in labels and "cube face" in labels
+
+
 def test_gaze_points_meet_the_floor_and_the_boxes():
     from visuomotor_gym.viz import family_plots as fp
 

@@ -45,10 +45,19 @@ def push_figure(trace):
     bal = fig.add_subplot(grid[1, 1], sharex=ang)
 
     first = int(np.argmin(np.linalg.norm(faces - hand[np.flatnonzero(touching)[0]], axis=1))) if touching.any() else -1
+    # loose cubes (PushRecovery's eleventh pass: they give way, told apart only by central vision); none before it
+    loose = np.zeros(len(faces), bool)
+    given = np.asarray(task.get("block_loose", loose), dtype=bool).reshape(-1)
+    loose[: min(len(given), len(faces))] = given[: len(faces)]
     for k, ((x, _y, z), h) in enumerate(zip(faces, halves)):
-        wall.add_patch(Rectangle((x - h, z - h), 2 * h, 2 * h, facecolor="#c89e5c", alpha=0.8,
+        firm_first = k == int(np.flatnonzero(~loose)[0]) if (~loose).any() else False
+        loose_first = k == int(np.flatnonzero(loose)[0]) if loose.any() else False
+        wall.add_patch(Rectangle((x - h, z - h), 2 * h, 2 * h, facecolor="#ead9b8" if loose[k] else "#c89e5c",
+                                 alpha=0.8, hatch="///" if loose[k] else None,
                                  edgecolor="k" if k == first else "0.4", lw=2.5 if k == first else 0.8,
-                                 label="cube face" if k == 0 else None))
+                                 label=("loose cube (gives way)" if loose_first else None) if loose[k]
+                                 else ("cube face" if firm_first else None)))
+        wall.text(x, z, str(k), ha="center", va="center", fontsize="small", color="0.2", clip_on=True)
     wall.plot(hand[:, 0], hand[:, 2], color=HAND_COLOR, lw=1.5, label="hand (palm centre)")
     y_wall = float(np.median(faces[:, 1]))
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -67,7 +76,8 @@ def push_figure(trace):
 
     angles = np.stack([angles_deg(gaze, f - eye) for f in faces], axis=1)
     for k in range(len(faces)):
-        ang.plot(t, angles[:, k], lw=0.8, alpha=0.6, label=f"cube {k}")
+        ang.plot(t, angles[:, k], lw=0.8, alpha=0.6, ls="--" if loose[k] else "-",
+                 label=f"cube {k}" + (" (loose)" if loose[k] else ""))
     ang.plot(t, angles.min(axis=1), color="k", lw=2, label="nearest cube")
     _onset_lines(ang, trace)
     ang.axvline(push_t, color="k", ls="--", label="shove onset")
