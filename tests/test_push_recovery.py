@@ -151,6 +151,21 @@ def test_the_body_falls_without_bracing(seed):
     assert env.unwrapped.task.fall_geoms is not None
 
 
+def _drive_hand(env, info, point):
+    """Drive the right hand (brace command on) beside ``point`` (world) until the push, then 2 cm beyond it, to the
+    episode's end: the last step's info."""
+    u = env.unwrapped
+    a = np.zeros(env.action_space.shape, np.float32)
+    a[3] = 1.0
+    while True:
+        pushed = u.data.time >= info["push_time"]
+        target = point + (0.0, -0.02, 0.0) if pushed else np.array([point[0], -0.4, point[2]])
+        a[:3] = sn.hand_target_action(target)
+        _obs, _r, terminated, truncated, step_info = env.step(a)
+        if terminated or truncated:
+            return step_info
+
+
 def test_a_hand_in_a_gap_does_not_hold(monkeypatch, tenth_pass):
     """The hand driven (true geometry) to the middle of the gap beside the cube nearest the shoulder: it
     passes between the cubes and the body falls; the same hand on that cube's face holds it. (The wall beside
@@ -161,21 +176,12 @@ def test_a_hand_in_a_gap_does_not_hold(monkeypatch, tenth_pass):
     for where in ("gap", "face"):
         env = gym.make(ENV, vision="oracle")
         _obs, info = env.reset(seed=4)
-        u = env.unwrapped
         faces, halves = info["block_faces"], info["block_half_sizes"]
         i = int(np.argmin(np.abs(faces[:, 0] - 0.05)))
         j = i + 1
         gap = 0.5 * ((faces[i, 0] + halves[i]) + (faces[j, 0] - halves[j]))
         point = faces[i].copy() if where == "face" else np.array([gap, faces[i, 1], 0.5 * (faces[i, 2] + faces[j, 2])])
-        a = np.zeros(env.action_space.shape, np.float32)
-        a[3] = 1.0
-        while True:
-            pushed = u.data.time >= info["push_time"]
-            target = point + (0.0, -0.02, 0.0) if pushed else np.array([point[0], -0.4, point[2]])
-            a[:3] = sn.hand_target_action(target)
-            _obs, _r, terminated, truncated, step_info = env.step(a)
-            if terminated or truncated:
-                break
+        step_info = _drive_hand(env, info, point)
         outcomes[where] = (step_info["is_success"], step_info["fallen"], step_info["first_contact_time"])
     assert outcomes["gap"][1] and outcomes["gap"][2] < 0, outcomes  # fell, never touched a cube
     assert outcomes["face"][2] > 0, outcomes  # touched the cube
@@ -805,16 +811,7 @@ def _drive_hand_into(cube_loose: bool, seed: int = 4):
     mask = np.zeros(sn.N_BLOCKS, dtype=bool)
     mask[i] = cube_loose
     u.task.set_loose(mask)
-    point = faces[i].copy()
-    a = np.zeros(env.action_space.shape, np.float32)
-    a[3] = 1.0
-    while True:
-        pushed = u.data.time >= info["push_time"]
-        target = point + (0.0, -0.02, 0.0) if pushed else np.array([point[0], -0.4, point[2]])
-        a[:3] = sn.hand_target_action(target)
-        _obs, _r, terminated, truncated, step_info = env.step(a)
-        if terminated or truncated:
-            break
+    step_info = _drive_hand(env, info, faces[i].copy())
     env.close()
     return step_info["fallen"], step_info["first_contact_time"], i
 

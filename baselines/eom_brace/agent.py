@@ -71,7 +71,7 @@ _LAYOUT = ObservationLayout(push_observation())
 _S = _LAYOUT.slices
 _NECK = neck_range_deg()
 N = sn.N_BLOCKS
-SHOULDER = np.array([0.0, -0.2, 0.4])  # right shoulder, stance frame (envs_assets/push.xml: upper_arm)
+SHOULDER = np.array(sn.RIGHT_SHOULDER)  # right shoulder, stance frame (envs_assets/push.xml: upper_arm)
 # The wall's side (PushRecovery's eighth pass: tasks.push_recovery.WALL_SIDE_RANDOM): every right-side constant below
 # (the shoulder, the hand's ready point, the scan's y, the expected wall normal) is mirrored (y -> -y) for a wall
 # on the left, and the left arm braces. Before the push the side is the sign of y of the cubes' lines of sight

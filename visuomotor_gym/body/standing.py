@@ -119,8 +119,11 @@ ALL_NAMES = {
 # proportions), axes of the world. A test checks it against the compiled model.
 STANCE_ORIGIN = np.array([0.0, 0.0, 0.93])
 STANCE_FRAME = FixedFrame(STANCE_ORIGIN)
+# The right shoulder in the stance frame (envs_assets/push.xml: upper_arm; the left one mirrored, y -> -y): the
+# task's bracing shoulder (which cubes are nearest it) and the eom_brace agent's.
+RIGHT_SHOULDER = (0.0, -0.2, 0.4)
 # Hand workspace of the hand_target action (stance frame, min/max, metres). Modelling choice: an arm's reach
-# (upper arm 0.29 m + forearm 0.265 m + hand) from its shoulder (0, -+0.2, 0.4) with the waist's help, and a body
+# (upper arm 0.29 m + forearm 0.265 m + hand) from its shoulder (RIGHT_SHOULDER, mirrored) with the waist's help, and a body
 # that leans up to ~30 deg toward a wall on its side: y from -1.1 (the right arm's far reach) to 1.1 (the left
 # arm's, mirrored; 0.3 before the left arm: the right arm's reach across the body).
 HAND_WORKSPACE = np.array([[-0.5, 0.7], [-1.1, 1.1], [-0.5, 0.9]])

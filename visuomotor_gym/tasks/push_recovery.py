@@ -142,9 +142,6 @@ FRONT_ROW_CENTRED = True
 LOOSE_CUBES = True
 LOOSE_PAIR = 2
 LOOSE_P = 0.5
-# The bracing shoulder (stance frame: the right shoulder, mirrored for a wall on the left; envs_assets/push.xml,
-# upper_arm; as baselines/eom_brace's SHOULDER). The stance origin is body.standing.STANCE_ORIGIN.
-BRACE_SHOULDER = (0.0, -0.2, 0.4)
 # The identity cue is a surface texture whose elements are TEXTURE_SPACING_M apart (modelling choice). By Bouma's
 # law (Bouma 1970: critical spacing = crowding_bouma x eccentricity, 0.5, the constant the vision model's crowding
 # uses, vision.foveation.VisionParams.crowding_bouma) an element among neighbours s deg apart is identified only
@@ -341,8 +338,9 @@ class PushRecoveryTask(Task):
         data.xfrc_applied[:] = 0.0
 
     def shoulder_world(self) -> np.ndarray:
-        """The bracing shoulder (world) for this episode's wall side (:data:`BRACE_SHOULDER`)."""
-        s = np.array(BRACE_SHOULDER, dtype=float)
+        """The bracing shoulder (world) for this episode's wall side (the body's ``RIGHT_SHOULDER``, mirrored for
+        a wall on the left)."""
+        s = np.array(sn.RIGHT_SHOULDER, dtype=float)
         if self.wall_side > 0:
             s[1] = -s[1]
         return s + sn.STANCE_ORIGIN

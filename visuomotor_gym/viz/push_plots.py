@@ -49,14 +49,14 @@ def push_figure(trace):
     loose = np.zeros(len(faces), bool)
     given = np.asarray(task.get("block_loose", loose), dtype=bool).reshape(-1)
     loose[: min(len(given), len(faces))] = given[: len(faces)]
+    labelled = set()  # one legend entry per kind
     for k, ((x, _y, z), h) in enumerate(zip(faces, halves)):
-        firm_first = k == int(np.flatnonzero(~loose)[0]) if (~loose).any() else False
-        loose_first = k == int(np.flatnonzero(loose)[0]) if loose.any() else False
+        kind = "loose cube (gives way)" if loose[k] else "cube face"
         wall.add_patch(Rectangle((x - h, z - h), 2 * h, 2 * h, facecolor="#ead9b8" if loose[k] else "#c89e5c",
                                  alpha=0.8, hatch="///" if loose[k] else None,
                                  edgecolor="k" if k == first else "0.4", lw=2.5 if k == first else 0.8,
-                                 label=("loose cube (gives way)" if loose_first else None) if loose[k]
-                                 else ("cube face" if firm_first else None)))
+                                 label=None if kind in labelled else kind))
+        labelled.add(kind)
         wall.text(x, z, str(k), ha="center", va="center", fontsize="small", color="0.2", clip_on=True)
     wall.plot(hand[:, 0], hand[:, 2], color=HAND_COLOR, lw=1.5, label="hand (palm centre)")
     y_wall = float(np.median(faces[:, 1]))
