@@ -61,35 +61,48 @@ DODGE_REFERENCE: dict[str, dict] = {
 }
 
 
-def pedestrian_fixations(trace) -> tuple[float, list[float]]:
-    """(share of the counted pedestrians fixated, latencies of the fixated ones) for one episode."""
+def first_fixations(trace) -> list[int | None]:
+    """Per pedestrian of the episode's crowd, the step at which its first fixation starts (the line of sight within
+    ``FIXATION_DEG`` of its seen point for at least ``FIXATION_MIN_S`` while it is ahead of the eye, after its
+    onset), None when it was never fixated."""
     t = np.asarray(trace.t, dtype=float)
     eye, gaze = np.asarray(trace.eye_pos, dtype=float), np.asarray(trace.gaze_dir, dtype=float)
     ped = np.asarray(trace.pedestrian_pos, dtype=float)  # (T, N, 3), NaN before onset
     crowd = np.asarray(trace.pedestrians, dtype=float).reshape(-1, 9)
-    dt = float(trace.dt)
-    need = max(int(round(FIXATION_MIN_S / dt)), 1)
+    need = max(int(round(FIXATION_MIN_S / float(trace.dt))), 1)
     cos_fix = math.cos(math.radians(FIXATION_DEG))
-    counted, fixated, latencies = 0, 0, []
+    starts: list[int | None] = []
     for i in range(crowd.shape[0]):
-        onset = crowd[i, 0]
-        if t[-1] - onset < MIN_PRESENT_S:
-            continue
-        counted += 1
         d = ped[:, i, :] - eye
         n = np.linalg.norm(d, axis=1)
         with np.errstate(invalid="ignore", divide="ignore"):
             cos = np.einsum("ij,ij->i", d, gaze) / n
         on = np.nan_to_num(cos, nan=-1.0) >= cos_fix
         on &= np.nan_to_num(d[:, 0], nan=-1.0) > 0.0  # ahead of the eye
-        on &= t >= onset - 1e-9  # parked before its onset
-        run = 0
+        on &= t >= crowd[i, 0] - 1e-9  # parked before its onset
+        start, run = None, 0
         for k, flag in enumerate(on.tolist()):
             run = run + 1 if flag else 0
             if run >= need:
-                fixated += 1
-                latencies.append(float(t[k - need + 1] - onset))
+                start = k - need + 1
                 break
+        starts.append(start)
+    return starts
+
+
+def pedestrian_fixations(trace) -> tuple[float, list[float]]:
+    """(share of the counted pedestrians fixated, latencies of the fixated ones) for one episode: the pedestrians
+    that appeared at least ``MIN_PRESENT_S`` before the end, fixated as :func:`first_fixations` has it."""
+    t = np.asarray(trace.t, dtype=float)
+    crowd = np.asarray(trace.pedestrians, dtype=float).reshape(-1, 9)
+    counted, fixated, latencies = 0, 0, []
+    for onset, start in zip(crowd[:, 0].tolist(), first_fixations(trace)):
+        if t[-1] - onset < MIN_PRESENT_S:
+            continue
+        counted += 1
+        if start is not None:
+            fixated += 1
+            latencies.append(float(t[start] - onset))
     return (fixated / counted if counted else float("nan")), latencies
 
 
