@@ -123,9 +123,9 @@ STANCE_FRAME = FixedFrame(STANCE_ORIGIN)
 # task's bracing shoulder (which cubes are nearest it) and the eom_brace agent's.
 RIGHT_SHOULDER = (0.0, -0.2, 0.4)
 # Hand workspace of the hand_target action (stance frame, min/max, metres). Modelling choice: an arm's reach
-# (upper arm 0.29 m + forearm 0.265 m + hand) from its shoulder (RIGHT_SHOULDER, mirrored) with the waist's help, and a body
-# that leans up to ~30 deg toward a wall on its side: y from -1.1 (the right arm's far reach) to 1.1 (the left
-# arm's, mirrored; 0.3 before the left arm: the right arm's reach across the body).
+# (upper arm 0.29 m + forearm 0.265 m + hand) from its shoulder (RIGHT_SHOULDER, mirrored) with the waist's help,
+# and a body that leans up to ~30 deg toward a wall on its side: y from -1.1 (the right arm's far reach) to 1.1
+# (the left arm's, mirrored; 0.3 before the left arm: the right arm's reach across the body).
 HAND_WORKSPACE = np.array([[-0.5, 0.7], [-1.1, 1.1], [-0.5, 0.9]])
 # Ready posture at reset (degrees): the seated body's (hand in front of the belly), modelling choice.
 READY_POSTURE_DEG = {"shoulder_flex": 30.0, "shoulder_abd": 10.0, "shoulder_rot": 0.0, "elbow": 80.0,

@@ -166,8 +166,8 @@ class ObstacleDodgeEnv(WalkerEnv):
         "crowd_distribution": ('``CrowdDistribution``, a dict of its fields, or a preset name: ``"wide"`` (the '
                                'default: singles and pairs from up to 70 deg off the perpendicular, one party '
                                'every 1-2 s), ``"wide_collision"`` (the same, most parties on a collision course), '
-                               '``"wide_give_way"`` (``"wide"`` with overtakers giving way), ``"groups"`` (pairs and triads from within 30 deg, the second '
-                               'definition) or ``"single"`` (every pedestrian alone, the first definition); '
+                               '``"wide_give_way"`` (``"wide"`` with overtakers giving way), ``"groups"`` (pairs '
+                               'and triads from within 30 deg, the second definition) or ``"single"`` (every pedestrian alone, the first definition); '
                                '``CROWD_PRESETS`` and ``DEFAULT_CROWD`` in ``visuomotor_gym.tasks.obstacle_dodge``'),
         "render_camera": '``"both"`` (top view beside the eye view), ``"side"``, ``"follow"``, ``"top"``, ``"eye"``',
     }

@@ -4,8 +4,9 @@ Per episode, from the trace (true scene, scoring only):
 
 * ``gaze_hand_lead_s``: the hand's first contact with a cube minus the start of the last stretch of gaze
   within 5 deg of that cube's face centre up to the contact (since PushRecovery's eleventh pass; before it,
-  the first time gaze was there: a look at the cube before the push, broken off, no longer counts) (Land, Mennie & Rusted 1999: gaze reaches an object ~0.56 s before the hand
-  acts on it; Johansson et al. 2001: gaze leads the hand to contact points). Undefined without a contact.
+  the first time gaze was there: a look at the cube before the push, broken off, no longer counts). Land,
+  Mennie & Rusted 1999: gaze reaches an object ~0.56 s before the hand acts on it; Johansson et al. 2001:
+  gaze leads the hand to contact points. Undefined without a contact.
 * ``hand_reaction_s``: the hand's movement onset after the push's onset (speed above 0.3 m/s); Maki &
   McIlroy's reviews put the onset of compensatory arm reactions ~100-150 ms after a perturbation
   (REFERENCES.md, marked unconfirmed: the range is our choice).

@@ -27,8 +27,8 @@ that do not veer are on a collision course with a walker going straight (45 % un
 adopted (it widens the gaze gain, but the moving eye then fixates more pedestrians than people do).
 
 **Give way** (``CrowdDistribution.give_way``, opt-in: on only in the preset ``"wide_give_way"``, off in ``"wide"``,
-the env's default, and in ``"wide_collision"``, ``"groups"`` and ``"single"``): the pedestrians otherwise walk straight (and veer) whatever the walker does, so one
-overtaking the walker from behind, outside the human field for seconds, would walk into its back, which no eye
+the env's default, and in ``"wide_collision"``, ``"groups"`` and ``"single"``): the pedestrians otherwise walk
+straight (and veer) whatever the walker does, so one overtaking the walker from behind, outside the human field for seconds, would walk into its back, which no eye
 looking ahead can prevent. In real crowds the one who sees the other and passes second, behind it, does most of
 the avoiding (Olivier et al. 2013; Knorr et al. 2016). A pedestrian behind the walker's frontal field (bearing from
 the walker's direction of travel beyond ``give_way_bearing_deg`` = 90 deg), with the walker ahead in its own frontal
@@ -73,7 +73,7 @@ control step (closing speeds are <= 3.4 m/s: <= 7 cm per 20 ms step).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import mujoco
 import numpy as np
@@ -244,16 +244,13 @@ class CrowdDistribution:
 # pedestrian whose predicted distance of closest approach is under ~1 m (Olivier et al. 2012), so a crossing that
 # misses by more asks nothing of the eye or the legs. Modelling choice, with its sweep on that page.
 DEFAULT_CROWD = "wide"  # the env's crowd when none is given (see CROWD_PRESETS)
+_WIDE = CrowdDistribution(angle_deg=WIDE_ANGLE_DEG, side_m=WIDE_SIDE_M, group_size=WIDE_GROUP_SIZE,
+                          onset_gap_s=WIDE_ONSET_GAP_S)
 CROWD_PRESETS = {"groups": CrowdDistribution(), "single": CrowdDistribution(group_size=(1.0, 1.0)),
-                 "wide": CrowdDistribution(angle_deg=WIDE_ANGLE_DEG, side_m=WIDE_SIDE_M,
-                                           group_size=WIDE_GROUP_SIZE, onset_gap_s=WIDE_ONSET_GAP_S),
-                 "wide_collision": CrowdDistribution(angle_deg=WIDE_ANGLE_DEG, side_m=WIDE_SIDE_M,
-                                                     group_size=WIDE_GROUP_SIZE, onset_gap_s=WIDE_ONSET_GAP_S,
-                                                     timing_s=COLLISION_TIMING_S),
+                 "wide": _WIDE,
+                 "wide_collision": replace(_WIDE, timing_s=COLLISION_TIMING_S),
                  # "wide" with overtakers giving way (opt-in; measured: the gaze gain falls, dodge_groups.md)
-                 "wide_give_way": CrowdDistribution(angle_deg=WIDE_ANGLE_DEG, side_m=WIDE_SIDE_M,
-                                                    group_size=WIDE_GROUP_SIZE, onset_gap_s=WIDE_ONSET_GAP_S,
-                                                    give_way=True)}
+                 "wide_give_way": replace(_WIDE, give_way=True)}
 
 
 @dataclass(frozen=True)

@@ -48,7 +48,8 @@ def push_figure(trace):
     # loose cubes (PushRecovery's eleventh pass: they give way, told apart only by central vision); none before it
     loose = np.zeros(len(faces), bool)
     given = np.asarray(task.get("block_loose", loose), dtype=bool).reshape(-1)
-    loose[: min(len(given), len(faces))] = given[: len(faces)]
+    n = min(len(given), len(faces))
+    loose[:n] = given[:n]
     labelled = set()  # one legend entry per kind
     for k, ((x, _y, z), h) in enumerate(zip(faces, halves)):
         kind = "loose cube (gives way)" if loose[k] else "cube face"
