@@ -237,7 +237,9 @@ class DodgeBeliefMPCAgent(FajenWarrenAgent):
             hold = int(math.ceil((p.min_fixation_s - (t - self._landed)) / p.plan_dt_s - 1e-9))
         if current >= 0 and not self._in_saccade and keys[current][0] == "ped":
             self._fixated.add(keys[current][1])  # the line of sight is on it, or its fixation is held
-        best = self._first_look(keys, closest, t) if hold == 0 and not self._in_saccade else None
+        # a first look waits for the present fixation's minimum duration, whatever it was on
+        settled = not self._in_saccade and t - self._landed >= p.min_fixation_s
+        best = self._first_look(keys, closest, t) if settled else None
         if best is None:
             best = self._plan(eye, gaze, pos0, vel, sig0, weights, current, hold)
         self.choice = keys[best]

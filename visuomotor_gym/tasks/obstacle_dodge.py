@@ -24,7 +24,8 @@ definition). **The env's default crowd is the preset ``"wide"``** (``DEFAULT_CRO
 from 3-8 m to the side, so that the threats come from bearings no single posture of the eye covers. The opt-in
 preset ``"wide_collision"`` is the same crowd with the timing within +-0.5 s, so that about three crossers in four
 that do not veer are on a collision course with a walker going straight (45 % under ``"wide"``); measured, not
-adopted (it widens the gaze gain, but the moving eye then fixates more pedestrians than people do).
+adopted (it widens the gaze gain only while the moving eye fixates more pedestrians than people do; with
+fixations in the human range the gain is +37, as under ``"wide"``).
 
 **Give way** (``CrowdDistribution.give_way``, opt-in: on only in the preset ``"wide_give_way"``, off in ``"wide"``,
 the env's default, and in ``"wide_collision"``, ``"groups"`` and ``"single"``): the pedestrians otherwise walk
