@@ -32,6 +32,10 @@ radius, 0.25 m here, it is ~1e-7 at 1 m and does not pull the gaze). This agent 
   (``threat_weight``, ``relevant_only``); the fixation is verged (``verge``) and held at least
   ``min_fixation_s``. Without these the planner looked at the nearest pedestrians, threat or not, and
   reached the goal on 26/60 of seeds 0-59.
+* **First looks** (opt-in, ``first_look``; off by default): a pedestrian not fixated yet is looked at before the
+  plan runs, so that it is first fixated about as soon after it appears as people do (the plan alone, whose
+  noise model has the acuity law only, held a near threat for seconds); measured in
+  docs/reproductions/data/terrain/dodge_groups.md ("The fourth definition with fixation counts in the human range").
 
 Every other constant is ``fajen_warren``'s.
 """
@@ -235,11 +239,13 @@ class DodgeBeliefMPCAgent(FajenWarrenAgent):
         if p.min_fixation_s > 0.0 and not self._in_saccade and self.choice in keys and t - self._landed < p.min_fixation_s:
             current = keys.index(self.choice)  # the fixation is held for its minimum duration
             hold = int(math.ceil((p.min_fixation_s - (t - self._landed)) / p.plan_dt_s - 1e-9))
-        if current >= 0 and not self._in_saccade and keys[current][0] == "ped":
-            self._fixated.add(keys[current][1])  # the line of sight is on it, or its fixation is held
-        # a first look waits for the present fixation's minimum duration, whatever it was on
-        settled = not self._in_saccade and t - self._landed >= p.min_fixation_s
-        best = self._first_look(keys, closest, t) if settled else None
+        best = None
+        if p.first_look:
+            if current >= 0 and not self._in_saccade and keys[current][0] == "ped":
+                self._fixated.add(keys[current][1])  # the line of sight is on it, or its fixation is held
+            # a first look waits for the present fixation's minimum duration, whatever it was on
+            if not self._in_saccade and t - self._landed >= p.min_fixation_s:
+                best = self._first_look(keys, closest, t)
         if best is None:
             best = self._plan(eye, gaze, pos0, vel, sig0, weights, current, hold)
         self.choice = keys[best]
