@@ -19,7 +19,7 @@ from visuomotor_gym import handpath
 from visuomotor_gym.bench.trace import EpisodeTrace
 from visuomotor_gym.metrics import gaze as G
 from visuomotor_gym.metrics import strategy
-from visuomotor_gym.metrics.dodge_realism import DODGE_REFERENCE, dodge_gaze_realism
+from visuomotor_gym.metrics.dodge_realism import DODGE_REFERENCE, dodge_gaze_realism, first_run
 from visuomotor_gym.metrics.reach_realism import REACH_REFERENCE, reach_measures, reach_realism
 from visuomotor_gym.metrics.realism import (
     GROUPS,
@@ -465,3 +465,11 @@ def test_lookahead_scores_high_and_its_held_twin_low_on_real_episodes():
     assert blind["score"] <= 0.5, blind
     held = blind["components"]["fixation_duration_s"]  # the held eye never saccades: undefined, scored 0
     assert held["episodes"] == 0 and held["score"] == 0.0
+
+
+def test_dodge_first_run_is_the_start_of_the_first_long_enough_run():
+    """A fixation starts at the first step of the first run of at least FIXATION_MIN_S on the pedestrian."""
+    assert first_run([False, True, True, False, True, True, True], 3) == 4
+    assert first_run([True, True, True], 3) == 0
+    assert first_run([True, True, False, True], 3) is None
+    assert first_run([], 1) is None

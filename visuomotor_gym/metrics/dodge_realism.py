@@ -80,14 +80,18 @@ def first_fixations(trace) -> list[int | None]:
         on = np.nan_to_num(cos, nan=-1.0) >= cos_fix
         on &= np.nan_to_num(d[:, 0], nan=-1.0) > 0.0  # ahead of the eye
         on &= t >= crowd[i, 0] - 1e-9  # parked before its onset
-        start, run = None, 0
-        for k, flag in enumerate(on.tolist()):
-            run = run + 1 if flag else 0
-            if run >= need:
-                start = k - need + 1
-                break
-        starts.append(start)
+        starts.append(first_run(on, need))
     return starts
+
+
+def first_run(on, need: int) -> int | None:
+    """The first step of the first run of at least ``need`` consecutive true values of ``on``, None without one."""
+    run = 0
+    for k, flag in enumerate(np.asarray(on, dtype=bool).tolist()):
+        run = run + 1 if flag else 0
+        if run >= need:
+            return k - need + 1
+    return None
 
 
 def pedestrian_fixations(trace) -> tuple[float, list[float]]:

@@ -42,13 +42,7 @@ def first_fixations_aoi(trace) -> list:
         on = best <= HALF_WIDTH_M + along * math.tan(math.radians(MARGIN_DEG))
         on &= np.nan_to_num(p[:, 0] - eye[:, 0], nan=-1.0) > 0.0
         on &= t >= crowd[i, 0] - 1e-9
-        start, run = None, 0
-        for k, flag in enumerate(on.tolist()):
-            run = run + 1 if flag else 0
-            if run >= need:
-                start = k - need + 1
-                break
-        starts.append(start)
+        starts.append(dr.first_run(on, need))
     return starts
 
 
